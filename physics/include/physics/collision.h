@@ -1,0 +1,53 @@
+// Contact manifolds between two shapes, and the queries that produce them.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "physics/math.h"
+#include "physics/shape.h"
+
+namespace tumble {
+
+struct ContactPoint {
+  Vec3 point_a;  // m, world: on (or inside) the surface of A
+  Vec3 point_b;  // m, world: on (or inside) the surface of B
+  // m: penetration along the normal, > 0 when overlapping, < 0 for a speculative contact
+  // separated by that gap.
+  double depth = 0;
+  // Names the pair of features (faces, edges, vertices) that made the point; the same while the
+  // same features touch, so a solver can carry impulses over from step to step.
+  std::uint64_t feature_id = 0;
+};
+
+struct ContactManifold {
+  Vec3 normal = Vec3::UnitZ();  // unit, world, from A towards B: moving B along it separates them
+  std::array<ContactPoint, 4> points;
+  int count = 0;
+};
+
+enum class NarrowPhaseMethod : std::uint8_t {
+  kAuto,    // the fastest exact method for each shape pair (SAT for polytopes)
+  kGjkEpa,  // GJK and EPA for every pair of convex shapes (for comparison and testing)
+};
+
+struct CollisionSettings {
+  // m: pairs separated by less than this still produce (speculative) contacts.
+  double margin = 0;
+  NarrowPhaseMethod method = NarrowPhaseMethod::kAuto;
+};
+
+// Outcome flags a query raises; a query that hits an iteration bound still returns its best answer.
+enum CollisionFlags : std::uint32_t {
+  kCollisionOk = 0,
+  kGjkIterationLimit = 1u << 0,
+  kEpaIterationLimit = 1u << 1,
+  kEpaDegenerate = 1u << 2,
+};
+
+// Contacts between shape `a` at `pose_a` and shape `b` at `pose_b`. Returns the flags; `out->count`
+// is 0 when the shapes are farther apart than the margin. Two half-spaces never collide.
+std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                      const CollisionSettings& settings, ContactManifold* out);
+
+}  // namespace tumble

@@ -1,0 +1,82 @@
+// Convex shapes. Each is made from a definition struct, validated on creation, and is immutable
+// afterwards so that many bodies can share one.
+#pragma once
+
+#include <memory>
+#include <variant>
+#include <vector>
+
+#include "physics/math.h"
+#include "physics/polyhedron.h"
+#include "physics/status.h"
+
+namespace tumble {
+
+// A ball. radius: m, > 0.
+struct SphereDef {
+  double radius = 0.5;
+};
+// A segment from (0,0,-half_height) to (0,0,+half_height) swept by a ball.
+// radius: m, > 0; half_height: m, > 0 (half the length of the cylindrical part).
+struct CapsuleDef {
+  double radius = 0.25;
+  double half_height = 0.5;
+};
+// The box [-h, h]^3. half_extents: m, each > 0.
+struct BoxDef {
+  Vec3 half_extents = Vec3::Constant(0.5);
+};
+// The convex hull of `points` (m, in the body frame). At least 4 points spanning a volume;
+// duplicates, interior and coplanar points are fine.
+struct HullDef {
+  std::vector<Vec3> points;
+};
+// The solid region z <= 0 of its frame (an infinite ground); its surface normal is the frame's +z.
+// Only static bodies may use it.
+struct HalfSpaceDef {};
+
+using ShapeDef = std::variant<SphereDef, CapsuleDef, BoxDef, HullDef, HalfSpaceDef>;
+
+// Ordered so that collision dispatch can always put the lower type first.
+enum class ShapeType : std::uint8_t { kSphere, kCapsule, kBox, kHull, kHalfSpace };
+const char* shape_type_name(ShapeType type);
+
+struct MassProperties {
+  double mass = 0;                      // kg
+  Vec3 center_of_mass = Vec3::Zero();   // m, shape frame
+  Mat3 inertia = Mat3::Zero();          // kg m^2, about the centre of mass, shape-frame axes
+};
+
+class Shape {
+ public:
+  // Validates the definition; the message names the bad field ("half_extents[1]: must be > 0").
+  static Result<Shape> create(const ShapeDef& def);
+
+  ShapeType type() const { return type_; }
+  double radius() const { return radius_; }            // sphere, capsule
+  double half_height() const { return half_height_; }  // capsule
+  const Vec3& half_extents() const { return half_extents_; }  // box
+  // The polyhedron of a box or hull; null for the other shapes.
+  const ConvexPolyhedron* polyhedron() const { return polyhedron_.get(); }
+
+  // Bounds in the shape frame; infinite for a half-space.
+  Aabb local_bounds() const;
+  double volume() const;  // m^3; infinite for a half-space
+  // Mass properties for a uniform density (kg/m^3).
+  MassProperties mass_properties(double density) const;
+  // A length that sets the scale of numerical tolerances: the largest half extent.
+  double size() const;
+  // The point of the shape farthest along `direction` (shape frame).
+  Vec3 support(const Vec3& direction) const;
+  // The same shape moved so that `offset` (shape frame) becomes the origin.
+  Shape recentred(const Vec3& offset) const;
+
+ private:
+  ShapeType type_ = ShapeType::kSphere;
+  double radius_ = 0;
+  double half_height_ = 0;
+  Vec3 half_extents_ = Vec3::Zero();
+  std::shared_ptr<const ConvexPolyhedron> polyhedron_;
+};
+
+}  // namespace tumble

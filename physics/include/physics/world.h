@@ -1,0 +1,87 @@
+// The world: owns bodies and finds which of them touch. Stepping (integration and contact
+// response) arrives with the solvers.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "physics/body.h"
+#include "physics/collision.h"
+#include "physics/math.h"
+#include "physics/status.h"
+
+namespace tumble {
+
+enum class BroadPhaseMethod : std::uint8_t {
+  kAuto,           // the world chooses (sweep-and-prune for few bodies, the grid otherwise)
+  kHashGrid,       // hierarchical hashed uniform grids, built in parallel
+  kSweepAndPrune,  // sort on x, sweep
+};
+
+struct WorldSettings {
+  Vec3 gravity = Vec3(0, 0, -9.81);  // m/s^2
+  int threads = 0;                   // OpenMP threads for the step; 0 = OpenMP's default
+  BroadPhaseMethod broad_phase = BroadPhaseMethod::kAuto;
+  CollisionSettings collision;
+};
+
+// A pair of bodies whose bounding boxes overlap; `a` < `b` by body index.
+struct BodyPair {
+  std::uint32_t a, b;
+  auto operator<=>(const BodyPair&) const = default;
+};
+
+struct Contact {
+  BodyId a, b;
+  ContactManifold manifold;
+};
+
+class World {
+ public:
+  explicit World(const WorldSettings& settings = {});
+
+  // Creates one body, or none and says why.
+  Result<BodyId> create_body(const BodyDef& def);
+  // Creates all bodies or none; a failure names the definition ("bodies[3].mass: must be > 0").
+  Result<std::vector<BodyId>> create_bodies(std::span<const BodyDef> defs);
+  Status remove_body(BodyId id);
+
+  bool contains(BodyId id) const;
+  // The body, or null when `id` is stale or was never made.
+  const Body* body(BodyId id) const;
+  BodyId id_at(std::uint32_t index) const;  // the live body in slot `index`, or an invalid id
+  std::size_t body_count() const { return live_count_; }
+  std::uint32_t slot_count() const { return static_cast<std::uint32_t>(bodies_.size()); }
+
+  const WorldSettings& settings() const { return settings_; }
+  void set_broad_phase(BroadPhaseMethod method) { settings_.broad_phase = method; }
+
+  // Broad phase: pairs of bodies whose world bounds (grown by the contact margin) overlap, at
+  // least one of them dynamic, sorted, unique.
+  std::span<const BodyPair> find_pairs();
+  // Broad and narrow phase: every touching pair's manifold, in pair order.
+  std::span<const Contact> find_contacts();
+  // Flags raised by the narrow phase in the last find_contacts() (see CollisionFlags).
+  std::uint32_t collision_flags() const { return collision_flags_; }
+
+ private:
+  struct Slot {
+    Body body;
+    std::uint32_t generation = 0;
+    bool alive = false;
+  };
+  void compute_bounds();
+
+  WorldSettings settings_;
+  std::vector<Slot> bodies_;
+  std::vector<std::uint32_t> free_slots_;
+  std::size_t live_count_ = 0;
+  std::vector<Aabb> bounds_;
+  std::vector<std::uint8_t> movable_;
+  std::vector<BodyPair> pairs_;
+  std::vector<Contact> contacts_;
+  std::uint32_t collision_flags_ = 0;
+};
+
+}  // namespace tumble

@@ -1,0 +1,73 @@
+#include <cmath>
+#include <string>
+
+#include "physics/body.h"
+
+namespace tumble {
+namespace {
+
+Status check_vector(const Vec3& v, const char* field) {
+  for (int k = 0; k < 3; ++k)
+    if (!is_finite(v[k]))
+      return Status::error(std::string(field) + "[" + std::to_string(k) + "]: must be finite");
+  return Status::ok();
+}
+
+}  // namespace
+
+Status validate(const BodyDef& def) {
+  const bool is_half_space = std::holds_alternative<HalfSpaceDef>(def.shape);
+  if (is_half_space && def.type != BodyType::kStatic)
+    return Status::error("type: a half_space must be static");
+  if (Status s = check_vector(def.position, "position"); !s) return s;
+  if (!is_finite(def.orientation)) return Status::error("orientation: must be finite");
+  const double norm = def.orientation.norm();
+  if (std::abs(norm - 1) > 1e-3)
+    return Status::error("orientation: must be a unit quaternion (norm is " +
+                         std::to_string(norm) + ")");
+  if (Status s = check_vector(def.linear_velocity, "linear_velocity"); !s) return s;
+  if (Status s = check_vector(def.angular_velocity, "angular_velocity"); !s) return s;
+  if (!is_finite(def.mass) || def.mass < 0) return Status::error("mass: must be finite and >= 0");
+  if (def.type == BodyType::kDynamic && def.mass == 0 && !(def.density > 0 && is_finite(def.density)))
+    return Status::error("density: must be finite and > 0 when mass is 0");
+  if (!is_finite(def.friction) || def.friction < 0)
+    return Status::error("friction: must be finite and >= 0");
+  if (!is_finite(def.restitution) || def.restitution < 0 || def.restitution > 1)
+    return Status::error("restitution: must be in [0, 1]");
+  return Status::ok();
+}
+
+Result<Body> make_body(const BodyDef& def) {
+  if (Status s = validate(def); !s) return s;
+  Result<Shape> shape = Shape::create(def.shape);
+  if (!shape) return shape.status().within("shape.");
+
+  Body body;
+  body.type = def.type;
+  body.orientation = def.orientation.normalized();
+  body.linear_velocity = def.linear_velocity;
+  body.angular_velocity = def.angular_velocity;
+  body.friction = def.friction;
+  body.restitution = def.restitution;
+
+  const double density = def.mass > 0 ? def.mass / shape.value().volume() : def.density;
+  MassProperties props = shape.value().mass_properties(
+      def.type == BodyType::kStatic && !std::isfinite(shape.value().volume()) ? 1.0 : density);
+  body.shape = shape.value().recentred(props.center_of_mass);
+  body.position = def.position + body.orientation * props.center_of_mass;
+
+  if (def.type == BodyType::kDynamic) {
+    if (!(props.mass > 0) || !std::isfinite(props.mass))
+      return Status::error("mass: the shape's mass is not a positive number");
+    body.mass = props.mass;
+    body.inverse_mass = 1.0 / props.mass;
+    body.inertia_body = props.inertia;
+    body.inverse_inertia_body = props.inertia.inverse();
+    if (!body.inverse_inertia_body.allFinite())
+      return Status::error("shape: its inertia tensor is singular");
+  }
+  body.update_world_inertia();
+  return body;
+}
+
+}  // namespace tumble

@@ -1,0 +1,172 @@
+#include "broad_phase.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace tumble {
+namespace {
+
+constexpr int kMaxLevels = 48;
+
+std::uint64_t cell_key(int level, std::int64_t x, std::int64_t y, std::int64_t z) {
+  // SplitMix64 finaliser over the packed cell: equal cells give equal keys; a collision between
+  // different cells only adds candidates, which the exact box test removes.
+  std::uint64_t h = static_cast<std::uint64_t>(level) * 0x9E3779B97F4A7C15ull;
+  for (std::int64_t c : {x, y, z}) {
+    h ^= static_cast<std::uint64_t>(c) + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+    h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
+    h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
+    h ^= h >> 31;
+  }
+  return h;
+}
+
+bool is_dead(const Aabb& box) { return !(box.min.x() <= box.max.x()); }
+
+}  // namespace
+
+void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
+  pairs->clear();
+  const auto& bounds = input.bounds;
+  const std::size_t n = bounds.size();
+  const int threads = std::max(1, input.threads);
+  thread_entries_.resize(threads);
+  thread_pairs_.resize(threads);
+
+  // Base cell size: the median extent of the bounded bodies.
+  sizes_.clear();
+  unbounded_.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (is_dead(bounds[i])) continue;
+    if (!bounds[i].is_bounded()) {
+      unbounded_.push_back(i);
+      continue;
+    }
+    sizes_.push_back(bounds[i].extent().maxCoeff());
+  }
+  double base = 1.0;
+  if (!sizes_.empty()) {
+    auto middle = sizes_.begin() + static_cast<std::ptrdiff_t>(sizes_.size() / 2);
+    std::nth_element(sizes_.begin(), middle, sizes_.end());
+    if (*middle > 0) base = *middle;
+  }
+  level_.assign(n, -1);
+  std::uint64_t occupied = 0;  // bit per level
+
+  // (1) Cells of each body on its own level.
+#pragma omp parallel num_threads(threads) reduction(| : occupied)
+  {
+    const int t = omp_get_thread_num();
+    auto& out = thread_entries_[t];
+    out.clear();
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+      const Aabb& box = bounds[i];
+      if (is_dead(box) || !box.is_bounded()) continue;
+      const double extent = box.extent().maxCoeff();
+      int level = 0;
+      double cell = base;
+      while (cell < extent && level < kMaxLevels - 1) {
+        cell *= 2;
+        ++level;
+      }
+      level_[i] = static_cast<std::int8_t>(level);
+      occupied |= 1ull << level;
+      const Eigen::Array3d lo = (box.min / cell).array().floor();
+      const Eigen::Array3d hi = (box.max / cell).array().floor();
+      for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
+        for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y()); ++y)
+          for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z()); ++z)
+            out.push_back({cell_key(level, x, y, z), static_cast<std::uint32_t>(i)});
+    }
+  }
+  // (2) One sorted array.
+  entries_.clear();
+  for (const auto& buffer : thread_entries_) entries_.insert(entries_.end(), buffer.begin(), buffer.end());
+  std::sort(entries_.begin(), entries_.end());
+
+  const auto emit = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
+    if (a == b || !(input.movable[a] || input.movable[b])) return;
+    if (!bounds[a].overlaps(bounds[b])) return;
+    out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+  };
+
+  // (3) Candidate pairs.
+  const std::int64_t entry_count = static_cast<std::int64_t>(entries_.size());
+#pragma omp parallel num_threads(threads)
+  {
+    auto& out = thread_pairs_[omp_get_thread_num()];
+    out.clear();
+    // Same cell: each run of equal keys, visited from its first entry.
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < entry_count; ++i) {
+      if (i > 0 && entries_[i - 1].key == entries_[i].key) continue;
+      for (std::int64_t j = i; j < entry_count && entries_[j].key == entries_[i].key; ++j)
+        for (std::int64_t k = j + 1; k < entry_count && entries_[k].key == entries_[i].key; ++k)
+          emit(entries_[j].body, entries_[k].body, out);
+    }
+    // Coarser levels: each body looks up the cells it covers there.
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+      const int own = level_[i];
+      if (own < 0) continue;
+      const Aabb& box = bounds[i];
+      double cell = base * std::ldexp(1.0, own);
+      for (int level = own + 1; level < kMaxLevels; ++level) {
+        cell *= 2;
+        if (!(occupied >> level & 1)) continue;
+        const Eigen::Array3d lo = (box.min / cell).array().floor();
+        const Eigen::Array3d hi = (box.max / cell).array().floor();
+        for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
+          for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y()); ++y)
+            for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z()); ++z) {
+              const std::uint64_t key = cell_key(level, x, y, z);
+              auto it = std::lower_bound(entries_.begin(), entries_.end(), Entry{key, 0});
+              for (; it != entries_.end() && it->key == key; ++it)
+                if (level_[it->body] == level) emit(static_cast<std::uint32_t>(i), it->body, out);
+            }
+      }
+    }
+    // Unbounded bodies meet everyone.
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+      if (is_dead(bounds[i])) continue;
+      for (std::uint32_t u : unbounded_)
+        if (!bounds[i].is_bounded() ? u < i : true) emit(static_cast<std::uint32_t>(i), u, out);
+    }
+  }
+  // (4) Reduction.
+  for (const auto& buffer : thread_pairs_) pairs->insert(pairs->end(), buffer.begin(), buffer.end());
+  std::sort(pairs->begin(), pairs->end());
+  pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
+}
+
+void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
+  pairs->clear();
+  const auto& bounds = input.bounds;
+  std::vector<std::uint32_t> order;
+  std::vector<std::uint32_t> unbounded;
+  for (std::uint32_t i = 0; i < bounds.size(); ++i) {
+    if (is_dead(bounds[i])) continue;
+    (bounds[i].is_bounded() ? order : unbounded).push_back(i);
+  }
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return bounds[a].min.x() < bounds[b].min.x() || (bounds[a].min.x() == bounds[b].min.x() && a < b);
+  });
+  auto emit = [&](std::uint32_t a, std::uint32_t b) {
+    if (!(input.movable[a] || input.movable[b]) || !bounds[a].overlaps(bounds[b])) return;
+    pairs->push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+  };
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (std::size_t j = i + 1; j < order.size() && bounds[order[j]].min.x() <= bounds[order[i]].max.x(); ++j)
+      emit(order[i], order[j]);
+  for (std::size_t k = 0; k < unbounded.size(); ++k) {
+    for (std::uint32_t i : order) emit(i, unbounded[k]);
+    for (std::size_t m = k + 1; m < unbounded.size(); ++m) emit(unbounded[k], unbounded[m]);
+  }
+  std::sort(pairs->begin(), pairs->end());
+}
+
+}  // namespace tumble

@@ -1,0 +1,73 @@
+// Narrow-phase dispatch by shape pair. The lower ShapeType goes first, so each pair has one
+// routine; a swapped pair's manifold is mirrored back. All work happens in one body's local frame
+// (the relative pose is formed once, in world coordinates), so contacts between bodies far from
+// the origin keep the precision of their size, not of their coordinates.
+#include "manifold.h"
+#include "narrow_phase.h"
+
+namespace tumble {
+namespace {
+
+std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b,
+                              const Pose& pose_b, const CollisionSettings& settings,
+                              ContactManifold* out) {
+  const Mat3 ra = pose_a.orientation.toRotationMatrix();
+  const Mat3 rb = pose_b.orientation.toRotationMatrix();
+  const Vec3 offset = pose_b.position - pose_a.position;
+  // B in A's frame, and A in B's frame.
+  const Mat3 b_in_a = ra.transpose() * rb;
+  const Vec3 b_at = ra.transpose() * offset;
+  const Mat3 a_in_b = b_in_a.transpose();
+  const Vec3 a_at = -(rb.transpose() * offset);
+  const double margin = settings.margin;
+  std::uint32_t flags = kCollisionOk;
+  bool in_b_frame = false;
+
+  switch (b.type()) {
+    case ShapeType::kHalfSpace:
+      flags = collide_half_space(a, a_in_b, a_at, margin, out);
+      in_b_frame = true;
+      break;
+    case ShapeType::kSphere:
+      flags = collide_sphere_sphere(a.radius(), b.radius(), b_at, margin, out);
+      break;
+    case ShapeType::kCapsule:
+      flags = a.type() == ShapeType::kSphere
+                  ? collide_sphere_capsule(a.radius(), b, b_in_a, b_at, margin, out)
+                  : collide_capsules(a, b, b_in_a, b_at, margin, out);
+      break;
+    case ShapeType::kBox:
+    case ShapeType::kHull:
+      if (a.type() == ShapeType::kSphere || a.type() == ShapeType::kCapsule) {
+        const Vec3 axis = a.type() == ShapeType::kCapsule
+                              ? Vec3(a_in_b.col(2) * a.half_height())
+                              : Vec3::Zero();
+        flags = collide_round_polytope(a_at - axis, a_at + axis, a.radius(), b, settings, out);
+        in_b_frame = true;
+      } else {
+        flags = collide_polytopes(*a.polyhedron(), *b.polyhedron(), b_in_a, b_at,
+                                  std::max(a.size(), b.size()), settings, out);
+      }
+      break;
+  }
+  if (in_b_frame)
+    manifold_to_world(rb, pose_b.position, out);
+  else
+    manifold_to_world(ra, pose_a.position, out);
+  return flags;
+}
+
+}  // namespace
+
+std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                      const CollisionSettings& settings, ContactManifold* out) {
+  out->count = 0;
+  if (a.type() == ShapeType::kHalfSpace && b.type() == ShapeType::kHalfSpace) return kCollisionOk;
+  if (a.type() <= b.type()) return collide_ordered(a, pose_a, b, pose_b, settings, out);
+  const std::uint32_t flags = collide_ordered(b, pose_b, a, pose_a, settings, out);
+  out->normal = -out->normal;
+  for (int i = 0; i < out->count; ++i) std::swap(out->points[i].point_a, out->points[i].point_b);
+  return flags;
+}
+
+}  // namespace tumble

@@ -1,0 +1,126 @@
+// Boxes and hulls against each other: the exact separating-axis test by default, GJK and EPA on
+// request; either way the contact normal becomes a manifold by face clipping.
+#include "epa.h"
+#include "manifold.h"
+#include "narrow_phase.h"
+#include "sat.h"
+#include "segment.h"
+
+namespace tumble {
+namespace {
+
+// A face is preferred over an edge pair, and A's face over B's, unless the other separates by
+// more than this share of the shapes' size: stable manifolds without giving up exactness.
+constexpr double kFeaturePreference = 1e-9;
+
+void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const EdgeQuery& query,
+                  ContactManifold* out) {
+  const auto& ea = a.polyhedron->edges[query.edge_a];
+  const auto& eb = b.polyhedron->edges[query.edge_b];
+  const SegmentClosest c =
+      closest_between_segments(a.point(ea.tail), a.point(ea.head), b.point(eb.tail), b.point(eb.head));
+  out->normal = query.axis;
+  out->count = 1;
+  ContactPoint& point = out->points[0];
+  point.point_a = c.on_first;
+  point.point_b = c.on_second;
+  point.depth = -query.separation;
+  point.feature_id = feature_id(kFeatureEdges, query.edge_a, query.edge_b, 0);
+}
+
+// A manifold for a known normal (A to B): clip when the normal is a face normal of either body,
+// otherwise one point at the witness pair.
+void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const Vec3& normal,
+                          double depth, const Vec3& witness_a, const Vec3& witness_b,
+                          double margin, double scale, ContactManifold* out) {
+  const std::uint32_t face_b = most_opposed_face(b, normal);
+  const std::uint32_t face_a = most_opposed_face(a, -normal);
+  const double align_a = a.face_normal(face_a).dot(normal);
+  const double align_b = -b.face_normal(face_b).dot(normal);
+  // EPA's normal is good to about 1e-12; a looser test would swallow edge axes that lie within
+  // a few microradians of a face normal.
+  constexpr double kFaceAlignment = 1 - 1e-13;
+  const bool a_aligned = align_a >= kFaceAlignment, b_aligned = align_b >= kFaceAlignment;
+  if (a_aligned || b_aligned) {
+    // Two nearly parallel faces: decide by their separations, exactly as the SAT path does, so
+    // that both paths give the same manifold.
+    bool use_a = a_aligned;
+    if (a_aligned && b_aligned) {
+      const Vec3 na = a.face_normal(face_a), nb = b.face_normal(face_b);
+      const double sep_a = na.dot(b.point(b.polyhedron->support_index(b.rotation.transpose() * -na))) -
+                           a.face_offset(face_a);
+      const double sep_b = nb.dot(a.point(a.polyhedron->support_index(a.rotation.transpose() * -nb))) -
+                           b.face_offset(face_b);
+      use_a = sep_a >= sep_b - kFeaturePreference * scale;
+    }
+    if (use_a)
+      clip_face_contact(a, face_a, b, most_opposed_face(b, a.face_normal(face_a)), true, margin, out);
+    else
+      clip_face_contact(b, face_b, a, most_opposed_face(a, b.face_normal(face_b)), false, margin, out);
+    if (out->count > 0) return;
+  }
+  out->normal = normal;
+  out->count = 1;
+  out->points[0].point_a = witness_a;
+  out->points[0].point_b = witness_b;
+  out->points[0].depth = depth;
+  out->points[0].feature_id =
+      feature_id(kFeatureVertex, a.polyhedron->support_index(a.rotation.transpose() * normal),
+                 b.polyhedron->support_index(b.rotation.transpose() * -normal), 0);
+}
+
+}  // namespace
+
+std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedron& b,
+                                const Mat3& rotation, const Vec3& translation, double scale,
+                                const CollisionSettings& settings, ContactManifold* out) {
+  out->count = 0;
+  const PlacedPolyhedron pa{&a, Mat3::Identity(), Vec3::Zero()};
+  const PlacedPolyhedron pb{&b, rotation, translation};
+  const double margin = settings.margin;
+
+  if (settings.method == NarrowPhaseMethod::kGjkEpa) {
+    const PolyhedronSupport support_a{&a};
+    const PolyhedronSupport local_b{&b};
+    const Transformed<PolyhedronSupport> support_b{local_b, rotation, translation};
+    GjkSettings gjk_settings;
+    gjk_settings.tolerance = 1e-12 * scale;
+    const GjkResult gjk = gjk_distance(support_a, support_b, translation, gjk_settings);
+    std::uint32_t flags = gjk.status == GjkStatus::kIterationLimit ? std::uint32_t{kGjkIterationLimit} : 0u;
+    if (gjk.status != GjkStatus::kIntersecting && gjk.distance > gjk_settings.tolerance) {
+      if (gjk.distance > margin) return flags;
+      const Vec3 normal = (gjk.point_b - gjk.point_a) / gjk.distance;
+      manifold_from_normal(pa, pb, normal, -gjk.distance, gjk.point_a, gjk.point_b, margin, scale, out);
+      return flags;
+    }
+    EpaSettings epa_settings;
+    epa_settings.tolerance = 1e-12 * scale;
+    const EpaResult epa = epa_penetration(support_a, support_b, gjk.simplex, epa_settings);
+    if (epa.status == EpaStatus::kIterationLimit) flags |= kEpaIterationLimit;
+    if (epa.status == EpaStatus::kDegenerate) flags |= kEpaDegenerate;
+    manifold_from_normal(pa, pb, epa.normal, epa.depth, epa.point_a, epa.point_b, margin, scale, out);
+    return flags;
+  }
+
+  const FaceQuery face_a = query_faces(pa, pb);
+  if (face_a.separation > margin) return kCollisionOk;
+  const FaceQuery face_b = query_faces(pb, pa);
+  if (face_b.separation > margin) return kCollisionOk;
+  const EdgeQuery edges = query_edges(pa, pb);
+  if (edges.separation > margin) return kCollisionOk;
+
+  const double preference = kFeaturePreference * scale;
+  const double best_face = std::max(face_a.separation, face_b.separation);
+  if (edges.separation > best_face + preference) {
+    edge_contact(pa, pb, edges, out);
+  } else if (face_a.separation >= face_b.separation - preference) {
+    const Vec3 n = pa.face_normal(face_a.face);
+    clip_face_contact(pa, face_a.face, pb, most_opposed_face(pb, n), true, margin, out);
+  } else {
+    const Vec3 n = pb.face_normal(face_b.face);
+    clip_face_contact(pb, face_b.face, pa, most_opposed_face(pa, n), false, margin, out);
+  }
+  return kCollisionOk;
+}
+
+}  // namespace tumble

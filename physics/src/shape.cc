@@ -1,0 +1,179 @@
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "mass_integrals.h"
+#include "physics/shape.h"
+
+namespace tumble {
+namespace {
+
+Status check_length(double value, const char* field) {
+  if (!is_finite(value)) return Status::error(std::string(field) + ": must be finite");
+  if (!(value > 0)) return Status::error(std::string(field) + ": must be > 0");
+  return Status::ok();
+}
+
+}  // namespace
+
+const char* shape_type_name(ShapeType type) {
+  switch (type) {
+    case ShapeType::kSphere: return "sphere";
+    case ShapeType::kCapsule: return "capsule";
+    case ShapeType::kBox: return "box";
+    case ShapeType::kHull: return "hull";
+    case ShapeType::kHalfSpace: return "half_space";
+  }
+  return "unknown";
+}
+
+Result<Shape> Shape::create(const ShapeDef& def) {
+  Shape shape;
+  if (const auto* sphere = std::get_if<SphereDef>(&def)) {
+    if (Status s = check_length(sphere->radius, "radius"); !s) return s;
+    shape.type_ = ShapeType::kSphere;
+    shape.radius_ = sphere->radius;
+  } else if (const auto* capsule = std::get_if<CapsuleDef>(&def)) {
+    if (Status s = check_length(capsule->radius, "radius"); !s) return s;
+    if (Status s = check_length(capsule->half_height, "half_height"); !s) return s;
+    shape.type_ = ShapeType::kCapsule;
+    shape.radius_ = capsule->radius;
+    shape.half_height_ = capsule->half_height;
+  } else if (const auto* box = std::get_if<BoxDef>(&def)) {
+    for (int k = 0; k < 3; ++k) {
+      const std::string field = "half_extents[" + std::to_string(k) + "]";
+      if (Status s = check_length(box->half_extents[k], field.c_str()); !s) return s;
+    }
+    shape.type_ = ShapeType::kBox;
+    shape.half_extents_ = box->half_extents;
+    shape.polyhedron_ = std::make_shared<ConvexPolyhedron>(make_box_polyhedron(box->half_extents));
+  } else if (const auto* hull = std::get_if<HullDef>(&def)) {
+    Result<ConvexPolyhedron> built = build_convex_hull(hull->points);
+    if (!built) return built.status();
+    shape.type_ = ShapeType::kHull;
+    shape.polyhedron_ = std::make_shared<ConvexPolyhedron>(std::move(built).value());
+    const Aabb bounds = shape.local_bounds();
+    shape.half_extents_ = 0.5 * bounds.extent();
+  } else {
+    shape.type_ = ShapeType::kHalfSpace;
+  }
+  return shape;
+}
+
+Aabb Shape::local_bounds() const {
+  switch (type_) {
+    case ShapeType::kSphere: return {Vec3::Constant(-radius_), Vec3::Constant(radius_)};
+    case ShapeType::kCapsule: {
+      const Vec3 half(radius_, radius_, radius_ + half_height_);
+      return {-half, half};
+    }
+    case ShapeType::kBox: return {-half_extents_, half_extents_};
+    case ShapeType::kHull: {
+      Aabb bounds;
+      for (const Vec3& v : polyhedron_->vertices) bounds.grow(v);
+      return bounds;
+    }
+    case ShapeType::kHalfSpace: return Aabb::infinite();
+  }
+  return Aabb::infinite();
+}
+
+double Shape::volume() const {
+  constexpr double pi = std::numbers::pi;
+  switch (type_) {
+    case ShapeType::kSphere: return 4.0 / 3.0 * pi * radius_ * radius_ * radius_;
+    case ShapeType::kCapsule:
+      return pi * radius_ * radius_ * (2 * half_height_ + 4.0 / 3.0 * radius_);
+    case ShapeType::kBox: return 8 * half_extents_.prod();
+    case ShapeType::kHull: return polyhedron_->volume;
+    case ShapeType::kHalfSpace: return std::numeric_limits<double>::infinity();
+  }
+  return 0;
+}
+
+MassProperties Shape::mass_properties(double density) const {
+  constexpr double pi = std::numbers::pi;
+  MassProperties props;
+  props.mass = density * volume();
+  const double m = props.mass;
+  switch (type_) {
+    case ShapeType::kSphere:
+      props.inertia = Mat3::Identity() * (0.4 * m * radius_ * radius_);
+      break;
+    case ShapeType::kCapsule: {
+      // Cylinder plus two hemispheres; each hemisphere's centroid sits 3r/8 beyond its flat face,
+      // and about that centroid a hemisphere has 83/320 m r^2 across its axis.
+      const double r = radius_, length = 2 * half_height_;
+      const double m_cylinder = density * pi * r * r * length;
+      const double m_hemisphere = density * 2.0 / 3.0 * pi * r * r * r;
+      const double along = 0.5 * m_cylinder * r * r + 2 * (0.4 * m_hemisphere * r * r);
+      const double lever = half_height_ + 3.0 * r / 8.0;
+      const double across = m_cylinder * (3 * r * r + length * length) / 12.0 +
+                            2 * m_hemisphere * (83.0 / 320.0 * r * r + lever * lever);
+      props.inertia = Vec3(across, across, along).asDiagonal();
+      break;
+    }
+    case ShapeType::kBox: {
+      const Vec3 e2 = (2 * half_extents_).cwiseProduct(2 * half_extents_);
+      props.inertia = Vec3(e2.y() + e2.z(), e2.x() + e2.z(), e2.x() + e2.y()).asDiagonal();
+      props.inertia *= m / 12.0;
+      break;
+    }
+    case ShapeType::kHull: {
+      const PolyhedronIntegrals integrals = integrate_polyhedron(*polyhedron_);
+      props.center_of_mass = integrals.centroid;
+      props.inertia = inertia_from_second_moment(integrals.second_moment, density);
+      break;
+    }
+    case ShapeType::kHalfSpace:
+      props.mass = std::numeric_limits<double>::infinity();
+      break;
+  }
+  return props;
+}
+
+double Shape::size() const {
+  switch (type_) {
+    case ShapeType::kSphere: return radius_;
+    case ShapeType::kCapsule: return radius_ + half_height_;
+    case ShapeType::kBox:
+    case ShapeType::kHull: return half_extents_.maxCoeff();
+    case ShapeType::kHalfSpace: return 1.0;
+  }
+  return 1.0;
+}
+
+Vec3 Shape::support(const Vec3& d) const {
+  switch (type_) {
+    case ShapeType::kSphere: {
+      const double n = d.norm();
+      return n > 0 ? Vec3(d * (radius_ / n)) : Vec3(radius_, 0, 0);
+    }
+    case ShapeType::kCapsule: {
+      const double n = d.norm();
+      const Vec3 tip(0, 0, d.z() >= 0 ? half_height_ : -half_height_);
+      return n > 0 ? Vec3(tip + d * (radius_ / n)) : tip;
+    }
+    case ShapeType::kBox:
+      return Vec3(d.x() >= 0 ? half_extents_.x() : -half_extents_.x(),
+                  d.y() >= 0 ? half_extents_.y() : -half_extents_.y(),
+                  d.z() >= 0 ? half_extents_.z() : -half_extents_.z());
+    case ShapeType::kHull: return polyhedron_->support(d);
+    case ShapeType::kHalfSpace: break;
+  }
+  TUMBLE_ASSERT(false && "a half-space has no support point");
+  return Vec3::Zero();
+}
+
+Shape Shape::recentred(const Vec3& offset) const {
+  if (type_ != ShapeType::kHull || offset.isZero(0)) return *this;
+  auto moved = std::make_shared<ConvexPolyhedron>(*polyhedron_);
+  for (Vec3& v : moved->vertices) v -= offset;
+  for (auto& face : moved->faces) face.offset -= face.normal.dot(offset);
+  moved->centroid -= offset;
+  Shape shape = *this;
+  shape.polyhedron_ = std::move(moved);
+  return shape;
+}
+
+}  // namespace tumble

@@ -1,0 +1,215 @@
+// Box-box contacts against an exact separating-axis reference, on 100k random pairs drawn from the
+// hard cases: generic overlaps, exact face-to-face touching, parallel edges, near-degenerate
+// orientations, tiny depths, size ratios up to 1:1000, and positions 1e5 m from the origin.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "physics/collision.h"
+#include "test_support.h"
+
+namespace tumble {
+namespace {
+
+using testing::Random;
+
+struct BoxPair {
+  Vec3 ha, hb;
+  Pose pa, pb;
+  const char* kind;
+};
+
+Quat small_rotation(Random& rng) {
+  const double angle = std::pow(10.0, rng.uniform(-12, -3));
+  return Quat(Eigen::AngleAxisd(angle, rng.direction()));
+}
+
+BoxPair make_pair(Random& rng, int index) {
+  BoxPair p;
+  p.ha = rng.vector(0.1, 2.0);
+  p.hb = rng.vector(0.1, 2.0);
+  p.pa.orientation = rng.rotation();
+  p.pb.orientation = rng.rotation();
+  const double reach = (p.ha.norm() + p.hb.norm());
+  switch (index % 7) {
+    case 0:  // generic: anywhere from deep overlap to clearly apart
+      p.kind = "generic";
+      p.pb.position = rng.direction() * rng.uniform(0, 1.1 * reach);
+      break;
+    case 1: {  // B's face flush on A's top face, turned about the shared normal
+      p.kind = "face-touch";
+      p.pa.orientation = Quat::Identity();
+      p.pb.orientation = Quat(Eigen::AngleAxisd(rng.uniform(0, M_PI), Vec3::UnitZ()));
+      p.pb.position = Vec3(rng.uniform(-p.ha.x(), p.ha.x()), rng.uniform(-p.ha.y(), p.ha.y()),
+                           p.ha.z() + p.hb.z());
+      break;
+    }
+    case 2: {  // edges parallel: both turned about x by 45 degrees plus a multiple of 90
+      p.kind = "parallel-edges";
+      const Quat q(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX()));
+      p.pa.orientation = Quat::Identity();
+      p.pb.orientation = q * Quat(Eigen::AngleAxisd(M_PI / 2 * rng.integer(0, 3), Vec3::UnitX()));
+      p.pb.position = Vec3(rng.uniform(-0.5, 0.5), 0, 0) +
+                      Vec3(0, 0, 1) * (p.ha.z() + std::sqrt(0.5) * (p.hb.y() + p.hb.z()) -
+                                       rng.uniform(0, 0.2));
+      break;
+    }
+    case 3: {  // nearly aligned: identity perturbed by 1e-12 .. 1e-3 rad
+      p.kind = "near-degenerate";
+      p.pa.orientation = small_rotation(rng);
+      p.pb.orientation = small_rotation(rng);
+      p.pb.position = Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1),
+                           p.ha.z() + p.hb.z() - rng.uniform(0, 0.3));
+      break;
+    }
+    case 4: {  // tiny penetration, 1e-12 .. 1e-6 m, on a random face
+      p.kind = "tiny-depth";
+      p.pa.orientation = Quat::Identity();
+      p.pb.orientation = Quat(Eigen::AngleAxisd(rng.uniform(0, M_PI), Vec3::UnitZ()));
+      p.pb.position = Vec3(rng.uniform(-0.3, 0.3) * p.ha.x(), rng.uniform(-0.3, 0.3) * p.ha.y(),
+                           p.ha.z() + p.hb.z() - std::pow(10.0, rng.uniform(-12, -6)));
+      break;
+    }
+    case 5: {  // size ratio up to 1:1000, the small box anywhere near the big one's surface
+      p.kind = "size-ratio";
+      p.ha = rng.vector(0.5, 1.0);
+      p.hb = rng.vector(0.0005, 0.005);
+      p.pb.position = p.pa.orientation * rng.vector(-1.0, 1.0).cwiseProduct(p.ha);
+      p.pb.position += p.pa.orientation * Vec3(0, 0, p.ha.z() * rng.uniform(0.99, 1.01));
+      break;
+    }
+    default: {  // far from the origin
+      p.kind = "far";
+      p.pb.position = rng.direction() * rng.uniform(0, 1.1 * reach);
+      break;
+    }
+  }
+  if (index % 7 == 6 || index % 5 == 0) {
+    const Vec3 far = Vec3(1e5, -1e5, 1e5);
+    p.pa.position += far;
+    p.pb.position += far;
+  }
+  return p;
+}
+
+struct Tally {
+  int checked = 0, overlapping = 0, separated = 0, normal_checked = 0;
+};
+
+void check_pairs(NarrowPhaseMethod method, int count, Tally* tally) {
+  Random rng(20261122);
+  CollisionSettings settings;
+  settings.method = method;
+  const Shape unit = Shape::create(BoxDef{}).value();
+  for (int i = 0; i < count; ++i) {
+    const BoxPair p = make_pair(rng, i);
+    const Shape a = Shape::create(BoxDef{p.ha}).value();
+    const Shape b = Shape::create(BoxDef{p.hb}).value();
+    const testing::ReferenceSat ref = testing::reference_box_sat(p.ha, p.pa, p.hb, p.pb);
+    ContactManifold m;
+    const std::uint32_t flags = collide(a, p.pa, b, p.pb, settings, &m);
+    const double size = std::max(p.ha.maxCoeff(), p.hb.maxCoeff());
+    const double tolerance = 1e-9 * size;
+    const std::string where = std::string(p.kind) + " pair " + std::to_string(i);
+    ASSERT_EQ(flags & (kGjkIterationLimit | kEpaIterationLimit), 0u) << where;
+    ++tally->checked;
+    if (ref.separation > tolerance) {
+      ++tally->separated;
+      ASSERT_EQ(m.count, 0) << where << " separated by " << ref.separation;
+      continue;
+    }
+    if (ref.separation > -tolerance) continue;  // touching: either answer is right
+    ++tally->overlapping;
+    ASSERT_GT(m.count, 0) << where << " overlaps by " << -ref.separation;
+    double depth = -1e300;
+    for (int k = 0; k < m.count; ++k) depth = std::max(depth, m.points[k].depth);
+    ASSERT_NEAR(depth, -ref.separation, tolerance) << where;
+    ASSERT_NEAR(m.normal.norm(), 1.0, 1e-12) << where;
+    // The normal is unique when no other axis comes within 1e-6 of the best separation.
+    if (ref.runner_up < ref.separation - 1e-6 * size) {
+      ++tally->normal_checked;
+      const double angle = std::acos(std::clamp(m.normal.dot(ref.axis), -1.0, 1.0));
+      ASSERT_LT(angle, 1e-6) << where << " normal " << m.normal.transpose() << " expected "
+                             << ref.axis.transpose();
+    }
+    for (int k = 0; k < m.count; ++k) {
+      const ContactPoint& c = m.points[k];
+      // Points lie on their own surfaces, and their gap is the point's depth along the normal.
+      ASSERT_NEAR(testing::box_signed_distance(p.ha, p.pa, c.point_a), 0, 1e-8 * size) << where;
+      ASSERT_NEAR(testing::box_signed_distance(p.hb, p.pb, c.point_b), 0, 1e-8 * size) << where;
+      ASSERT_LT((c.point_a - c.point_b - c.depth * m.normal).norm(), 1e-8 * size) << where;
+      ASSERT_LE(c.depth, -ref.separation + tolerance) << where;
+    }
+  }
+  (void)unit;
+}
+
+TEST(BoxCollision, SatMatchesExactReferenceOn100kPairs) {
+  Tally tally;
+  check_pairs(NarrowPhaseMethod::kAuto, 100000, &tally);
+  EXPECT_EQ(tally.checked, 100000);
+  // The generator must really produce both outcomes and unique normals, or the test is hollow.
+  EXPECT_GT(tally.overlapping, 40000);
+  EXPECT_GT(tally.separated, 5000);
+  EXPECT_GT(tally.normal_checked, 20000);
+}
+
+TEST(BoxCollision, GjkEpaMatchesExactReferenceOn100kPairs) {
+  Tally tally;
+  check_pairs(NarrowPhaseMethod::kGjkEpa, 100000, &tally);
+  EXPECT_GT(tally.overlapping, 40000);
+}
+
+TEST(BoxCollision, RestingBoxGivesFourPointsWithStableIds) {
+  const Shape a = Shape::create(BoxDef{Vec3(2, 2, 0.5)}).value();
+  const Shape b = Shape::create(BoxDef{}).value();
+  Pose pa, pb;
+  pb.position = Vec3(0.1, -0.2, 0.5 + 0.5 - 0.01);
+  ContactManifold first, second;
+  collide(a, pa, b, pb, {}, &first);
+  ASSERT_EQ(first.count, 4);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(first.points[k].depth, 0.01, 1e-12);
+  EXPECT_TRUE(first.normal.isApprox(Vec3::UnitZ(), 1e-12));
+  // Slide a little: the same features touch, so the ids must be the same set.
+  pb.position += Vec3(0.01, 0.02, 0.001);
+  collide(a, pa, b, pb, {}, &second);
+  ASSERT_EQ(second.count, 4);
+  for (int k = 0; k < 4; ++k) {
+    bool found = false;
+    for (int j = 0; j < 4; ++j) found |= first.points[k].feature_id == second.points[j].feature_id;
+    EXPECT_TRUE(found) << "point " << k;
+  }
+}
+
+TEST(BoxCollision, CrossedEdgesGiveOnePointBetweenTheEdges) {
+  const Shape box = Shape::create(BoxDef{}).value();
+  Pose pa, pb;
+  // A's top edge along x (rotated 45 deg about x), B's bottom edge along y (45 deg about y).
+  pa.orientation = Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX()));
+  pb.orientation = Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY()));
+  const double reach = std::sqrt(0.5);
+  pb.position = Vec3(0, 0, 2 * reach - 0.05);
+  ContactManifold m;
+  collide(box, pa, box, pb, {}, &m);
+  ASSERT_EQ(m.count, 1);
+  EXPECT_NEAR(m.points[0].depth, 0.05, 1e-12);
+  EXPECT_TRUE(m.normal.isApprox(Vec3::UnitZ(), 1e-12));
+  EXPECT_NEAR(m.points[0].point_a.z(), reach, 1e-12);
+}
+
+TEST(BoxCollision, SpeculativeMarginReportsNegativeDepth) {
+  const Shape box = Shape::create(BoxDef{}).value();
+  Pose pa, pb;
+  pb.position = Vec3(0, 0, 1.03);
+  CollisionSettings settings;
+  ContactManifold m;
+  collide(box, pa, box, pb, settings, &m);
+  EXPECT_EQ(m.count, 0);
+  settings.margin = 0.05;
+  collide(box, pa, box, pb, settings, &m);
+  ASSERT_EQ(m.count, 4);
+  EXPECT_NEAR(m.points[0].depth, -0.03, 1e-12);
+}
+
+}  // namespace
+}  // namespace tumble
