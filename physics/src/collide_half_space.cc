@@ -1,5 +1,7 @@
 // Anything against the ground half-space (solid z <= 0 of its frame): every vertex or core end
 // below the plane (or within the margin above it) is a contact; more than four are reduced.
+#include <limits>
+
 #include "manifold.h"
 #include "narrow_phase.h"
 
@@ -40,6 +42,8 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
     }
     case ShapeType::kHalfSpace: return kCollisionOk;
   }
+  out->depth = -std::numeric_limits<double>::infinity();
+  for (const ContactPoint& c : candidates) out->depth = std::max(out->depth, c.depth);
   reduce_points(candidates, out->normal, out);
   return kCollisionOk;
 }

@@ -11,7 +11,7 @@ namespace {
 
 // A face is preferred over an edge pair, and A's face over B's, unless the other separates by
 // more than this share of the shapes' size: stable manifolds without giving up exactness.
-constexpr double kFeaturePreference = 1e-9;
+constexpr double kFeaturePreference = 2e-10;
 
 void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const EdgeQuery& query,
                   ContactManifold* out) {
@@ -20,6 +20,7 @@ void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const Ed
   const SegmentClosest c =
       closest_between_segments(a.point(ea.tail), a.point(ea.head), b.point(eb.tail), b.point(eb.head));
   out->normal = query.axis;
+  out->depth = -query.separation;
   out->count = 1;
   ContactPoint& point = out->points[0];
   point.point_a = c.on_first;
@@ -57,9 +58,13 @@ void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, 
       clip_face_contact(a, face_a, b, most_opposed_face(b, a.face_normal(face_a)), true, margin, out);
     else
       clip_face_contact(b, face_b, a, most_opposed_face(a, b.face_normal(face_b)), false, margin, out);
-    if (out->count > 0) return;
+    if (out->count > 0) {
+      out->depth = depth;  // EPA's (or GJK's) own answer, not re-measured on the chosen face
+      return;
+    }
   }
   out->normal = normal;
+  out->depth = depth;
   out->count = 1;
   out->points[0].point_a = witness_a;
   out->points[0].point_b = witness_b;
@@ -110,10 +115,11 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
   if (edges.separation > margin) return kCollisionOk;
 
   const double preference = kFeaturePreference * scale;
-  const double best_face = std::max(face_a.separation, face_b.separation);
-  if (edges.separation > best_face + preference) {
+  const bool use_a = face_a.separation >= face_b.separation - preference;
+  const double chosen_face = use_a ? face_a.separation : face_b.separation;
+  if (edges.separation > chosen_face + preference) {
     edge_contact(pa, pb, edges, out);
-  } else if (face_a.separation >= face_b.separation - preference) {
+  } else if (use_a) {
     const Vec3 n = pa.face_normal(face_a.face);
     clip_face_contact(pa, face_a.face, pb, most_opposed_face(pb, n), true, margin, out);
   } else {

@@ -14,6 +14,7 @@ namespace {
 void single_point(const Vec3& normal, const Vec3& surface_a, const Vec3& surface_b, double depth,
                   std::uint64_t id, ContactManifold* out) {
   out->normal = normal;
+  out->depth = depth;
   out->count = 1;
   out->points[0] = {surface_a, surface_b, depth, id};
 }
@@ -75,6 +76,7 @@ std::uint32_t collide_capsules(const Shape& a, const Shape& b, const Mat3& rotat
     const double hi = std::min(a.half_height(), std::max(pb.z(), qb.z()));
     if (hi > lo) {
       out->normal = n;
+      out->depth = radii - distance;
       out->count = 0;
       for (double z : {lo, hi}) {
         const Vec3 on_a(0, 0, z);
@@ -176,6 +178,7 @@ std::uint32_t collide_round_polytope(const Vec3& p, const Vec3& q, double radius
       }
       if (t1 > t0) {
         out->normal = -face.normal;
+        out->depth = depth;
         out->count = 0;
         for (double t : {t0, t1}) {
           const Vec3 x = p + t * (q - p);

@@ -77,6 +77,19 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
                               incident_face, v.tag);
     candidates.push_back(c);
   }
+  // The incident body's deepest vertex fixes the pair's depth. In deep overlaps the incident face
+  // can lie wholly outside the reference face's prism; that vertex is then the one contact.
+  const std::uint32_t deepest =
+      incident.polyhedron->support_index(incident.rotation.transpose() * -n);
+  const Vec3 v = incident.point(deepest);
+  const double deepest_separation = n.dot(v) - offset;
+  out->depth = -deepest_separation;
+  if (candidates.empty() && deepest_separation <= margin) {
+    const Vec3 on_reference = v - deepest_separation * n;
+    candidates.push_back({reference_is_a ? on_reference : v, reference_is_a ? v : on_reference,
+                          -deepest_separation,
+                          feature_id(kFeatureVertex, reference_face, deepest, reference_is_a ? 1 : 2)});
+  }
   out->normal = reference_is_a ? n : Vec3(-n);
   reduce_points(candidates, out->normal, out);
 }

@@ -22,6 +22,9 @@ struct ContactPoint {
 
 struct ContactManifold {
   Vec3 normal = Vec3::UnitZ();  // unit, world, from A towards B: moving B along it separates them
+  // m: the pair's penetration along the normal (exact for polytopes): moving B by depth * normal
+  // leaves the shapes just touching. Points carry their own, never larger, depths.
+  double depth = 0;
   std::array<ContactPoint, 4> points;
   int count = 0;
 };
