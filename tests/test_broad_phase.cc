@@ -19,8 +19,11 @@ std::vector<BodyPair> brute_force(const Scene& s) {
   std::vector<BodyPair> pairs;
   for (std::uint32_t i = 0; i < s.bounds.size(); ++i)
     for (std::uint32_t j = i + 1; j < s.bounds.size(); ++j) {
-      if (!(s.bounds[i].min.x() <= s.bounds[i].max.x()) || !(s.bounds[j].min.x() <= s.bounds[j].max.x())) continue;
-      if ((s.movable[i] || s.movable[j]) && s.bounds[i].overlaps(s.bounds[j])) pairs.push_back({i, j});
+      if (!(s.bounds[i].min.x() <= s.bounds[i].max.x()) ||
+          !(s.bounds[j].min.x() <= s.bounds[j].max.x()))
+        continue;
+      if ((s.movable[i] || s.movable[j]) && s.bounds[i].overlaps(s.bounds[j]))
+        pairs.push_back({i, j});
     }
   return pairs;
 }
@@ -47,7 +50,8 @@ Scene make_scene(const std::string& kind, Random& rng, int n) {
       half = Vec3::Constant(0.5 * std::pow(10.0, rng.uniform(-3, 2)));
     } else {  // "borders": boxes snapped so their faces sit on multiples of their size
       half = Vec3::Constant(0.5);
-      centre = Vec3(rng.integer(0, 15), rng.integer(0, 15), rng.integer(0, 15)) + Vec3::Constant(0.5);
+      centre =
+          Vec3(rng.integer(0, 15), rng.integer(0, 15), rng.integer(0, 15)) + Vec3::Constant(0.5);
       if (i % 2) centre += Vec3(0.5, 0, 0);  // faces exactly touching neighbours
     }
     add_box(s, centre + offset, half, i % 5 != 0);  // every fifth body static

@@ -71,8 +71,8 @@ TEST(Epa, BoxDepthsAlongEachAxis) {
     for (double depth : {0.3, 1e-3, 1e-9, 1e-13}) {
       Vec3 offset = Vec3::Zero();
       offset[axis] = 1 - depth;
-      const Transformed<BoxSupport> moved{cube, Mat3::Identity(), offset + Vec3(0.1, 0.1, 0.1) -
-                                                                      0.1 * Vec3::Unit(axis)};
+      const Transformed<BoxSupport> moved{cube, Mat3::Identity(),
+                                          offset + Vec3(0.1, 0.1, 0.1) - 0.1 * Vec3::Unit(axis)};
       const GjkResult g = gjk_distance(cube, moved, offset);
       ASSERT_EQ(g.status, GjkStatus::kIntersecting);
       const EpaResult e = epa_penetration(cube, moved, g.simplex);
@@ -97,7 +97,8 @@ TEST(Epa, SegmentInsideBox) {
 std::vector<Vec3> random_cloud(Random& rng, int count) {
   std::vector<Vec3> points;
   const Vec3 scale = rng.vector(0.2, 1.5);
-  for (int i = 0; i < count; ++i) points.push_back(rng.vector(-1, 1).cwiseProduct(scale));
+  for (int i = 0; i < count; ++i)
+    points.push_back(rng.vector(-1, 1).cwiseProduct(scale));
   return points;
 }
 
@@ -118,6 +119,7 @@ TEST(Epa, RandomHullsAgreeWithSatAndSeparateAlongTheirNormal) {
     }
     const double size = std::max(a.value().size(), b.value().size());
     CollisionSettings sat, gjk;
+    sat.method = NarrowPhaseMethod::kSat;
     gjk.method = NarrowPhaseMethod::kGjkEpa;
     ContactManifold ms, mg;
     const std::uint32_t flags_sat = collide(a.value(), pa, b.value(), pb, sat, &ms);

@@ -7,9 +7,13 @@
 namespace tumble {
 namespace {
 
-Shape make(const ShapeDef& def) { return Shape::create(def).value(); }
+Shape make(const ShapeDef& def) {
+  return Shape::create(def).value();
+}
 
-Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
+Pose at(const Vec3& p, const Quat& q = Quat::Identity()) {
+  return {p, q};
+}
 
 TEST(RoundShapes, SphereSphere) {
   ContactManifold m;
@@ -48,7 +52,8 @@ TEST(RoundShapes, SphereOnBoxFaceEdgeAndInside) {
 
 TEST(RoundShapes, SphereAgainstHullMatchesSphereAgainstEqualBox) {
   std::vector<Vec3> corners;
-  for (int i = 0; i < 8; ++i) corners.emplace_back((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1);
+  for (int i = 0; i < 8; ++i)
+    corners.emplace_back((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1);
   const Shape hull = make(HullDef{corners});
   const Shape box = make(BoxDef{Vec3(1, 1, 1)});
   const Shape ball = make(SphereDef{0.4});
@@ -69,7 +74,8 @@ TEST(RoundShapes, CapsuleLyingOnBoxGivesTwoPoints) {
   const Shape capsule = make(CapsuleDef{0.25, 1.0});
   const Shape box = make(BoxDef{Vec3(2, 2, 0.5)});
   // Capsule axis along x, resting 1 cm deep on the top face.
-  const Pose pose = at(Vec3(0.3, 0, 0.5 + 0.25 - 0.01), Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY())));
+  const Pose pose =
+      at(Vec3(0.3, 0, 0.5 + 0.25 - 0.01), Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY())));
   ContactManifold m;
   collide(capsule, pose, box, at(Vec3::Zero()), {}, &m);
   ASSERT_EQ(m.count, 2);
@@ -116,7 +122,8 @@ TEST(HalfSpace, BoxHullSphereCapsuleOnTheGround) {
   const double lowest = 0.6 - 0.5 * (std::cos(0.3) + std::sin(0.3));
   EXPECT_NEAR(m.depth, -lowest, 1e-12);
   EXPECT_TRUE(m.normal.isApprox(-Vec3::UnitZ()));
-  for (int k = 0; k < m.count; ++k) EXPECT_NEAR(m.points[k].point_b.z(), 0, 1e-15);
+  for (int k = 0; k < m.count; ++k)
+    EXPECT_NEAR(m.points[k].point_b.z(), 0, 1e-15);
   // A flat box on the ground: four corners.
   collide(make(BoxDef{}), at(Vec3(0, 0, 0.49)), ground, at(Vec3::Zero()), {}, &m);
   EXPECT_EQ(m.count, 4);
@@ -131,15 +138,17 @@ TEST(HalfSpace, BoxHullSphereCapsuleOnTheGround) {
   EXPECT_EQ(m.count, 4);
   EXPECT_NEAR(m.depth, 0.1, 1e-12);
   double deepest_point = 0;
-  for (int k = 0; k < m.count; ++k) deepest_point = std::max(deepest_point, m.points[k].depth);
+  for (int k = 0; k < m.count; ++k)
+    deepest_point = std::max(deepest_point, m.points[k].depth);
   EXPECT_NEAR(deepest_point, 0.1, 1e-12);
   // Sphere and capsule; and the ground as body A flips the normal.
   collide(ground, at(Vec3::Zero()), make(SphereDef{0.5}), at(Vec3(0, 0, 0.4)), {}, &m);
   ASSERT_EQ(m.count, 1);
   EXPECT_NEAR(m.depth, 0.1, 1e-15);
   EXPECT_TRUE(m.normal.isApprox(Vec3::UnitZ()));
-  collide(make(CapsuleDef{0.2, 1}), at(Vec3(0, 0, 0.15), Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()))),
-          ground, at(Vec3::Zero()), {}, &m);
+  collide(make(CapsuleDef{0.2, 1}),
+          at(Vec3(0, 0, 0.15), Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()))), ground,
+          at(Vec3::Zero()), {}, &m);
   EXPECT_EQ(m.count, 2);
   EXPECT_NEAR(m.depth, 0.05, 1e-12);
   // Far from the origin nothing changes.

@@ -99,7 +99,8 @@ TEST(Shapes, CapsuleAndSphereInertiaMatchIntegration) {
 }
 
 TEST(Shapes, BoxInertiaIsTheStandardFormula) {
-  const MassProperties p = Shape::create(BoxDef{Vec3(0.5, 1, 1.5)}).value().mass_properties(1.0 / 6.0);
+  const MassProperties p =
+      Shape::create(BoxDef{Vec3(0.5, 1, 1.5)}).value().mass_properties(1.0 / 6.0);
   EXPECT_NEAR(p.mass, 1.0, 1e-12);
   EXPECT_NEAR(p.inertia(0, 0), (4 + 9) / 12.0, 1e-12);
   EXPECT_NEAR(p.inertia(1, 1), (1 + 9) / 12.0, 1e-12);
@@ -155,7 +156,8 @@ TEST(Bodies, HullBodyIsPlacedAtItsCentreOfMass) {
 TEST(World, BatchCreationIsAllOrNothing) {
   World world;
   std::vector<BodyDef> defs(5);
-  for (int i = 0; i < 5; ++i) defs[i].position = Vec3(0, 0, 2.0 * i);
+  for (int i = 0; i < 5; ++i)
+    defs[i].position = Vec3(0, 0, 2.0 * i);
   defs[3].shape = BoxDef{Vec3(1, 1, -2)};
   const auto result = world.create_bodies(defs);
   ASSERT_FALSE(result.ok());

@@ -19,18 +19,21 @@ class Random {
   double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
   int integer(int lo, int hi) { return lo + static_cast<int>(uniform() * (hi - lo + 1)); }
-  Vec3 vector(double lo, double hi) { return Vec3(uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)); }
+  Vec3 vector(double lo, double hi) {
+    return Vec3(uniform(lo, hi), uniform(lo, hi), uniform(lo, hi));
+  }
   Quat rotation() {
     // Shoemake's uniform random rotation.
     const double u1 = uniform(), u2 = uniform(), u3 = uniform();
     const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
-    return Quat(b * std::cos(2 * M_PI * u3), a * std::sin(2 * M_PI * u2), a * std::cos(2 * M_PI * u2),
-                b * std::sin(2 * M_PI * u3))
+    return Quat(b * std::cos(2 * M_PI * u3), a * std::sin(2 * M_PI * u2),
+                a * std::cos(2 * M_PI * u2), b * std::sin(2 * M_PI * u3))
         .normalized();
   }
   Vec3 direction() {
     Vec3 v;
-    do v = vector(-1, 1);
+    do
+      v = vector(-1, 1);
     while (v.squaredNorm() > 1 || v.squaredNorm() < 1e-6);
     return v.normalized();
   }
@@ -40,13 +43,14 @@ class Random {
 };
 
 struct ReferenceSat {
-  double separation;   // > 0 separated, < 0 overlapping by -separation
-  Vec3 axis;           // from A to B
-  double runner_up;    // separation along the best axis that is not parallel to `axis`
+  double separation;  // > 0 separated, < 0 overlapping by -separation
+  Vec3 axis;          // from A to B
+  double runner_up;   // separation along the best axis that is not parallel to `axis`
 };
 
 // Brute force: project all 8 corners of both boxes on each of the 15 candidate axes.
-inline ReferenceSat reference_box_sat(const Vec3& ha, const Pose& pa, const Vec3& hb, const Pose& pb) {
+inline ReferenceSat reference_box_sat(const Vec3& ha, const Pose& pa, const Vec3& hb,
+                                      const Pose& pb) {
   const Mat3 ra = pa.orientation.toRotationMatrix(), rb = pb.orientation.toRotationMatrix();
   // Relative frame of A, so that far-off coordinates do not cost precision here either.
   const Mat3 r = ra.transpose() * rb;
@@ -59,8 +63,10 @@ inline ReferenceSat reference_box_sat(const Vec3& ha, const Pose& pa, const Vec3
   }
   std::array<Vec3, 15> axes;
   int n = 0;
-  for (int i = 0; i < 3; ++i) axes[n++] = Vec3::Unit(i);
-  for (int i = 0; i < 3; ++i) axes[n++] = r.col(i);
+  for (int i = 0; i < 3; ++i)
+    axes[n++] = Vec3::Unit(i);
+  for (int i = 0; i < 3; ++i)
+    axes[n++] = r.col(i);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       const Vec3 c = Vec3::Unit(i).cross(r.col(j));

@@ -23,12 +23,13 @@ Status validate(const BodyDef& def) {
   if (!is_finite(def.orientation)) return Status::error("orientation: must be finite");
   const double norm = def.orientation.norm();
   if (std::abs(norm - 1) > 1e-3)
-    return Status::error("orientation: must be a unit quaternion (norm is " +
-                         std::to_string(norm) + ")");
+    return Status::error("orientation: must be a unit quaternion (norm is " + std::to_string(norm) +
+                         ")");
   if (Status s = check_vector(def.linear_velocity, "linear_velocity"); !s) return s;
   if (Status s = check_vector(def.angular_velocity, "angular_velocity"); !s) return s;
   if (!is_finite(def.mass) || def.mass < 0) return Status::error("mass: must be finite and >= 0");
-  if (def.type == BodyType::kDynamic && def.mass == 0 && !(def.density > 0 && is_finite(def.density)))
+  if (def.type == BodyType::kDynamic && def.mass == 0 &&
+      !(def.density > 0 && is_finite(def.density)))
     return Status::error("density: must be finite and > 0 when mass is 0");
   if (!is_finite(def.friction) || def.friction < 0)
     return Status::error("friction: must be finite and >= 0");

@@ -23,7 +23,9 @@ std::uint64_t cell_key(int level, std::int64_t x, std::int64_t y, std::int64_t z
   return h;
 }
 
-bool is_dead(const Aabb& box) { return !(box.min.x() <= box.max.x()); }
+bool is_dead(const Aabb& box) {
+  return !(box.min.x() <= box.max.x());
+}
 
 }  // namespace
 
@@ -77,14 +79,17 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
       const Eigen::Array3d lo = (box.min / cell).array().floor();
       const Eigen::Array3d hi = (box.max / cell).array().floor();
       for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
-        for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y()); ++y)
-          for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z()); ++z)
+        for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y());
+             ++y)
+          for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z());
+               ++z)
             out.push_back({cell_key(level, x, y, z), static_cast<std::uint32_t>(i)});
     }
   }
   // (2) One sorted array.
   entries_.clear();
-  for (const auto& buffer : thread_entries_) entries_.insert(entries_.end(), buffer.begin(), buffer.end());
+  for (const auto& buffer : thread_entries_)
+    entries_.insert(entries_.end(), buffer.begin(), buffer.end());
   std::sort(entries_.begin(), entries_.end());
 
   const auto emit = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
@@ -119,9 +124,12 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
         if (!(occupied >> level & 1)) continue;
         const Eigen::Array3d lo = (box.min / cell).array().floor();
         const Eigen::Array3d hi = (box.max / cell).array().floor();
-        for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
-          for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y()); ++y)
-            for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z()); ++z) {
+        for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x());
+             ++x)
+          for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y());
+               ++y)
+            for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z());
+                 ++z) {
               const std::uint64_t key = cell_key(level, x, y, z);
               auto it = std::lower_bound(entries_.begin(), entries_.end(), Entry{key, 0});
               for (; it != entries_.end() && it->key == key; ++it)
@@ -138,7 +146,8 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     }
   }
   // (4) Reduction.
-  for (const auto& buffer : thread_pairs_) pairs->insert(pairs->end(), buffer.begin(), buffer.end());
+  for (const auto& buffer : thread_pairs_)
+    pairs->insert(pairs->end(), buffer.begin(), buffer.end());
   std::sort(pairs->begin(), pairs->end());
   pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
 }
@@ -153,18 +162,22 @@ void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs)
     (bounds[i].is_bounded() ? order : unbounded).push_back(i);
   }
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return bounds[a].min.x() < bounds[b].min.x() || (bounds[a].min.x() == bounds[b].min.x() && a < b);
+    return bounds[a].min.x() < bounds[b].min.x() ||
+           (bounds[a].min.x() == bounds[b].min.x() && a < b);
   });
   auto emit = [&](std::uint32_t a, std::uint32_t b) {
     if (!(input.movable[a] || input.movable[b]) || !bounds[a].overlaps(bounds[b])) return;
     pairs->push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
   };
   for (std::size_t i = 0; i < order.size(); ++i)
-    for (std::size_t j = i + 1; j < order.size() && bounds[order[j]].min.x() <= bounds[order[i]].max.x(); ++j)
+    for (std::size_t j = i + 1;
+         j < order.size() && bounds[order[j]].min.x() <= bounds[order[i]].max.x(); ++j)
       emit(order[i], order[j]);
   for (std::size_t k = 0; k < unbounded.size(); ++k) {
-    for (std::uint32_t i : order) emit(i, unbounded[k]);
-    for (std::size_t m = k + 1; m < unbounded.size(); ++m) emit(unbounded[k], unbounded[m]);
+    for (std::uint32_t i : order)
+      emit(i, unbounded[k]);
+    for (std::size_t m = k + 1; m < unbounded.size(); ++m)
+      emit(unbounded[k], unbounded[m]);
   }
   std::sort(pairs->begin(), pairs->end());
 }

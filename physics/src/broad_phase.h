@@ -22,8 +22,8 @@
 namespace tumble {
 
 struct BroadPhaseInput {
-  std::span<const Aabb> bounds;            // by body slot; an empty box is a dead slot
-  std::span<const std::uint8_t> movable;   // 1 for dynamic bodies
+  std::span<const Aabb> bounds;           // by body slot; an empty box is a dead slot
+  std::span<const std::uint8_t> movable;  // 1 for dynamic bodies
   int threads = 1;
 };
 

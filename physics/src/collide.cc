@@ -39,9 +39,8 @@ std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b
     case ShapeType::kBox:
     case ShapeType::kHull:
       if (a.type() == ShapeType::kSphere || a.type() == ShapeType::kCapsule) {
-        const Vec3 axis = a.type() == ShapeType::kCapsule
-                              ? Vec3(a_in_b.col(2) * a.half_height())
-                              : Vec3::Zero();
+        const Vec3 axis =
+            a.type() == ShapeType::kCapsule ? Vec3(a_in_b.col(2) * a.half_height()) : Vec3::Zero();
         flags = collide_round_polytope(a_at - axis, a_at + axis, a.radius(), b, settings, out);
         in_b_frame = true;
       } else {
@@ -66,7 +65,8 @@ std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const 
   if (a.type() <= b.type()) return collide_ordered(a, pose_a, b, pose_b, settings, out);
   const std::uint32_t flags = collide_ordered(b, pose_b, a, pose_a, settings, out);
   out->normal = -out->normal;
-  for (int i = 0; i < out->count; ++i) std::swap(out->points[i].point_a, out->points[i].point_b);
+  for (int i = 0; i < out->count; ++i)
+    std::swap(out->points[i].point_a, out->points[i].point_b);
   return flags;
 }
 

@@ -20,7 +20,9 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
     candidates.push_back({on_a, Vec3(core.x(), core.y(), 0), depth, id});
   };
   switch (a.type()) {
-    case ShapeType::kSphere: consider(translation, a.radius(), kFeatureVertex); break;
+    case ShapeType::kSphere:
+      consider(translation, a.radius(), kFeatureVertex);
+      break;
     case ShapeType::kCapsule: {
       const Vec3 axis = rotation.col(2) * a.half_height();
       consider(translation - axis, a.radius(), kFeatureVertex | 0);
@@ -40,10 +42,12 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
       }
       break;
     }
-    case ShapeType::kHalfSpace: return kCollisionOk;
+    case ShapeType::kHalfSpace:
+      return kCollisionOk;
   }
   out->depth = -std::numeric_limits<double>::infinity();
-  for (const ContactPoint& c : candidates) out->depth = std::max(out->depth, c.depth);
+  for (const ContactPoint& c : candidates)
+    out->depth = std::max(out->depth, c.depth);
   reduce_points(candidates, out->normal, out);
   return kCollisionOk;
 }

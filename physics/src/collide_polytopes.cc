@@ -17,8 +17,8 @@ void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const Ed
                   ContactManifold* out) {
   const auto& ea = a.polyhedron->edges[query.edge_a];
   const auto& eb = b.polyhedron->edges[query.edge_b];
-  const SegmentClosest c =
-      closest_between_segments(a.point(ea.tail), a.point(ea.head), b.point(eb.tail), b.point(eb.head));
+  const SegmentClosest c = closest_between_segments(a.point(ea.tail), a.point(ea.head),
+                                                    b.point(eb.tail), b.point(eb.head));
   out->normal = query.axis;
   out->depth = -query.separation;
   out->count = 1;
@@ -32,8 +32,8 @@ void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const Ed
 // A manifold for a known normal (A to B): clip when the normal is a face normal of either body,
 // otherwise one point at the witness pair.
 void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const Vec3& normal,
-                          double depth, const Vec3& witness_a, const Vec3& witness_b,
-                          double margin, double scale, ContactManifold* out) {
+                          double depth, const Vec3& witness_a, const Vec3& witness_b, double margin,
+                          double scale, ContactManifold* out) {
   const std::uint32_t face_b = most_opposed_face(b, normal);
   const std::uint32_t face_a = most_opposed_face(a, -normal);
   const double align_a = a.face_normal(face_a).dot(normal);
@@ -48,16 +48,20 @@ void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, 
     bool use_a = a_aligned;
     if (a_aligned && b_aligned) {
       const Vec3 na = a.face_normal(face_a), nb = b.face_normal(face_b);
-      const double sep_a = na.dot(b.point(b.polyhedron->support_index(b.rotation.transpose() * -na))) -
-                           a.face_offset(face_a);
-      const double sep_b = nb.dot(a.point(a.polyhedron->support_index(a.rotation.transpose() * -nb))) -
-                           b.face_offset(face_b);
+      const double sep_a =
+          na.dot(b.point(b.polyhedron->support_index(b.rotation.transpose() * -na))) -
+          a.face_offset(face_a);
+      const double sep_b =
+          nb.dot(a.point(a.polyhedron->support_index(a.rotation.transpose() * -nb))) -
+          b.face_offset(face_b);
       use_a = sep_a >= sep_b - kFeaturePreference * scale;
     }
     if (use_a)
-      clip_face_contact(a, face_a, b, most_opposed_face(b, a.face_normal(face_a)), true, margin, out);
+      clip_face_contact(a, face_a, b, most_opposed_face(b, a.face_normal(face_a)), true, margin,
+                        out);
     else
-      clip_face_contact(b, face_b, a, most_opposed_face(a, b.face_normal(face_b)), false, margin, out);
+      clip_face_contact(b, face_b, a, most_opposed_face(a, b.face_normal(face_b)), false, margin,
+                        out);
     if (out->count > 0) {
       out->depth = depth;  // EPA's (or GJK's) own answer, not re-measured on the chosen face
       return;
@@ -84,18 +88,26 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
   const PlacedPolyhedron pb{&b, rotation, translation};
   const double margin = settings.margin;
 
-  if (settings.method == NarrowPhaseMethod::kGjkEpa) {
+  // SAT tests every Minkowski-face edge pair, so its cost grows with |E_A| |E_B|; past this many
+  // pairs GJK/EPA is faster at the same exactness (bench/narrow_phase.cc).
+  constexpr std::size_t kSatEdgePairLimit = 400;
+  const bool use_gjk = settings.method == NarrowPhaseMethod::kGjkEpa ||
+                       (settings.method == NarrowPhaseMethod::kAuto &&
+                        a.edges.size() * b.edges.size() > kSatEdgePairLimit);
+  if (use_gjk) {
     const PolyhedronSupport support_a{&a};
     const PolyhedronSupport local_b{&b};
     const Transformed<PolyhedronSupport> support_b{local_b, rotation, translation};
     GjkSettings gjk_settings;
     gjk_settings.tolerance = 1e-12 * scale;
     const GjkResult gjk = gjk_distance(support_a, support_b, translation, gjk_settings);
-    std::uint32_t flags = gjk.status == GjkStatus::kIterationLimit ? std::uint32_t{kGjkIterationLimit} : 0u;
+    std::uint32_t flags =
+        gjk.status == GjkStatus::kIterationLimit ? std::uint32_t{kGjkIterationLimit} : 0u;
     if (gjk.status != GjkStatus::kIntersecting && gjk.distance > gjk_settings.tolerance) {
       if (gjk.distance > margin) return flags;
       const Vec3 normal = (gjk.point_b - gjk.point_a) / gjk.distance;
-      manifold_from_normal(pa, pb, normal, -gjk.distance, gjk.point_a, gjk.point_b, margin, scale, out);
+      manifold_from_normal(pa, pb, normal, -gjk.distance, gjk.point_a, gjk.point_b, margin, scale,
+                           out);
       return flags;
     }
     EpaSettings epa_settings;
@@ -103,7 +115,8 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
     const EpaResult epa = epa_penetration(support_a, support_b, gjk.simplex, epa_settings);
     if (epa.status == EpaStatus::kIterationLimit) flags |= kEpaIterationLimit;
     if (epa.status == EpaStatus::kDegenerate) flags |= kEpaDegenerate;
-    manifold_from_normal(pa, pb, epa.normal, epa.depth, epa.point_a, epa.point_b, margin, scale, out);
+    manifold_from_normal(pa, pb, epa.normal, epa.depth, epa.point_a, epa.point_b, margin, scale,
+                         out);
     return flags;
   }
 

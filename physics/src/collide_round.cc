@@ -39,9 +39,8 @@ std::uint32_t collide_sphere_sphere(double radius_a, double radius_b, const Vec3
   return kCollisionOk;
 }
 
-std::uint32_t collide_sphere_capsule(double radius_a, const Shape& capsule_b,
-                                     const Mat3& rotation, const Vec3& translation,
-                                     double margin, ContactManifold* out) {
+std::uint32_t collide_sphere_capsule(double radius_a, const Shape& capsule_b, const Mat3& rotation,
+                                     const Vec3& translation, double margin, ContactManifold* out) {
   out->count = 0;
   const Vec3 axis = rotation.col(2) * capsule_b.half_height();
   const Vec3 p = translation - axis, q = translation + axis;
@@ -104,9 +103,9 @@ std::uint32_t collide_round_polytope(const Vec3& p, const Vec3& q, double radius
   const double tolerance = 1e-12 * (polytope_b.size() + radius + (q - p).norm());
   const bool is_point = p == q;
   std::uint32_t flags = kCollisionOk;
-  Vec3 normal;          // A to B
-  Vec3 core_point;      // deepest point of A's core
-  double core_depth;    // how far the core reaches into B (negative: its distance from B)
+  Vec3 normal;        // A to B
+  Vec3 core_point;    // deepest point of A's core
+  double core_depth;  // how far the core reaches into B (negative: its distance from B)
 
   if (is_point && polytope_b.type() == ShapeType::kBox) {
     // Closed form: clamp to the box, or push out through the nearest face from inside.
@@ -172,9 +171,12 @@ std::uint32_t collide_round_polytope(const Vec3& p, const Vec3& q, double radius
         const Vec3 v0 = poly.face_vertex(face, k), v1 = poly.face_vertex(face, k + 1);
         const Vec3 side = (v1 - v0).cross(face.normal);
         const double dp = side.dot(p - v0), dq = side.dot(q - v0);
-        if (dp > 0 && dq > 0) t1 = -1;  // wholly outside this side
-        else if (dp > 0) t0 = std::max(t0, dp / (dp - dq));
-        else if (dq > 0) t1 = std::min(t1, dp / (dp - dq));
+        if (dp > 0 && dq > 0)
+          t1 = -1;  // wholly outside this side
+        else if (dp > 0)
+          t0 = std::max(t0, dp / (dp - dq));
+        else if (dq > 0)
+          t1 = std::min(t1, dp / (dp - dq));
       }
       if (t1 > t0) {
         out->normal = -face.normal;

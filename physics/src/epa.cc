@@ -47,7 +47,8 @@ bool Polytope::expand(int seed, int apex) {
   std::array<Visit, kMaxFaces> stack;
   int top = 0;
   faces[seed].obsolete = true;
-  for (int e = 2; e >= 0; --e) stack[top++] = {faces[seed].adjacent[e], faces[seed].adjacent_edge[e]};
+  for (int e = 2; e >= 0; --e)
+    stack[top++] = {faces[seed].adjacent[e], faces[seed].adjacent_edge[e]};
   while (top > 0) {
     const Visit visit = stack[--top];
     Face& f = faces[visit.face];

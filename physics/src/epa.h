@@ -26,8 +26,8 @@ enum class EpaStatus { kConverged, kIterationLimit, kDegenerate };
 
 struct EpaResult {
   EpaStatus status = EpaStatus::kConverged;
-  double depth = 0;                 // m, >= 0 up to rounding
-  Vec3 normal = Vec3::UnitZ();      // unit, from A to B: moving B by depth * normal separates
+  double depth = 0;             // m, >= 0 up to rounding
+  Vec3 normal = Vec3::UnitZ();  // unit, from A to B: moving B by depth * normal separates
   Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();  // deepest points, common frame
   int iterations = 0;
 };
@@ -109,7 +109,8 @@ EpaResult epa_penetration(const A& a, const B& b, const Simplex& start,
   poly.vertex_count = poly.face_count = 0;
   for (int i = 0; i < start.size; ++i) {
     bool repeated = false;
-    for (int j = 0; j < poly.vertex_count; ++j) repeated |= poly.vertices[j].w == start.v[i].w;
+    for (int j = 0; j < poly.vertex_count; ++j)
+      repeated |= poly.vertices[j].w == start.v[i].w;
     if (!repeated) poly.add_vertex(start.v[i]);
   }
   auto finish_flat = [&](const Vec3& normal, double depth, EpaStatus status) {
@@ -120,14 +121,16 @@ EpaResult epa_penetration(const A& a, const B& b, const Simplex& start,
     double w[3];
     const Vec3 p = normal * depth;
     gjk_detail::triangle_weights(poly.vertices[0].w, poly.vertices[1].w, poly.vertices[2].w, p, w);
-    result.point_a = w[0] * poly.vertices[0].a + w[1] * poly.vertices[1].a + w[2] * poly.vertices[2].a;
-    result.point_b = w[0] * poly.vertices[0].b + w[1] * poly.vertices[1].b + w[2] * poly.vertices[2].b;
+    result.point_a =
+        w[0] * poly.vertices[0].a + w[1] * poly.vertices[1].a + w[2] * poly.vertices[2].a;
+    result.point_b =
+        w[0] * poly.vertices[0].b + w[1] * poly.vertices[1].b + w[2] * poly.vertices[2].b;
     return result;
   };
 
   // (1) Raise the simplex to a triangle: add support points off the current point or line.
-  static const Vec3 axes[6] = {Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(),
-                               -Vec3::UnitY(), Vec3::UnitZ(), -Vec3::UnitZ()};
+  static const Vec3 axes[6] = {Vec3::UnitX(),  -Vec3::UnitX(), Vec3::UnitY(),
+                               -Vec3::UnitY(), Vec3::UnitZ(),  -Vec3::UnitZ()};
   if (poly.vertex_count == 4) {
     const Vec3& p0 = poly.vertices[0].w;
     const Vec3 e1 = poly.vertices[1].w - p0, e2 = poly.vertices[2].w - p0,
@@ -147,11 +150,11 @@ EpaResult epa_penetration(const A& a, const B& b, const Simplex& start,
           best = f;
         }
       }
-      const SimplexVertex keep[3] = {poly.vertices[faces4[best][0]],
-                                     poly.vertices[faces4[best][1]],
+      const SimplexVertex keep[3] = {poly.vertices[faces4[best][0]], poly.vertices[faces4[best][1]],
                                      poly.vertices[faces4[best][2]]};
       poly.vertex_count = 0;
-      for (const auto& k : keep) poly.add_vertex(k);
+      for (const auto& k : keep)
+        poly.add_vertex(k);
     }
   }
   if (poly.vertex_count == 1) {
@@ -206,14 +209,15 @@ EpaResult epa_penetration(const A& a, const B& b, const Simplex& start,
       // One side is flush with a supporting plane: the triangle is part of the boundary.
       const int iapex = poly.add_vertex(up_ok ? up : down);
       const int triples[4][3] = {{ia, ib, ic}, {ia, ib, iapex}, {ib, ic, iapex}, {ic, ia, iapex}};
-      const Vec3 inside = (poly.vertices[0].w + poly.vertices[1].w + poly.vertices[2].w +
-                           poly.vertices[iapex].w) / 4;
+      const Vec3 inside =
+          (poly.vertices[0].w + poly.vertices[1].w + poly.vertices[2].w + poly.vertices[iapex].w) /
+          4;
       if (!poly.build(triples, 4, inside)) return finish_flat(n, n.dot(p0), EpaStatus::kDegenerate);
     }
   } else {
     const int triples[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
-    const Vec3 inside = (poly.vertices[0].w + poly.vertices[1].w + poly.vertices[2].w +
-                         poly.vertices[3].w) / 4;
+    const Vec3 inside =
+        (poly.vertices[0].w + poly.vertices[1].w + poly.vertices[2].w + poly.vertices[3].w) / 4;
     if (!poly.build(triples, 4, inside)) {
       result.status = EpaStatus::kDegenerate;
       return result;

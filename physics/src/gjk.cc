@@ -7,7 +7,9 @@
 namespace tumble::gjk_detail {
 namespace {
 
-double cross2(const Vec3& x, const Vec3& y, int i, int j) { return x[i] * y[j] - x[j] * y[i]; }
+double cross2(const Vec3& x, const Vec3& y, int i, int j) {
+  return x[i] * y[j] - x[j] * y[i];
+}
 
 // Copies only the live vertices: the rest of a simplex is never read.
 void assign(Simplex& to, const Simplex& from) {
@@ -116,8 +118,12 @@ Vec3 closest_point(Simplex& s) {
     case 1:
       s.weight[0] = 1;
       return s.v[0].w;
-    case 2: result = closest_on_segment(s, 0, 1, out); break;
-    case 3: result = closest_on_triangle(s, 0, 1, 2, out); break;
+    case 2:
+      result = closest_on_segment(s, 0, 1, out);
+      break;
+    case 3:
+      result = closest_on_triangle(s, 0, 1, 2, out);
+      break;
     default: {
       const Vec3& a = s.v[0].w;
       const Vec3 ab = s.v[1].w - a, ac = s.v[2].w - a, ad = s.v[3].w - a;

@@ -41,14 +41,14 @@ enum class GjkStatus { kSeparated, kIntersecting, kIterationLimit };
 
 struct GjkResult {
   GjkStatus status = GjkStatus::kSeparated;
-  double distance = 0;  // m
+  double distance = 0;                                  // m
   Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();  // closest points, common frame
   Simplex simplex;
   int iterations = 0;
 };
 
 struct GjkSettings {
-  double tolerance = 1e-12;  // m: |v| below this counts as touching; scale with the shapes
+  double tolerance = 1e-12;     // m: |v| below this counts as touching; scale with the shapes
   double relative_gap = 1e-13;  // stop when |v|^2 - v.w <= relative_gap * |v|^2
   int max_iterations = 128;
 };
@@ -97,7 +97,8 @@ GjkResult gjk_distance(const A& a, const B& b, const Vec3& initial_direction,
       break;
     }
     bool repeated = false;
-    for (int i = 0; i < s.size; ++i) repeated |= (s.v[i].w == w.w);
+    for (int i = 0; i < s.size; ++i)
+      repeated |= (s.v[i].w == w.w);
     if (repeated) {
       result.status = GjkStatus::kSeparated;
       break;

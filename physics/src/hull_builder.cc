@@ -59,14 +59,16 @@ Result<ConvexPolyhedron> build_convex_hull(std::span<const Vec3> points) {
 
   // Work relative to the bounding-box centre: qhull's tolerances are relative to coordinates.
   Aabb box;
-  for (const Vec3& p : points) box.grow(p);
+  for (const Vec3& p : points)
+    box.grow(p);
   const Vec3 centre = 0.5 * (box.min + box.max);
   const double span = box.extent().maxCoeff();
   if (!(span > 0)) return Status::error("points: all points coincide (degenerate hull)");
 
   std::vector<coordT> coords(points.size() * 3);
   for (std::size_t i = 0; i < points.size(); ++i)
-    for (int k = 0; k < 3; ++k) coords[3 * i + k] = points[i][k] - centre[k];
+    for (int k = 0; k < 3; ++k)
+      coords[3 * i + k] = points[i][k] - centre[k];
 
   CapturedStream errors;
   qhT qh_storage;
@@ -103,7 +105,8 @@ Result<ConvexPolyhedron> build_convex_hull(std::span<const Vec3> points) {
       vertexT** vertexp;
       FOREACHvertex_(facet->vertices) loop.push_back(vertex_index.at(vertex->id));
       Vec3 mid = Vec3::Zero();
-      for (auto v : loop) mid += hull.vertices[v];
+      for (auto v : loop)
+        mid += hull.vertices[v];
       mid /= static_cast<double>(loop.size());
       // Counter-clockwise about the outward normal: sort by angle in the facet plane.
       const Vec3 u = (hull.vertices[loop[0]] - mid).normalized();
@@ -115,7 +118,8 @@ Result<ConvexPolyhedron> build_convex_hull(std::span<const Vec3> points) {
       face.count = static_cast<std::uint32_t>(loop.size());
       // The plane through the outermost vertex, in our coordinates, so that it supports the hull.
       face.offset = -std::numeric_limits<double>::infinity();
-      for (auto v : loop) face.offset = std::max(face.offset, face.normal.dot(hull.vertices[v]));
+      for (auto v : loop)
+        face.offset = std::max(face.offset, face.normal.dot(hull.vertices[v]));
       hull.face_vertices.insert(hull.face_vertices.end(), loop.begin(), loop.end());
       hull.faces.push_back(face);
     }
@@ -175,7 +179,8 @@ ConvexPolyhedron make_box_polyhedron(const Vec3& h) {
   }
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> directed;
   for (std::uint32_t f = 0; f < 6; ++f)
-    for (std::uint32_t k = 0; k < 4; ++k) directed[{loops[f][k], loops[f][(k + 1) % 4]}] = f;
+    for (std::uint32_t k = 0; k < 4; ++k)
+      directed[{loops[f][k], loops[f][(k + 1) % 4]}] = f;
   for (const auto& [key, left] : directed)
     if (key.first < key.second)
       box.edges.push_back({key.first, key.second, left, directed.at({key.second, key.first})});

@@ -36,8 +36,7 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   polygon.clear();
   const auto& inc_face = incident.polyhedron->faces[incident_face];
   for (std::uint32_t k = 0; k < inc_face.count; ++k)
-    polygon.push_back(
-        {incident.point(incident.polyhedron->face_vertices[inc_face.first + k]), k});
+    polygon.push_back({incident.point(incident.polyhedron->face_vertices[inc_face.first + k]), k});
 
   const auto& ref_face = reference.polyhedron->faces[reference_face];
   const Vec3 n = reference.face_normal(reference_face);
@@ -58,7 +57,8 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
       if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
         const double t = da / (da - db);
         // The crossing is named by the incident edge (its first vertex's tag) and the side.
-        clipped.push_back({a.point + t * (b.point - a.point), kEdgeTag | ((a.tag & 0xFF) << 8) | k});
+        clipped.push_back(
+            {a.point + t * (b.point - a.point), kEdgeTag | ((a.tag & 0xFF) << 8) | k});
       }
     }
     std::swap(polygon, clipped);
@@ -86,9 +86,9 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   out->depth = -deepest_separation;
   if (candidates.empty() && deepest_separation <= margin) {
     const Vec3 on_reference = v - deepest_separation * n;
-    candidates.push_back({reference_is_a ? on_reference : v, reference_is_a ? v : on_reference,
-                          -deepest_separation,
-                          feature_id(kFeatureVertex, reference_face, deepest, reference_is_a ? 1 : 2)});
+    candidates.push_back(
+        {reference_is_a ? on_reference : v, reference_is_a ? v : on_reference, -deepest_separation,
+         feature_id(kFeatureVertex, reference_face, deepest, reference_is_a ? 1 : 2)});
   }
   out->normal = reference_is_a ? n : Vec3(-n);
   reduce_points(candidates, out->normal, out);
@@ -98,7 +98,8 @@ void reduce_points(std::span<const ContactPoint> candidates, const Vec3& normal,
                    ContactManifold* out) {
   const std::size_t count = candidates.size();
   if (count <= 4) {
-    for (std::size_t i = 0; i < count; ++i) out->points[i] = candidates[i];
+    for (std::size_t i = 0; i < count; ++i)
+      out->points[i] = candidates[i];
     out->count = static_cast<int>(count);
     return;
   }
@@ -132,8 +133,9 @@ void reduce_points(std::span<const ContactPoint> candidates, const Vec3& normal,
   int n = 0;
   for (std::size_t i : {first, second, third, fourth}) {
     bool repeated = false;
-    for (int k = 0; k < n; ++k) repeated |= out->points[k].feature_id == candidates[i].feature_id &&
-                                            out->points[k].point_b == candidates[i].point_b;
+    for (int k = 0; k < n; ++k)
+      repeated |= out->points[k].feature_id == candidates[i].feature_id &&
+                  out->points[k].point_b == candidates[i].point_b;
     if (!repeated) out->points[n++] = candidates[i];
   }
   out->count = n;

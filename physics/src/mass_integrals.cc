@@ -5,7 +5,8 @@ namespace tumble {
 PolyhedronIntegrals integrate_polyhedron(const ConvexPolyhedron& polyhedron) {
   // Tetrahedra from the vertex mean keep the summands small, so nothing cancels badly.
   Vec3 reference = Vec3::Zero();
-  for (const Vec3& v : polyhedron.vertices) reference += v;
+  for (const Vec3& v : polyhedron.vertices)
+    reference += v;
   reference /= static_cast<double>(polyhedron.vertices.size());
 
   // The covariance of the unit tetrahedron (0, e1, e2, e3) scaled by its determinant.

@@ -8,7 +8,7 @@
 namespace tumble {
 
 struct PolyhedronIntegrals {
-  double volume = 0;           // m^3
+  double volume = 0;  // m^3
   Vec3 centroid = Vec3::Zero();
   Mat3 second_moment = Mat3::Zero();  // integral of (x - centroid)(x - centroid)^T dV, m^5
 };

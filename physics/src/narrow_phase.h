@@ -13,9 +13,8 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
 // Sphere A (centre at the origin of A's frame) against sphere or capsule B placed in A's frame.
 std::uint32_t collide_sphere_sphere(double radius_a, double radius_b, const Vec3& centre_b,
                                     double margin, ContactManifold* out);
-std::uint32_t collide_sphere_capsule(double radius_a, const Shape& capsule_b,
-                                     const Mat3& rotation, const Vec3& translation,
-                                     double margin, ContactManifold* out);
+std::uint32_t collide_sphere_capsule(double radius_a, const Shape& capsule_b, const Mat3& rotation,
+                                     const Vec3& translation, double margin, ContactManifold* out);
 std::uint32_t collide_capsules(const Shape& a, const Shape& b, const Mat3& rotation,
                                const Vec3& translation, double margin, ContactManifold* out);
 // A sphere or capsule A, given by its core segment p..q (p == q for a sphere) and radius in B's

@@ -32,7 +32,8 @@ EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) {
   b_normals.resize(pb.faces.size());
   for (std::size_t i = 0; i < pb.vertices.size(); ++i)
     b_vertices[i] = rotation * pb.vertices[i] + translation;
-  for (std::size_t i = 0; i < pb.faces.size(); ++i) b_normals[i] = rotation * pb.faces[i].normal;
+  for (std::size_t i = 0; i < pb.faces.size(); ++i)
+    b_normals[i] = rotation * pb.faces[i].normal;
 
   EdgeQuery best;
   for (std::uint32_t i = 0; i < pa.edges.size(); ++i) {

@@ -18,11 +18,16 @@ Status check_length(double value, const char* field) {
 
 const char* shape_type_name(ShapeType type) {
   switch (type) {
-    case ShapeType::kSphere: return "sphere";
-    case ShapeType::kCapsule: return "capsule";
-    case ShapeType::kBox: return "box";
-    case ShapeType::kHull: return "hull";
-    case ShapeType::kHalfSpace: return "half_space";
+    case ShapeType::kSphere:
+      return "sphere";
+    case ShapeType::kCapsule:
+      return "capsule";
+    case ShapeType::kBox:
+      return "box";
+    case ShapeType::kHull:
+      return "hull";
+    case ShapeType::kHalfSpace:
+      return "half_space";
   }
   return "unknown";
 }
@@ -62,18 +67,22 @@ Result<Shape> Shape::create(const ShapeDef& def) {
 
 Aabb Shape::local_bounds() const {
   switch (type_) {
-    case ShapeType::kSphere: return {Vec3::Constant(-radius_), Vec3::Constant(radius_)};
+    case ShapeType::kSphere:
+      return {Vec3::Constant(-radius_), Vec3::Constant(radius_)};
     case ShapeType::kCapsule: {
       const Vec3 half(radius_, radius_, radius_ + half_height_);
       return {-half, half};
     }
-    case ShapeType::kBox: return {-half_extents_, half_extents_};
+    case ShapeType::kBox:
+      return {-half_extents_, half_extents_};
     case ShapeType::kHull: {
       Aabb bounds;
-      for (const Vec3& v : polyhedron_->vertices) bounds.grow(v);
+      for (const Vec3& v : polyhedron_->vertices)
+        bounds.grow(v);
       return bounds;
     }
-    case ShapeType::kHalfSpace: return Aabb::infinite();
+    case ShapeType::kHalfSpace:
+      return Aabb::infinite();
   }
   return Aabb::infinite();
 }
@@ -81,12 +90,16 @@ Aabb Shape::local_bounds() const {
 double Shape::volume() const {
   constexpr double pi = std::numbers::pi;
   switch (type_) {
-    case ShapeType::kSphere: return 4.0 / 3.0 * pi * radius_ * radius_ * radius_;
+    case ShapeType::kSphere:
+      return 4.0 / 3.0 * pi * radius_ * radius_ * radius_;
     case ShapeType::kCapsule:
       return pi * radius_ * radius_ * (2 * half_height_ + 4.0 / 3.0 * radius_);
-    case ShapeType::kBox: return 8 * half_extents_.prod();
-    case ShapeType::kHull: return polyhedron_->volume;
-    case ShapeType::kHalfSpace: return std::numeric_limits<double>::infinity();
+    case ShapeType::kBox:
+      return 8 * half_extents_.prod();
+    case ShapeType::kHull:
+      return polyhedron_->volume;
+    case ShapeType::kHalfSpace:
+      return std::numeric_limits<double>::infinity();
   }
   return 0;
 }
@@ -134,11 +147,15 @@ MassProperties Shape::mass_properties(double density) const {
 
 double Shape::size() const {
   switch (type_) {
-    case ShapeType::kSphere: return radius_;
-    case ShapeType::kCapsule: return radius_ + half_height_;
+    case ShapeType::kSphere:
+      return radius_;
+    case ShapeType::kCapsule:
+      return radius_ + half_height_;
     case ShapeType::kBox:
-    case ShapeType::kHull: return half_extents_.maxCoeff();
-    case ShapeType::kHalfSpace: return 1.0;
+    case ShapeType::kHull:
+      return half_extents_.maxCoeff();
+    case ShapeType::kHalfSpace:
+      return 1.0;
   }
   return 1.0;
 }
@@ -158,8 +175,10 @@ Vec3 Shape::support(const Vec3& d) const {
       return Vec3(d.x() >= 0 ? half_extents_.x() : -half_extents_.x(),
                   d.y() >= 0 ? half_extents_.y() : -half_extents_.y(),
                   d.z() >= 0 ? half_extents_.z() : -half_extents_.z());
-    case ShapeType::kHull: return polyhedron_->support(d);
-    case ShapeType::kHalfSpace: break;
+    case ShapeType::kHull:
+      return polyhedron_->support(d);
+    case ShapeType::kHalfSpace:
+      break;
   }
   TUMBLE_ASSERT(false && "a half-space has no support point");
   return Vec3::Zero();
@@ -168,8 +187,10 @@ Vec3 Shape::support(const Vec3& d) const {
 Shape Shape::recentred(const Vec3& offset) const {
   if (type_ != ShapeType::kHull || offset.isZero(0)) return *this;
   auto moved = std::make_shared<ConvexPolyhedron>(*polyhedron_);
-  for (Vec3& v : moved->vertices) v -= offset;
-  for (auto& face : moved->faces) face.offset -= face.normal.dot(offset);
+  for (Vec3& v : moved->vertices)
+    v -= offset;
+  for (auto& face : moved->faces)
+    face.offset -= face.normal.dot(offset);
   moved->centroid -= offset;
   Shape shape = *this;
   shape.polyhedron_ = std::move(moved);

@@ -12,7 +12,9 @@ namespace {
 // Below this many bodies sorting on one axis beats building grids.
 constexpr std::size_t kSweepAndPruneBelow = 64;
 
-int thread_count(int requested) { return requested > 0 ? requested : omp_get_max_threads(); }
+int thread_count(int requested) {
+  return requested > 0 ? requested : omp_get_max_threads();
+}
 
 // One grid per thread of the program: the world's own scratch, reused from call to call.
 HashGrid& scratch_grid() {
@@ -79,7 +81,9 @@ bool World::contains(BodyId id) const {
          bodies_[id.index].generation == id.generation;
 }
 
-const Body* World::body(BodyId id) const { return contains(id) ? &bodies_[id.index].body : nullptr; }
+const Body* World::body(BodyId id) const {
+  return contains(id) ? &bodies_[id.index].body : nullptr;
+}
 
 BodyId World::id_at(std::uint32_t index) const {
   if (index >= bodies_.size() || !bodies_[index].alive) return {};
@@ -126,7 +130,8 @@ std::span<const Contact> World::find_contacts() {
   contacts_.resize(pairs_.size());
   std::uint32_t flags = 0;
 #pragma omp parallel for schedule(static) num_threads(thread_count(settings_.threads)) \
-    reduction(| : flags) if (n > 64)
+    reduction(|                                                                        \
+              : flags) if (n > 64)
   for (std::int64_t i = 0; i < n; ++i) {
     const Body& a = bodies_[pairs_[i].a].body;
     const Body& b = bodies_[pairs_[i].b].body;

@@ -38,8 +38,8 @@ struct BodyDef {
   // Mass: kg. When 0 the mass comes from `density` (kg/m^3) and the shape's volume.
   double mass = 0;
   double density = 1000;
-  double friction = 0.5;     // Coulomb coefficient, >= 0
-  double restitution = 0;    // in [0, 1]
+  double friction = 0.5;   // Coulomb coefficient, >= 0
+  double restitution = 0;  // in [0, 1]
 };
 
 // Checks a definition without creating anything; the message names the field.
@@ -50,14 +50,14 @@ Status validate(const BodyDef& def);
 struct Body {
   Shape shape;
   BodyType type = BodyType::kDynamic;
-  double mass = 0, inverse_mass = 0;            // kg, 1/kg (0 for static)
-  Mat3 inertia_body = Mat3::Zero();             // kg m^2, body frame, about the centre of mass
+  double mass = 0, inverse_mass = 0;  // kg, 1/kg (0 for static)
+  Mat3 inertia_body = Mat3::Zero();   // kg m^2, body frame, about the centre of mass
   Mat3 inverse_inertia_body = Mat3::Zero();
-  Mat3 inverse_inertia_world = Mat3::Zero();    // kept current with the orientation
-  Vec3 position = Vec3::Zero();                 // m, centre of mass
+  Mat3 inverse_inertia_world = Mat3::Zero();  // kept current with the orientation
+  Vec3 position = Vec3::Zero();               // m, centre of mass
   Quat orientation = Quat::Identity();
-  Vec3 linear_velocity = Vec3::Zero();          // m/s
-  Vec3 angular_velocity = Vec3::Zero();         // rad/s, world frame
+  Vec3 linear_velocity = Vec3::Zero();   // m/s
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
   double friction = 0.5;
   double restitution = 0;
 

@@ -30,8 +30,10 @@ struct ContactManifold {
 };
 
 enum class NarrowPhaseMethod : std::uint8_t {
-  kAuto,    // the fastest exact method for each shape pair (SAT for polytopes)
-  kGjkEpa,  // GJK and EPA for every pair of convex shapes (for comparison and testing)
+  kAuto,    // the fastest exact method for each pair: SAT for small polytopes (boxes), GJK/EPA
+            // when the edge pairs to test grow large (hulls); see docs/PERFORMANCE.md
+  kSat,     // the separating-axis test for every pair of polytopes
+  kGjkEpa,  // GJK and EPA for every pair of polytopes
 };
 
 struct CollisionSettings {

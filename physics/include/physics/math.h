@@ -12,9 +12,15 @@ using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 using Quat = Eigen::Quaterniond;
 
-inline bool is_finite(double x) { return std::isfinite(x); }
-inline bool is_finite(const Vec3& v) { return v.allFinite(); }
-inline bool is_finite(const Quat& q) { return q.coeffs().allFinite(); }
+inline bool is_finite(double x) {
+  return std::isfinite(x);
+}
+inline bool is_finite(const Vec3& v) {
+  return v.allFinite();
+}
+inline bool is_finite(const Quat& q) {
+  return q.coeffs().allFinite();
+}
 
 // A rigid transform from a local frame to the world: world = rotation * local + position.
 struct Pose {

@@ -13,10 +13,10 @@ namespace tumble {
 
 struct ConvexPolyhedron {
   struct Face {
-    Vec3 normal;            // unit, outward
-    double offset;          // plane: normal . x = offset
-    std::uint32_t first;    // into face_vertices
-    std::uint32_t count;    // vertices of the loop, counter-clockwise seen from outside
+    Vec3 normal;          // unit, outward
+    double offset;        // plane: normal . x = offset
+    std::uint32_t first;  // into face_vertices
+    std::uint32_t count;  // vertices of the loop, counter-clockwise seen from outside
   };
   struct Edge {
     std::uint32_t tail, head;   // vertex indices

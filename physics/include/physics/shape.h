@@ -42,9 +42,9 @@ enum class ShapeType : std::uint8_t { kSphere, kCapsule, kBox, kHull, kHalfSpace
 const char* shape_type_name(ShapeType type);
 
 struct MassProperties {
-  double mass = 0;                      // kg
-  Vec3 center_of_mass = Vec3::Zero();   // m, shape frame
-  Mat3 inertia = Mat3::Zero();          // kg m^2, about the centre of mass, shape-frame axes
+  double mass = 0;                     // kg
+  Vec3 center_of_mass = Vec3::Zero();  // m, shape frame
+  Mat3 inertia = Mat3::Zero();         // kg m^2, about the centre of mass, shape-frame axes
 };
 
 class Shape {
@@ -53,8 +53,8 @@ class Shape {
   static Result<Shape> create(const ShapeDef& def);
 
   ShapeType type() const { return type_; }
-  double radius() const { return radius_; }            // sphere, capsule
-  double half_height() const { return half_height_; }  // capsule
+  double radius() const { return radius_; }                   // sphere, capsule
+  double half_height() const { return half_height_; }         // capsule
   const Vec3& half_extents() const { return half_extents_; }  // box
   // The polyhedron of a box or hull; null for the other shapes.
   const ConvexPolyhedron* polyhedron() const { return polyhedron_.get(); }
