@@ -94,13 +94,7 @@ template <SupportShape A, SupportShape B>
 EpaResult epa_penetration(const A& a, const B& b, const Simplex& start,
                           const EpaSettings& settings = {}) {
   using namespace epa_detail;
-  auto support = [&](const Vec3& d) {
-    SimplexVertex sv;
-    sv.a = a.support(d);
-    sv.b = b.support(-d);
-    sv.w = sv.a - sv.b;
-    return sv;
-  };
+  auto support = [&](const Vec3& d) { return minkowski_support(a, b, d); };
   EpaResult result;
   const double tol = settings.tolerance;
   // The polytope is large (about 60 kB); one per thread, reused, keeps the stack small and the

@@ -53,6 +53,16 @@ struct GjkSettings {
   int max_iterations = 128;
 };
 
+// The point of A - B farthest along d, with the support points of A and B that make it.
+template <SupportShape A, SupportShape B>
+SimplexVertex minkowski_support(const A& a, const B& b, const Vec3& d) {
+  SimplexVertex sv;
+  sv.a = a.support(d);
+  sv.b = b.support(-d);
+  sv.w = sv.a - sv.b;
+  return sv;
+}
+
 namespace gjk_detail {
 
 // Closest point of a simplex to the origin; reduces the simplex to the support set of that point
@@ -68,13 +78,7 @@ GjkResult gjk_distance(const A& a, const B& b, const Vec3& initial_direction,
                        const GjkSettings& settings = {}) {
   GjkResult result;
   Simplex& s = result.simplex;
-  auto support = [&](const Vec3& d) {
-    SimplexVertex sv;
-    sv.a = a.support(d);
-    sv.b = b.support(-d);
-    sv.w = sv.a - sv.b;
-    return sv;
-  };
+  auto support = [&](const Vec3& d) { return minkowski_support(a, b, d); };
   Vec3 d = initial_direction.squaredNorm() > 0 ? initial_direction : Vec3(1, 0, 0);
   s.v[0] = support(-d);
   s.weight[0] = 1;
