@@ -100,7 +100,6 @@ void check_pairs(NarrowPhaseMethod method, int count, Tally* tally) {
   Random rng(20261122);
   CollisionSettings settings;
   settings.method = method;
-  const Shape unit = Shape::create(BoxDef{}).value();
   for (int i = 0; i < count; ++i) {
     const BoxPair p = make_pair(rng, i);
     const Shape a = Shape::create(BoxDef{p.ha}).value();
@@ -139,7 +138,6 @@ void check_pairs(NarrowPhaseMethod method, int count, Tally* tally) {
       ASSERT_LE(c.depth, -ref.separation + tolerance) << where;
     }
   }
-  (void)unit;
 }
 
 TEST(BoxCollision, SatMatchesExactReferenceOn100kPairs) {

@@ -77,8 +77,7 @@ Mat3 integrate_inertia(const Shape& shape, double density, int cells) {
     for (int j = 0; j < cells; ++j)
       for (int k = 0; k < cells; ++k) {
         const Vec3 p = box.min + step.cwiseProduct(Vec3(i + 0.5, j + 0.5, k + 0.5));
-        // Inside test through the support function: a convex shape contains p when no
-        // direction separates it; for a capsule the distance to the core decides.
+        // Inside test: distance to the core segment (a sphere's core is a point).
         const double r = shape.radius();
         const Vec3 core(0, 0, std::clamp(p.z(), -shape.half_height(), shape.half_height()));
         if ((p - core).norm() > r) continue;

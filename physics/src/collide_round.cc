@@ -9,8 +9,7 @@
 namespace tumble {
 namespace {
 
-// Writes one point between core points `on_a` (core of A) and `on_b` (surface of B or core of B
-// with its radius already removed), both in one frame.
+// Writes a one-point manifold from the two surface points, both in one frame.
 void single_point(const Vec3& normal, const Vec3& surface_a, const Vec3& surface_b, double depth,
                   std::uint64_t id, ContactManifold* out) {
   out->normal = normal;
