@@ -20,7 +20,7 @@ test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
 demo: build
-	@$(BUILD_DIR)/apps/tumble-demo
+	@$(BUILD_DIR)/apps/tumble-run
 
 bench: CMAKE_FLAGS += -DTUMBLE_BENCH_PEERS=ON
 bench:

@@ -66,6 +66,8 @@ Result<Body> make_body(const BodyDef& def) {
     body.inverse_inertia_body = props.inertia.inverse();
     if (!body.inverse_inertia_body.allFinite())
       return Status::error("shape: its inertia tensor is singular");
+    const Mat3 spherical = Mat3::Identity() * (props.inertia.trace() / 3);
+    body.spherical_inertia = (props.inertia - spherical).norm() <= 1e-12 * props.inertia.norm();
   }
   body.update_world_inertia();
   return body;

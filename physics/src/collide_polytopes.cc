@@ -1,5 +1,8 @@
 // Boxes and hulls against each other: the exact separating-axis test by default, GJK and EPA on
 // request; either way the contact normal becomes a manifold by face clipping.
+#include <algorithm>
+#include <cmath>
+
 #include "epa.h"
 #include "manifold.h"
 #include "narrow_phase.h"
@@ -12,6 +15,13 @@ namespace {
 // A face is preferred over an edge pair, and A's face over B's, unless the other separates by
 // more than this share of the shapes' size: stable manifolds without giving up exactness.
 constexpr double kFeaturePreference = 2e-10;
+
+// How much better another feature must separate the shapes to be chosen; `separation` is the
+// pair's (negative when overlapping).
+double feature_tolerance(const CollisionSettings& settings, double scale, double separation) {
+  return kFeaturePreference * scale + settings.feature_slack +
+         settings.feature_slack_relative * std::max(0.0, -separation);
+}
 
 void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const EdgeQuery& query,
                   ContactManifold* out) {
@@ -32,16 +42,17 @@ void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const Ed
 // A manifold for a known normal (A to B): clip when the normal is a face normal of either body,
 // otherwise one point at the witness pair.
 void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const Vec3& normal,
-                          double depth, const Vec3& witness_a, const Vec3& witness_b, double margin,
-                          double scale, ContactManifold* out) {
+                          double depth, const Vec3& witness_a, const Vec3& witness_b,
+                          const CollisionSettings& settings, double scale, ContactManifold* out) {
+  const double margin = settings.margin;
   const std::uint32_t face_b = most_opposed_face(b, normal);
   const std::uint32_t face_a = most_opposed_face(a, -normal);
   const double align_a = a.face_normal(face_a).dot(normal);
   const double align_b = -b.face_normal(face_b).dot(normal);
-  // EPA's normal is good to about 1e-12; a looser test would swallow edge axes that lie within
-  // a few microradians of a face normal.
-  constexpr double kFaceAlignment = 1 - 1e-13;
-  const bool a_aligned = align_a >= kFaceAlignment, b_aligned = align_b >= kFaceAlignment;
+  // By default only faces parallel to EPA's accuracy (about 1e-12 in the cosine); a solver asks
+  // for more so that slightly tilted faces keep their full manifold.
+  const double face_alignment = std::cos(settings.face_angle);
+  const bool a_aligned = align_a >= face_alignment, b_aligned = align_b >= face_alignment;
   if (a_aligned || b_aligned) {
     // Two nearly parallel faces: decide by their separations, exactly as the SAT path does, so
     // that both paths give the same manifold.
@@ -54,7 +65,7 @@ void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, 
       const double sep_b =
           nb.dot(a.point(a.polyhedron->support_index(a.rotation.transpose() * -nb))) -
           b.face_offset(face_b);
-      use_a = sep_a >= sep_b - kFeaturePreference * scale;
+      use_a = sep_a >= sep_b - feature_tolerance(settings, scale, std::max(sep_a, sep_b));
     }
     if (use_a)
       clip_face_contact(a, face_a, b, most_opposed_face(b, a.face_normal(face_a)), true, margin,
@@ -106,8 +117,8 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
     if (gjk.status != GjkStatus::kIntersecting && gjk.distance > gjk_settings.tolerance) {
       if (gjk.distance > margin) return flags;
       const Vec3 normal = (gjk.point_b - gjk.point_a) / gjk.distance;
-      manifold_from_normal(pa, pb, normal, -gjk.distance, gjk.point_a, gjk.point_b, margin, scale,
-                           out);
+      manifold_from_normal(pa, pb, normal, -gjk.distance, gjk.point_a, gjk.point_b, settings,
+                           scale, out);
       return flags;
     }
     EpaSettings epa_settings;
@@ -115,7 +126,7 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
     const EpaResult epa = epa_penetration(support_a, support_b, gjk.simplex, epa_settings);
     if (epa.status == EpaStatus::kIterationLimit) flags |= kEpaIterationLimit;
     if (epa.status == EpaStatus::kDegenerate) flags |= kEpaDegenerate;
-    manifold_from_normal(pa, pb, epa.normal, epa.depth, epa.point_a, epa.point_b, margin, scale,
+    manifold_from_normal(pa, pb, epa.normal, epa.depth, epa.point_a, epa.point_b, settings, scale,
                          out);
     return flags;
   }
@@ -127,10 +138,11 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
   const EdgeQuery edges = query_edges(pa, pb);
   if (edges.separation > margin) return kCollisionOk;
 
-  const double preference = kFeaturePreference * scale;
-  const bool use_a = face_a.separation >= face_b.separation - preference;
+  const double deepest = std::max({face_a.separation, face_b.separation, edges.separation});
+  const double tolerance = feature_tolerance(settings, scale, deepest);
+  const bool use_a = face_a.separation >= face_b.separation - tolerance;
   const double chosen_face = use_a ? face_a.separation : face_b.separation;
-  if (edges.separation > chosen_face + preference) {
+  if (edges.separation > chosen_face + tolerance) {
     edge_contact(pa, pb, edges, out);
   } else if (use_a) {
     const Vec3 n = pa.face_normal(face_a.face);
@@ -139,6 +151,7 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
     const Vec3 n = pb.face_normal(face_b.face);
     clip_face_contact(pb, face_b.face, pa, most_opposed_face(pa, n), false, margin, out);
   }
+  if (out->count > 0) out->depth = -deepest;  // the exact pair penetration, whatever the feature
   return kCollisionOk;
 }
 

@@ -2,9 +2,12 @@
 
 #include <omp.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "broad_phase.h"
+#include "step_scratch.h"
 
 namespace tumble {
 namespace {
@@ -24,7 +27,51 @@ HashGrid& scratch_grid() {
 
 }  // namespace
 
-World::World(const WorldSettings& settings) : settings_(settings) {}
+World::World(const WorldSettings& settings)
+    : settings_(settings), scratch_(std::make_unique<StepScratch>()) {}
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+Status validate(const WorldSettings& s) {
+  if (!is_finite(s.gravity)) return Status::error("gravity: must be finite");
+  if (s.threads < 0) return Status::error("threads: must be >= 0");
+  if (!(s.collision.margin >= 0) || !std::isfinite(s.collision.margin))
+    return Status::error("collision.margin: must be finite and >= 0");
+  const SolverSettings& v = s.solver;
+  if (v.iterations < 1 || v.iterations > 1000) return Status::error("solver.iterations: must be in [1, 1000]");
+  if (v.soft_iterations < 1 || v.soft_iterations > 1000)
+    return Status::error("solver.soft_iterations: must be in [1, 1000]");
+  if (v.substeps < 1 || v.substeps > 1000) return Status::error("solver.substeps: must be in [1, 1000]");
+  if (v.position_iterations < 0 || v.position_iterations > 1000)
+    return Status::error("solver.position_iterations: must be in [0, 1000]");
+  if (v.exact_max_points < 0) return Status::error("solver.exact_max_points: must be >= 0");
+  if (v.friction_directions < 4 || v.friction_directions > 32)
+    return Status::error("solver.friction_directions: must be in [4, 32]");
+  if (v.lemke_pivots_per_unknown < 1)
+    return Status::error("solver.lemke_pivots_per_unknown: must be >= 1");
+  auto non_negative = [](double x) { return std::isfinite(x) && x >= 0; };
+  if (!non_negative(v.slop)) return Status::error("solver.slop: must be finite and >= 0");
+  if (!non_negative(v.speculative_distance))
+    return Status::error("solver.speculative_distance: must be finite and >= 0");
+  if (!non_negative(v.restitution_threshold))
+    return Status::error("solver.restitution_threshold: must be finite and >= 0");
+  if (!(v.contact_hertz > 0) || !std::isfinite(v.contact_hertz))
+    return Status::error("solver.contact_hertz: must be finite and > 0");
+  if (!non_negative(v.contact_damping_ratio))
+    return Status::error("solver.contact_damping_ratio: must be finite and >= 0");
+  if (!(v.max_push_velocity > 0) || !std::isfinite(v.max_push_velocity))
+    return Status::error("solver.max_push_velocity: must be finite and > 0");
+  if (!non_negative(v.max_correction)) return Status::error("solver.max_correction: must be finite and >= 0");
+  if (!(v.baumgarte >= 0 && v.baumgarte <= 1)) return Status::error("solver.baumgarte: must be in [0, 1]");
+  return Status::ok();
+}
+
+Status World::set_settings(const WorldSettings& settings) {
+  if (Status s = validate(settings); !s) return s;
+  settings_ = settings;
+  return Status::ok();
+}
 
 Result<BodyId> World::create_body(const BodyDef& def) {
   Result<std::vector<BodyId>> ids = create_bodies(std::span<const BodyDef>(&def, 1));
@@ -90,11 +137,16 @@ BodyId World::id_at(std::uint32_t index) const {
   return {index, bodies_[index].generation};
 }
 
-void World::compute_bounds() {
+// With dt > 0 each body's bounds grow by how far it can move in the step (its speculative
+// distance), so pairs about to touch are found before they do.
+void World::compute_bounds(double dt) {
   const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
   bounds_.resize(bodies_.size());
   movable_.resize(bodies_.size());
-  const double margin = settings_.collision.margin;
+  speculative_.assign(bodies_.size(), 0.0);
+  const double base_margin =
+      settings_.collision.margin + (dt > 0 ? settings_.solver.speculative_distance : 0.0);
+  const double gravity = settings_.gravity.norm();
 #pragma omp parallel for schedule(static) num_threads(thread_count(settings_.threads)) if (n > 256)
   for (std::int64_t i = 0; i < n; ++i) {
     const Slot& slot = bodies_[i];
@@ -103,13 +155,25 @@ void World::compute_bounds() {
       movable_[i] = 0;
       continue;
     }
-    bounds_[i] = transform_aabb(slot.body.shape.local_bounds(), slot.body.pose()).expanded(margin);
-    movable_[i] = slot.body.is_static() ? 0 : 1;
+    const Body& body = slot.body;
+    const Aabb local = body.shape.local_bounds();
+    if (dt > 0 && !body.is_static()) {
+      const double reach = 0.5 * local.extent().norm();
+      speculative_[i] = (body.linear_velocity.norm() + gravity * dt +
+                         body.angular_velocity.norm() * reach) * dt;
+    }
+    bounds_[i] = transform_aabb(local, body.pose()).expanded(base_margin + speculative_[i]);
+    movable_[i] = body.is_static() ? 0 : 1;
   }
 }
 
 std::span<const BodyPair> World::find_pairs() {
-  compute_bounds();
+  compute_bounds(0);
+  run_broad_phase();
+  return pairs_;
+}
+
+void World::run_broad_phase() {
   const BroadPhaseInput input{bounds_, movable_, thread_count(settings_.threads)};
   BroadPhaseMethod method = settings_.broad_phase;
   if (method == BroadPhaseMethod::kAuto)
@@ -119,11 +183,15 @@ std::span<const BodyPair> World::find_pairs() {
     sweep_and_prune(input, &pairs_);
   else
     scratch_grid().find_pairs(input, &pairs_);
-  return pairs_;
 }
 
 std::span<const Contact> World::find_contacts() {
   find_pairs();
+  find_contacts(0);
+  return contacts_;
+}
+
+void World::find_contacts(double dt) {
   const std::int64_t n = static_cast<std::int64_t>(pairs_.size());
   // Every pair writes its own slot, then the touching ones are packed in pair order: the same
   // result for any thread count.
@@ -138,14 +206,22 @@ std::span<const Contact> World::find_contacts() {
     Contact& contact = contacts_[i];
     contact.a = {pairs_[i].a, bodies_[pairs_[i].a].generation};
     contact.b = {pairs_[i].b, bodies_[pairs_[i].b].generation};
-    flags |= collide(a.shape, a.pose(), b.shape, b.pose(), settings_.collision, &contact.manifold);
+    CollisionSettings settings = settings_.collision;
+    if (dt > 0) {
+      settings.margin += settings_.solver.speculative_distance + speculative_[pairs_[i].a] +
+                         speculative_[pairs_[i].b];
+      // A stepping world wants the same manifold from step to step (see CollisionSettings).
+      settings.feature_slack = std::max(settings.feature_slack, settings_.solver.slop);
+      settings.feature_slack_relative = std::max(settings.feature_slack_relative, 0.05);
+      settings.face_angle = std::max(settings.face_angle, 0.02);
+    }
+    flags |= collide(a.shape, a.pose(), b.shape, b.pose(), settings, &contact.manifold);
   }
   std::size_t kept = 0;
   for (std::size_t i = 0; i < contacts_.size(); ++i)
     if (contacts_[i].manifold.count > 0) contacts_[kept++] = contacts_[i];
   contacts_.resize(kept);
   collision_flags_ = flags;
-  return contacts_;
 }
 
 }  // namespace tumble

@@ -60,6 +60,8 @@ struct Body {
   Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
   double friction = 0.5;
   double restitution = 0;
+  // The inertia is a multiple of the identity (sphere, cube): no gyroscopic torque.
+  bool spherical_inertia = false;
 
   bool is_static() const { return type == BodyType::kStatic; }
   Pose pose() const { return {position, orientation}; }

@@ -40,6 +40,16 @@ struct CollisionSettings {
   // m: pairs separated by less than this still produce (speculative) contacts.
   double margin = 0;
   NarrowPhaseMethod method = NarrowPhaseMethod::kAuto;
+  // Contact features for a solver: a face contact (several points) is kept unless an edge pair,
+  // or the other body's face, separates the shapes by more than `feature_slack` (m) plus
+  // `feature_slack_relative` of the penetration. A stack then keeps its four-point manifolds
+  // when a box tilts a little; `depth` stays the exact pair penetration either way. 0 (the
+  // default) picks the exact minimum-penetration feature.
+  double feature_slack = 0;
+  double feature_slack_relative = 0;
+  // GJK/EPA path: a face whose normal is within this angle (rad) of the contact normal is
+  // clipped as a face. The default only accepts faces parallel to EPA's accuracy.
+  double face_angle = 4.5e-7;
 };
 
 // Outcome flags a query raises; a query that hits an iteration bound still returns its best answer.

@@ -1,8 +1,8 @@
-// The world: owns bodies and finds which of them touch. Stepping (integration and contact
-// response) arrives with the solvers.
+// The world: owns bodies, finds which of them touch, and steps them.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -10,6 +10,7 @@
 #include "physics/collision.h"
 #include "physics/math.h"
 #include "physics/status.h"
+#include "physics/step.h"
 
 namespace tumble {
 
@@ -24,7 +25,11 @@ struct WorldSettings {
   int threads = 0;                   // OpenMP threads for the step; 0 = OpenMP's default
   BroadPhaseMethod broad_phase = BroadPhaseMethod::kAuto;
   CollisionSettings collision;
+  SolverSettings solver;
 };
+
+// Checks settings without applying them; the message names the field.
+Status validate(const WorldSettings& settings);
 
 // A pair of bodies whose bounding boxes overlap; `a` < `b` by body index.
 struct BodyPair {
@@ -37,9 +42,14 @@ struct Contact {
   ContactManifold manifold;
 };
 
+struct StepScratch;
+
 class World {
  public:
   explicit World(const WorldSettings& settings = {});
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
 
   // Creates one body, or none and says why.
   Result<BodyId> create_body(const BodyDef& def);
@@ -55,7 +65,21 @@ class World {
   std::uint32_t slot_count() const { return static_cast<std::uint32_t>(bodies_.size()); }
 
   const WorldSettings& settings() const { return settings_; }
+  // Applies all settings or none.
+  Status set_settings(const WorldSettings& settings);
   void set_broad_phase(BroadPhaseMethod method) { settings_.broad_phase = method; }
+
+  // Advances the world by dt seconds (> 0): broad phase, narrow phase, contact preparation,
+  // solve and integrate per island, position correction. See StepStats for what it reports.
+  Status step(double dt);
+  const StepStats& last_step() const { return stats_; }
+  double time() const { return time_; }  // s, simulated
+  std::uint64_t step_count() const { return stats_.step; }
+  // Normal impulse (N s) of each contact point of the last step, in the order of contacts()'s
+  // manifolds and their points.
+  std::span<const double> contact_impulses() const { return impulses_; }
+  // The manifolds of the last step (or of the last find_contacts()).
+  std::span<const Contact> contacts() const { return contacts_; }
 
   // Broad phase: pairs of bodies whose world bounds (grown by the contact margin) overlap, at
   // least one of them dynamic, sorted, unique.
@@ -71,7 +95,14 @@ class World {
     std::uint32_t generation = 0;
     bool alive = false;
   };
-  void compute_bounds();
+  void compute_bounds(double dt);
+  void run_broad_phase();
+  void find_contacts(double dt);
+  // Stages of step().
+  void prepare_contacts(double dt);
+  void solve_islands(double dt);
+  void correct_positions();
+  void finish_step(double dt);
 
   WorldSettings settings_;
   std::vector<Slot> bodies_;
@@ -82,6 +113,11 @@ class World {
   std::vector<BodyPair> pairs_;
   std::vector<Contact> contacts_;
   std::uint32_t collision_flags_ = 0;
+  std::vector<double> speculative_;  // m, how far each body may move in the step
+  std::vector<double> impulses_;
+  std::unique_ptr<StepScratch> scratch_;
+  StepStats stats_;
+  double time_ = 0;
 };
 
 }  // namespace tumble

@@ -1,0 +1,69 @@
+// How the world steps: the contact solver and its settings, and what a step reports.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace tumble {
+
+enum class SolverKind : std::uint8_t {
+  kExact,  // one linear complementarity problem per island, solved by Lemke's algorithm
+  kPgs,    // projected Gauss-Seidel (sequential impulses), warm-started, one velocity solve
+  kSoft,   // substeps with soft contacts: solve with bias, integrate, relax without bias
+  kAuto,   // exact for islands up to `exact_max_points` contact points, soft for larger ones
+};
+std::string_view solver_name(SolverKind kind);
+std::optional<SolverKind> solver_from_name(std::string_view name);
+
+struct SolverSettings {
+  SolverKind kind = SolverKind::kAuto;
+  // Velocity iterations: per step for pgs, per substep for soft (the relax pass does as many).
+  int iterations = 10;
+  int soft_iterations = 2;
+  int substeps = 4;  // soft only; the others take one step of dt
+  // Position iterations after the velocity solve (exact, pgs): nonlinear Gauss-Seidel that moves
+  // bodies out of penetration without adding velocity.
+  int position_iterations = 3;
+  // auto: an island with at most this many contact points goes to the exact solver.
+  int exact_max_points = 16;
+  // Directions of the friction pyramid in the exact solver (its facets); 4 to 32. The first one
+  // follows the sliding direction, so a sliding body feels the full Coulomb force.
+  int friction_directions = 8;
+  // Lemke: pivots allowed per unknown before the island falls back to pgs.
+  int lemke_pivots_per_unknown = 20;
+  double slop = 1e-4;                  // m: penetration left alone, so resting contacts keep still
+  double speculative_distance = 0.02;  // m: gap below which contacts exist even at rest
+  double restitution_threshold = 1.0;  // m/s: slower impacts do not bounce
+  double contact_hertz = 60;           // soft: stiffness of the contact spring, Hz
+  double contact_damping_ratio = 10;   // soft: its damping ratio (strongly over-damped)
+  double max_push_velocity = 3;        // m/s: penetration is resolved no faster than this
+  double max_correction = 0.2;         // m: position correction per iteration (exact, pgs)
+  double baumgarte = 0.2;              // fraction of penetration corrected per position iteration
+};
+
+// Wall time of the step's stages, seconds.
+struct StageTimes {
+  double broad_phase = 0, narrow_phase = 0, prepare = 0, solve = 0, correct_positions = 0,
+         total = 0;
+};
+
+struct StepStats {
+  std::uint64_t step = 0;  // steps taken so far, this one included
+  std::uint32_t pairs = 0, manifolds = 0, contact_points = 0;
+  std::uint32_t islands = 0, exact_islands = 0, iterative_islands = 0;
+  // Islands the exact solver could not finish (pivot bound, ray termination): solved by pgs.
+  std::uint32_t exact_fallbacks = 0;
+  std::uint64_t lemke_pivots = 0;
+  std::uint64_t velocity_iterations = 0;  // pgs and soft, summed over islands and substeps
+  // Largest complementarity residual of a normal contact row after the solve, m/s:
+  // |min(impulse / effective mass, normal velocity - target)|; 0 when exactly solved.
+  double residual = 0;
+  double max_penetration = 0;  // m, the deepest contact point found this step
+  std::uint32_t collision_flags = 0;
+  // Bodies whose implicit gyroscopic step hit its Newton iteration bound.
+  std::uint32_t gyroscopic_limit_hits = 0;
+  StageTimes time;
+};
+
+}  // namespace tumble

@@ -1,0 +1,352 @@
+#include "contact_solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "rotation.h"
+
+namespace tumble {
+namespace {
+
+// Relative tangential speeds below this leave the friction basis fixed to the normal, so resting
+// contacts keep one basis from step to step.
+constexpr double kSlidingSpeed = 1e-3;
+
+double effective_mass(const Body& a, const Body& b, const Vec3& ra, const Vec3& rb,
+                      const Vec3& direction) {
+  const Vec3 ca = ra.cross(direction);
+  const Vec3 cb = rb.cross(direction);
+  const double k = a.inverse_mass + b.inverse_mass + ca.dot(a.inverse_inertia_world * ca) +
+                   cb.dot(b.inverse_inertia_world * cb);
+  return k > 0 ? 1.0 / k : 0.0;
+}
+
+// A unit vector perpendicular to `n`, chosen the same way every time.
+Vec3 any_perpendicular(const Vec3& n) {
+  const Vec3 axis = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
+  return n.cross(axis).normalized();
+}
+
+bool less_pair(const CachedImpulse& c, BodyId a, BodyId b) {
+  return c.a.index != a.index ? c.a.index < a.index : c.b.index < b.index;
+}
+
+}  // namespace
+
+void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
+                  const Body& b, std::span<const CachedImpulse> cache,
+                  std::vector<ContactRow>* rows, std::vector<NormalBlock>* blocks) {
+  const std::size_t first_row = rows->size();
+  const std::uint32_t block = static_cast<std::uint32_t>(blocks->size());
+  const Vec3& n = manifold.normal;
+  const double friction = std::sqrt(a.friction * b.friction);
+  const double restitution = std::max(a.restitution, b.restitution);
+  auto first = std::lower_bound(cache.begin(), cache.end(), 0,
+                                [&](const CachedImpulse& c, int) { return less_pair(c, id_a, id_b); });
+  const Mat3 ra_to_local = a.orientation.conjugate().toRotationMatrix();
+  const Mat3 rb_to_local = b.orientation.conjugate().toRotationMatrix();
+  const double match_distance = 0.05 * std::min(a.shape.size(), b.shape.size());
+
+  for (int i = 0; i < manifold.count; ++i) {
+    const ContactPoint& point = manifold.points[i];
+    ContactRow row;
+    row.a = id_a.index;
+    row.b = id_b.index;
+    row.normal = n;
+    row.ra = point.point_a - a.position;
+    row.rb = point.point_b - b.position;
+    row.local_a = ra_to_local * row.ra;
+    row.local_b = rb_to_local * row.rb;
+    row.separation = -point.depth;
+    row.friction = friction;
+    row.restitution = restitution;
+    row.feature = point.feature_id;
+    row.manifold = block;
+    row.block_index = static_cast<std::uint8_t>(i);
+    row.block_size = static_cast<std::uint8_t>(manifold.count);
+
+    const Vec3 dv = b.linear_velocity + b.angular_velocity.cross(row.rb) - a.linear_velocity -
+                    a.angular_velocity.cross(row.ra);
+    row.relative_velocity = dv.dot(n);
+    // Friction along the sliding direction when sliding: a sliding body then feels exactly the
+    // Coulomb force, whatever its direction (no bias from the basis).
+    const Vec3 slip = dv - row.relative_velocity * n;
+    const double slip_speed = slip.norm();
+    row.tangent1 = slip_speed > kSlidingSpeed ? Vec3(slip / slip_speed) : any_perpendicular(n);
+    row.tangent2 = n.cross(row.tangent1);
+    row.normal_mass = effective_mass(a, b, row.ra, row.rb, n);
+    row.tangent_mass1 = effective_mass(a, b, row.ra, row.rb, row.tangent1);
+    row.tangent_mass2 = effective_mass(a, b, row.ra, row.rb, row.tangent2);
+
+    // Feature ids change when a vertex of a face resting on an equal face moves across the
+    // other's edge by a nanometre; the point has not moved, so its impulse still applies
+    // (Jolt matches all points this way).
+    const CachedImpulse* match = nullptr;
+    double nearest = match_distance * match_distance;
+    for (auto it = first; it != cache.end() && it->a == id_a && it->b == id_b; ++it) {
+      if (it->feature == row.feature) {
+        match = &*it;
+        break;
+      }
+      const double d2 = (it->local_a - row.local_a).squaredNorm();
+      if (d2 < nearest) {
+        nearest = d2;
+        match = &*it;
+      }
+    }
+    if (match != nullptr) {
+      row.normal_impulse = match->normal;
+      row.tangent_impulse1 = match->friction.dot(row.tangent1);
+      row.tangent_impulse2 = match->friction.dot(row.tangent2);
+    }
+    rows->push_back(row);
+  }
+
+  NormalBlock normal_block;
+  const int count = manifold.count;
+  if (count > 1) {
+    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 4, 4>;
+    Small k(count, count);
+    for (int i = 0; i < count; ++i) {
+      const ContactRow& ri = (*rows)[first_row + i];
+      const Vec3 ai = a.inverse_inertia_world * ri.ra.cross(n);
+      const Vec3 bi = b.inverse_inertia_world * ri.rb.cross(n);
+      for (int j = 0; j < count; ++j) {
+        const ContactRow& rj = (*rows)[first_row + j];
+        k(i, j) = a.inverse_mass + b.inverse_mass + rj.ra.cross(n).dot(ai) + rj.rb.cross(n).dot(bi);
+      }
+    }
+    const Eigen::SelfAdjointEigenSolver<Small> eigen(k);
+    const double largest = eigen.eigenvalues().maxCoeff();
+    Small inverse = Small::Zero(count, count);
+    for (int e = 0; e < count; ++e) {
+      const double value = eigen.eigenvalues()[e];
+      if (value > 1e-9 * largest)
+        inverse += (eigen.eigenvectors().col(e) / value) * eigen.eigenvectors().col(e).transpose();
+    }
+    normal_block.inverse.topLeftCorner(count, count) = inverse;
+  }
+  blocks->push_back(normal_block);
+}
+
+Softness contact_softness(double hertz, double damping_ratio, double h) {
+  if (hertz <= 0) return {};
+  const double omega = 2 * std::numbers::pi * hertz;
+  const double a1 = 2 * damping_ratio + h * omega;
+  const double a2 = h * omega * a1;
+  const double a3 = 1 / (1 + a2);
+  return {omega / a1, a2 * a3, a3};
+}
+
+void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                std::span<SolverBody> bodies) {
+  for (std::uint32_t id : ids) {
+    const ContactRow& row = rows[id];
+    const Vec3 impulse = row.normal_impulse * row.normal + row.tangent_impulse1 * row.tangent1 +
+                         row.tangent_impulse2 * row.tangent2;
+    apply_impulse(row, impulse, bodies);
+  }
+}
+
+namespace {
+
+struct NormalTarget {
+  double bias = 0, mass_scale = 1, impulse_scale = 0;
+};
+
+NormalTarget normal_target(const ContactRow& row, std::span<const SolverBody> bodies,
+                           const SolverSettings& settings, const Softness* soft, double inverse_h) {
+  const double separation = current_separation(row, bodies);
+  if (separation > 0) return {separation * inverse_h, 1, 0};  // may close the gap, no more
+  if (soft != nullptr && separation + settings.slop < 0)
+    return {std::max(soft->bias_rate * (separation + settings.slop), -settings.max_push_velocity),
+            soft->mass_scale, soft->impulse_scale};
+  return {};
+}
+
+void solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
+  if (row.friction <= 0) return;
+  const Vec3 dv = relative_velocity(row, bodies);
+  const double limit = row.friction * row.normal_impulse;
+  const double old1 = row.tangent_impulse1, old2 = row.tangent_impulse2;
+  double new1 = old1 - row.tangent_mass1 * dv.dot(row.tangent1);
+  double new2 = old2 - row.tangent_mass2 * dv.dot(row.tangent2);
+  // The circular cone: no direction of sliding is preferred.
+  const double magnitude = std::sqrt(new1 * new1 + new2 * new2);
+  if (magnitude > limit) {
+    const double scale = magnitude > 0 ? limit / magnitude : 0;
+    new1 *= scale;
+    new2 *= scale;
+  }
+  row.tangent_impulse1 = new1;
+  row.tangent_impulse2 = new2;
+  apply_impulse(row, (new1 - old1) * row.tangent1 + (new2 - old2) * row.tangent2, bodies);
+}
+
+void solve_normal(ContactRow& row, std::span<SolverBody> bodies, const NormalTarget& target) {
+  const double vn = relative_velocity(row, bodies).dot(row.normal);
+  const double delta = -row.normal_mass * target.mass_scale * (vn + target.bias) -
+                       target.impulse_scale * row.normal_impulse;
+  const double updated = std::max(row.normal_impulse + delta, 0.0);
+  apply_impulse(row, (updated - row.normal_impulse) * row.normal, bodies);
+  row.normal_impulse = updated;
+  row.max_normal_impulse = std::max(row.max_normal_impulse, updated);
+}
+
+// The manifold's rows rows[ids[0..count)]: friction point by point, then the normals as a block
+// when the block solution keeps every impulse non-negative, else point by point.
+void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int count,
+                    std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                    const SolverSettings& settings, const Softness* soft, double inverse_h) {
+  for (int i = 0; i < count; ++i) solve_friction(rows[ids[i]], bodies);
+  NormalTarget targets[4];
+  for (int i = 0; i < count; ++i)
+    targets[i] = normal_target(rows[ids[i]], bodies, settings, soft, inverse_h);
+  if (count == 1) {
+    solve_normal(rows[ids[0]], bodies, targets[0]);
+    return;
+  }
+  Eigen::Vector4d error = Eigen::Vector4d::Zero();
+  for (int i = 0; i < count; ++i) {
+    const ContactRow& row = rows[ids[i]];
+    error[i] = relative_velocity(row, bodies).dot(row.normal) + targets[i].bias;
+  }
+  const Eigen::Matrix4d& inverse = blocks[rows[ids[0]].manifold].inverse;
+  const Eigen::Vector4d step = inverse * error;
+  double updated[4];
+  bool feasible = true;
+  for (int i = 0; i < count; ++i) {
+    const ContactRow& row = rows[ids[i]];
+    updated[i] = row.normal_impulse - targets[i].mass_scale * step[i] -
+                 targets[i].impulse_scale * row.normal_impulse;
+    feasible &= updated[i] >= 0;
+  }
+  if (!feasible) {
+    for (int i = 0; i < count; ++i) solve_normal(rows[ids[i]], bodies, targets[i]);
+    return;
+  }
+  for (int i = 0; i < count; ++i) {
+    ContactRow& row = rows[ids[i]];
+    apply_impulse(row, (updated[i] - row.normal_impulse) * row.normal, bodies);
+    row.normal_impulse = updated[i];
+    row.max_normal_impulse = std::max(row.max_normal_impulse, updated[i]);
+  }
+}
+
+}  // namespace
+
+void solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                    std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                    const SolverSettings& settings, const Softness* soft, double h,
+                    bool backward) {
+  const double inverse_h = 1 / h;
+  const std::size_t count = ids.size();
+  // A manifold's rows are consecutive in `ids`; visit manifolds forwards or backwards.
+  if (!backward) {
+    for (std::size_t k = 0; k < count;) {
+      const int size = rows[ids[k]].block_size;
+      solve_manifold(rows, &ids[k], size, blocks, bodies, settings, soft, inverse_h);
+      k += size;
+    }
+  } else {
+    for (std::size_t end = count; end > 0;) {
+      const ContactRow& last = rows[ids[end - 1]];
+      const std::size_t start = end - 1 - last.block_index;
+      solve_manifold(rows, &ids[start], last.block_size, blocks, bodies, settings, soft, inverse_h);
+      end = start;
+    }
+  }
+}
+
+void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                       std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                       const SolverSettings& settings) {
+  auto bounces = [&](const ContactRow& row) {
+    return row.restitution > 0 && row.relative_velocity < -settings.restitution_threshold &&
+           row.max_normal_impulse > 0;
+  };
+  for (std::size_t k = 0; k < ids.size();) {
+    const int count = rows[ids[k]].block_size;
+    const std::uint32_t* block = &ids[k];
+    k += count;
+    int bouncing = 0;
+    for (int i = 0; i < count; ++i) bouncing += bounces(rows[block[i]]) ? 1 : 0;
+    if (bouncing == 0) continue;
+    // A face landing flat bounces as one: the block solve gives every corner its target at
+    // once, where single points would each undo part of the others' work.
+    if (bouncing == count && count > 1) {
+      Eigen::Vector4d error = Eigen::Vector4d::Zero();
+      for (int i = 0; i < count; ++i) {
+        const ContactRow& row = rows[block[i]];
+        error[i] = relative_velocity(row, bodies).dot(row.normal) +
+                   row.restitution * row.relative_velocity;
+      }
+      const Eigen::Vector4d step = blocks[rows[block[0]].manifold].inverse * error;
+      bool feasible = true;
+      for (int i = 0; i < count; ++i) feasible &= rows[block[i]].normal_impulse - step[i] >= 0;
+      if (feasible) {
+        for (int i = 0; i < count; ++i) {
+          ContactRow& row = rows[block[i]];
+          apply_impulse(row, -step[i] * row.normal, bodies);
+          row.normal_impulse -= step[i];
+        }
+        continue;
+      }
+    }
+    for (int i = 0; i < count; ++i) {
+      ContactRow& row = rows[block[i]];
+      if (!bounces(row)) continue;
+      const double vn = relative_velocity(row, bodies).dot(row.normal);
+      const double delta = -row.normal_mass * (vn + row.restitution * row.relative_velocity);
+      const double updated = std::max(row.normal_impulse + delta, 0.0);
+      apply_impulse(row, (updated - row.normal_impulse) * row.normal, bodies);
+      row.normal_impulse = updated;
+    }
+  }
+}
+
+void correct_positions(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
+                       std::span<const SolverBody> bodies, std::span<Pose> poses,
+                       const SolverSettings& settings) {
+  for (std::uint32_t id : ids) {
+    const ContactRow& row = rows[id];
+    Pose& pa = poses[row.a];
+    Pose& pb = poses[row.b];
+    const Vec3 ra = pa.orientation * row.local_a;
+    const Vec3 rb = pb.orientation * row.local_b;
+    const double separation = (pb.position + rb - pa.position - ra).dot(row.normal);
+    const double error = std::clamp(settings.baumgarte * (separation + settings.slop),
+                                    -settings.max_correction, 0.0);
+    if (error == 0) continue;
+    const SolverBody& a = bodies[row.a];
+    const SolverBody& b = bodies[row.b];
+    const Vec3 ca = ra.cross(row.normal);
+    const Vec3 cb = rb.cross(row.normal);
+    const double k = a.inverse_mass + b.inverse_mass + ca.dot(a.inverse_inertia * ca) +
+                     cb.dot(b.inverse_inertia * cb);
+    if (k <= 0) continue;
+    const Vec3 push = (-error / k) * row.normal;
+    pa.position -= a.inverse_mass * push;
+    pb.position += b.inverse_mass * push;
+    if (a.inverse_mass > 0) pa.orientation = rotated(pa.orientation, -(a.inverse_inertia * ra.cross(push)));
+    if (b.inverse_mass > 0) pb.orientation = rotated(pb.orientation, b.inverse_inertia * rb.cross(push));
+  }
+}
+
+double normal_residual(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
+                       std::span<const SolverBody> bodies, double h) {
+  double residual = 0;
+  for (std::uint32_t id : ids) {
+    const ContactRow& row = rows[id];
+    if (row.normal_mass <= 0) continue;
+    const double separation = current_separation(row, bodies);
+    const double target = separation > 0 ? -separation / h : 0;
+    const double gap_velocity = relative_velocity(row, bodies).dot(row.normal) - target;
+    const double impulse_velocity = row.normal_impulse / row.normal_mass;
+    residual = std::max(residual, std::abs(std::min(impulse_velocity, gap_velocity)));
+  }
+  return residual;
+}
+
+}  // namespace tumble

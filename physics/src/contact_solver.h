@@ -1,0 +1,129 @@
+// Contact constraints of one step and the iterative passes over them: warm start, projected
+// Gauss-Seidel with or without soft bias, restitution, and the position correction.
+//
+// Ideas from Catto's sequential impulses (GDC 2006-2014) and Box2D v3's soft step (Catto,
+// "Solver2D", 2024): anchors move with the bodies during substeps, so each substep sees its own
+// separation, and penetration is pushed out by a spring of fixed stiffness, then the velocity the
+// push added is relaxed away.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "physics/body.h"
+#include "physics/collision.h"
+#include "physics/math.h"
+#include "physics/step.h"
+
+namespace tumble {
+
+// Velocities and what the solvers need of a body, kept compact; statics have zero inverse mass.
+struct SolverBody {
+  Vec3 v = Vec3::Zero(), w = Vec3::Zero();
+  double inverse_mass = 0;
+  Mat3 inverse_inertia = Mat3::Zero();  // world, fixed during the step
+  // Motion since the start of the step, for the separation of moving anchors.
+  Vec3 delta_position = Vec3::Zero();
+  Quat delta_rotation = Quat::Identity();
+};
+
+// One contact point between bodies `a` and `b` (slot indices).
+struct ContactRow {
+  std::uint32_t a = 0, b = 0;
+  Vec3 normal, tangent1, tangent2;  // world; normal from a to b
+  Vec3 ra, rb;                      // lever arms from the centres of mass at the step start
+  Vec3 local_a, local_b;            // the same anchors in body axes, for position correction
+  double separation = 0;            // m at the step start; < 0 overlapping
+  double normal_mass = 0, tangent_mass1 = 0, tangent_mass2 = 0;
+  double friction = 0, restitution = 0;
+  double relative_velocity = 0;  // normal velocity at the step start, m/s
+  double normal_impulse = 0, tangent_impulse1 = 0, tangent_impulse2 = 0;
+  double max_normal_impulse = 0;
+  std::uint64_t feature = 0;
+  std::uint32_t manifold = 0;  // index of its NormalBlock
+  std::uint8_t block_index = 0, block_size = 1;  // place among its manifold's rows
+};
+
+// The normal rows of one manifold solved together: K = J A J^T over its points and K's
+// pseudo-inverse. Four points on a face make K singular; the pseudo-inverse spreads the load
+// evenly instead of by the order in which single points would be visited, which is what keeps
+// a tall stack from tilting (sequential single points push one corner, then the next).
+struct NormalBlock {
+  Eigen::Matrix4d inverse = Eigen::Matrix4d::Zero();
+};
+
+// Impulses of the last step, looked up by body pair and feature to warm-start the next one.
+struct CachedImpulse {
+  BodyId a, b;
+  std::uint64_t feature = 0;
+  Vec3 local_a = Vec3::Zero();  // the point in A's axes, for matching when features change
+  double normal = 0;
+  Vec3 friction = Vec3::Zero();  // world
+};
+
+// Builds the rows of one manifold. `cache` is sorted by (a, b); a row starts from the impulse of
+// the cached point with its feature id, or else of the nearest cached point close enough.
+void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
+                  const Body& b, std::span<const CachedImpulse> cache,
+                  std::vector<ContactRow>* rows, std::vector<NormalBlock>* blocks);
+
+// Spring parameters of a soft contact over a substep h (Catto 2011, "Soft constraints").
+struct Softness {
+  double bias_rate = 0, mass_scale = 1, impulse_scale = 0;
+};
+Softness contact_softness(double hertz, double damping_ratio, double h);
+
+void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                std::span<SolverBody> bodies);
+
+// One Gauss-Seidel sweep. With `soft` set, penetration beyond the slop is pushed out through the
+// spring; without it contacts are rigid and only gaps (speculative contacts) add bias. Sweeps
+// alternate direction (`backward`), so that no end of a stack is always solved last.
+void solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                    std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                    const SolverSettings& settings, const Softness* soft, double h,
+                    bool backward);
+
+// Gives bouncing contacts their outgoing velocity, e times the approach velocity.
+void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                       std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                       const SolverSettings& settings);
+
+// Nonlinear Gauss-Seidel on positions (Catto, Box2D 2.x): moves bodies out of penetration
+// without touching velocities.
+void correct_positions(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
+                       std::span<const SolverBody> bodies, std::span<Pose> poses,
+                       const SolverSettings& settings);
+
+// |min(impulse / effective mass, normal velocity - target)| over the normal rows, m/s.
+double normal_residual(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
+                       std::span<const SolverBody> bodies, double h);
+
+inline Vec3 relative_velocity(const ContactRow& row, std::span<const SolverBody> bodies) {
+  const SolverBody& a = bodies[row.a];
+  const SolverBody& b = bodies[row.b];
+  return b.v + b.w.cross(row.rb) - a.v - a.w.cross(row.ra);
+}
+
+inline void apply_impulse(const ContactRow& row, const Vec3& impulse,
+                          std::span<SolverBody> bodies) {
+  SolverBody& a = bodies[row.a];
+  SolverBody& b = bodies[row.b];
+  a.v -= a.inverse_mass * impulse;
+  a.w -= a.inverse_inertia * row.ra.cross(impulse);
+  b.v += b.inverse_mass * impulse;
+  b.w += b.inverse_inertia * row.rb.cross(impulse);
+}
+
+// The separation of a row now, from the bodies' motion since the step start.
+inline double current_separation(const ContactRow& row, std::span<const SolverBody> bodies) {
+  const SolverBody& a = bodies[row.a];
+  const SolverBody& b = bodies[row.b];
+  const Vec3 moved = (b.delta_position + b.delta_rotation * row.rb - row.rb) -
+                     (a.delta_position + a.delta_rotation * row.ra - row.ra);
+  return row.separation + moved.dot(row.normal);
+}
+
+}  // namespace tumble

@@ -1,0 +1,122 @@
+#include "lemke.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace tumble {
+namespace {
+
+// Variables are numbered w_0..w_{n-1}, z_0..z_{n-1}, then the artificial z0 (index 2n).
+struct Tableau {
+  int n;
+  Eigen::MatrixXd basis_inverse;  // B^-1 of the current basis
+  Eigen::VectorXd values;         // values of the basic variables, B^-1 q
+  std::vector<int> basic;         // which variable each row holds
+
+  // The entering variable's column in the current basis: B^-1 a, with the original columns
+  // a(w_i) = e_i, a(z_j) = -M e_j, a(z0) = -1.
+  Eigen::VectorXd column(const Eigen::MatrixXd& m, int variable) const {
+    if (variable < n) return basis_inverse.col(variable);
+    if (variable < 2 * n) return -(basis_inverse * m.col(variable - n));
+    return -basis_inverse.rowwise().sum();
+  }
+
+  void pivot(int row, int entering, const Eigen::VectorXd& column) {
+    const double p = column[row];
+    basis_inverse.row(row) /= p;
+    values[row] /= p;
+    for (int i = 0; i < n; ++i) {
+      if (i == row || column[i] == 0) continue;
+      basis_inverse.row(i) -= column[i] * basis_inverse.row(row);
+      values[i] -= column[i] * values[row];
+    }
+    basic[row] = entering;
+  }
+};
+
+// True when row i's ratio vector (value, B^-1 row) / column[i] is lexicographically smaller
+// than row j's.
+bool lexicographically_smaller(const Tableau& t, const Eigen::VectorXd& column, int i, int j) {
+  const double ri = t.values[i] / column[i], rj = t.values[j] / column[j];
+  const double scale = 1e-12 * std::max({1.0, std::abs(ri), std::abs(rj)});
+  if (std::abs(ri - rj) > scale) return ri < rj;
+  for (int k = 0; k < t.n; ++k) {
+    const double ai = t.basis_inverse(i, k) / column[i];
+    const double aj = t.basis_inverse(j, k) / column[j];
+    if (std::abs(ai - aj) > 1e-12 * std::max({1.0, std::abs(ai), std::abs(aj)})) return ai < aj;
+  }
+  return i < j;
+}
+
+}  // namespace
+
+LemkeResult solve_lcp_lemke(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, int max_pivots,
+                            Eigen::VectorXd* z) {
+  const int n = static_cast<int>(q.size());
+  z->setZero(n);
+  LemkeResult result;
+  if (!m.allFinite() || !q.allFinite()) {
+    result.outcome = LemkeOutcome::kNotFinite;
+    return result;
+  }
+  if (n == 0 || q.minCoeff() >= 0) return result;  // z = 0 already complements w = q
+
+  const int artificial = 2 * n;
+  Tableau t{n, Eigen::MatrixXd::Identity(n, n), q, std::vector<int>(n)};
+  for (int i = 0; i < n; ++i) t.basic[i] = i;
+
+  // z0 enters at the level that makes every w non-negative; the most negative w leaves.
+  int row = 0;
+  for (int i = 1; i < n; ++i)
+    if (q[i] < q[row]) row = i;
+  int entering = artificial;
+  Eigen::VectorXd column = t.column(m, entering);
+  int leaving = t.basic[row];
+  t.pivot(row, entering, column);
+  ++result.pivots;
+
+  while (true) {
+    // The complement of the variable that just left enters.
+    entering = leaving < n ? leaving + n : leaving - n;
+    column = t.column(m, entering);
+    const double tolerance = 1e-12 * std::max(1.0, column.cwiseAbs().maxCoeff());
+    double min_ratio = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < n; ++i)
+      if (column[i] > tolerance) min_ratio = std::min(min_ratio, t.values[i] / column[i]);
+    row = -1;
+    if (std::isfinite(min_ratio)) {
+      const double tie = 1e-12 * std::max(1.0, std::abs(min_ratio));
+      for (int i = 0; i < n; ++i) {
+        if (column[i] <= tolerance || t.values[i] / column[i] > min_ratio + tie) continue;
+        // z0 leaving ends the path: take it whenever it ties for the minimum ratio.
+        if (t.basic[i] == artificial) {
+          row = i;
+          break;
+        }
+        if (row < 0 || lexicographically_smaller(t, column, i, row)) row = i;
+      }
+    }
+    if (row < 0) {
+      result.outcome = LemkeOutcome::kRayTermination;
+      return result;
+    }
+    if (result.pivots >= max_pivots) {
+      result.outcome = LemkeOutcome::kPivotLimit;
+      return result;
+    }
+    leaving = t.basic[row];
+    t.pivot(row, entering, column);
+    ++result.pivots;
+    if (leaving == artificial) break;
+  }
+
+  for (int i = 0; i < n; ++i) {
+    const int variable = t.basic[i];
+    if (variable >= n && variable < 2 * n) (*z)[variable - n] = std::max(t.values[i], 0.0);
+  }
+  return result;
+}
+
+}  // namespace tumble

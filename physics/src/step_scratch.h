@@ -1,0 +1,36 @@
+// The step's working memory, kept by the world and reused from step to step.
+#pragma once
+
+#include <vector>
+
+#include "contact_solver.h"
+#include "islands.h"
+
+namespace tumble {
+
+enum class IslandSolver : std::uint8_t { kExact, kPgs, kSoft };
+
+struct IslandReport {
+  IslandSolver solver = IslandSolver::kSoft;
+  bool exact_failed = false;
+  std::uint32_t gyroscopic_limit_hits = 0;
+  std::uint64_t lemke_pivots = 0, velocity_iterations = 0;
+  double residual = 0;
+};
+
+struct StepScratch {
+  std::vector<SolverBody> bodies;  // by slot
+  std::vector<Pose> poses;         // by slot
+  std::vector<std::uint8_t> dynamic;
+  std::vector<ContactRow> rows;               // manifold order
+  std::vector<NormalBlock> blocks;            // one per manifold
+  std::vector<std::uint32_t> row_begin;       // rows of manifold m: [row_begin[m], row_begin[m+1])
+  std::vector<IslandLink> links;              // one per manifold
+  Islands islands;
+  std::vector<std::uint32_t> island_rows;     // row ids, island by island
+  std::vector<std::uint32_t> island_row_begin;
+  std::vector<IslandReport> reports;
+  std::vector<CachedImpulse> cache;  // last step's impulses, sorted by body pair
+};
+
+}  // namespace tumble

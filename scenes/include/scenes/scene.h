@@ -1,0 +1,37 @@
+// Scenes: a world's settings and initial bodies, read from JSON (docs/SCENES.md lists every
+// field with its unit) or made by the standard generators (standard.h).
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "physics/body.h"
+#include "physics/status.h"
+#include "physics/world.h"
+
+namespace tumble {
+
+struct SceneDef {
+  std::string name = "unnamed";
+  WorldSettings world;
+  double dt = 1.0 / 60;  // s per step
+  double duration = 10;  // s: how long a run of the scene lasts unless told otherwise
+  std::vector<BodyDef> bodies;
+};
+
+// Parses and validates a whole scene; nothing partial comes back. Errors name the field's path,
+// e.g. "bodies[3].size[1]: must be > 0".
+Result<SceneDef> parse_scene(std::string_view json_text);
+// Reads a file and parses it; errors start with the file's path.
+Result<SceneDef> load_scene_file(const std::string& path);
+// The scene as JSON that parse_scene reads back to the same scene (numbers round-trip exactly).
+std::string scene_to_json(const SceneDef& scene);
+
+// A world with the scene's settings and bodies.
+Result<World> make_world(const SceneDef& scene);
+
+// The scene built into every binary: boxes falling on a floor.
+std::string_view default_scene_json();
+
+}  // namespace tumble

@@ -1,0 +1,43 @@
+// The standard scenes of ../shared/SCENES.md, built bit for bit as specified there, so our figures
+// and the peer engines' compare like for like. Tests, benchmarks and the server share them.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "scenes/scene.h"
+
+namespace tumble {
+
+// The generator SCENES.md specifies for the pile's orientations: a 32-bit LCG, seed 12345.
+class SceneRandom {
+ public:
+  std::uint32_t next() {
+    state_ = 1664525u * state_ + 1013904223u;
+    return state_;
+  }
+  double uniform() { return (next() >> 8) / 16777216.0; }
+
+ private:
+  std::uint32_t state_ = 12345;
+};
+
+// Every scene has the conventions of SCENES.md: unit boxes of 1 kg, mu = 0.5, restitution 0,
+// dt = 1/60, gravity -9.81 z (none in bullet and spin), the ground a static plane z = 0.
+SceneDef pile_scene(int count = 1000);          // S1: a lattice of tilted boxes falling, 10 s
+SceneDef pyramid_scene(int base = 20);          // S2: base boxes at the bottom, 20 s
+SceneDef tower_scene(int height = 20);          // S3: 20 s
+SceneDef mass_ratio_scene(bool inverted = false);  // S4: 1, 1, 1000 kg bottom to top (inverted:
+                                                   // 1000, 1, 1), 10 s
+SceneDef bullet_scene();                        // S5: 0.1 m box at 300 m/s at a 5 cm wall, 1 s
+SceneDef slide_scene(double speed = 5);         // S6: a box sliding on the ground, 3 s
+SceneDef spin_scene();                          // S7: a 1x2x3 box spinning near its middle axis
+SceneDef bounce_scene(double height = 1, double restitution = 0.5);  // dropped from `height`
+                                                   // (bottom face above ground), 3 s
+
+// A standard scene by name, with an optional size: "pile", "pile:250", "pyramid:10", "tower:5",
+// "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "default".
+Result<SceneDef> standard_scene(std::string_view name);
+
+}  // namespace tumble

@@ -1,0 +1,290 @@
+// The JSON scene format. Every field is checked with its path; unknown fields are errors, so a
+// misspelt key never silently falls back to a default.
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "scenes/scene.h"
+
+namespace tumble {
+namespace {
+
+using Json = nlohmann::json;
+
+// A failure already carrying its field path; thrown inside the parser only, caught at its edge.
+struct FieldError {
+  std::string message;
+};
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw FieldError{path + ": " + what};
+}
+
+// An object being read: remembers which keys were used so the rest can be reported.
+class ObjectReader {
+ public:
+  ObjectReader(const Json& json, std::string path) : json_(json), path_(std::move(path)) {
+    if (!json_.is_object()) fail(path_.empty() ? "scene" : path_, "must be an object");
+  }
+
+  const Json* find(const std::string& key) {
+    used_.insert(key);
+    const auto it = json_.find(key);
+    return it == json_.end() ? nullptr : &*it;
+  }
+  std::string child(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  double number(const std::string& key, double fallback) {
+    const Json* value = find(key);
+    if (value == nullptr) return fallback;
+    return read_number(*value, child(key));
+  }
+  int integer(const std::string& key, int fallback, int min, int max) {
+    const Json* value = find(key);
+    if (value == nullptr) return fallback;
+    if (!value->is_number_integer()) fail(child(key), "must be an integer");
+    const auto v = value->get<long long>();
+    if (v < min || v > max)
+      fail(child(key), "must be in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    return static_cast<int>(v);
+  }
+  std::string string(const std::string& key, const std::string& fallback) {
+    const Json* value = find(key);
+    if (value == nullptr) return fallback;
+    if (!value->is_string()) fail(child(key), "must be a string");
+    return value->get<std::string>();
+  }
+  bool boolean(const std::string& key, bool fallback) {
+    const Json* value = find(key);
+    if (value == nullptr) return fallback;
+    if (!value->is_boolean()) fail(child(key), "must be true or false");
+    return value->get<bool>();
+  }
+  Vec3 vector(const std::string& key, const Vec3& fallback) {
+    const Json* value = find(key);
+    if (value == nullptr) return fallback;
+    return read_vector(*value, child(key));
+  }
+  void reject_unknown() const {
+    for (const auto& [key, value] : json_.items())
+      if (!used_.contains(key)) fail(child(key), "unknown field");
+  }
+
+  static double read_number(const Json& value, const std::string& path) {
+    if (!value.is_number()) fail(path, "must be a number");
+    const double v = value.get<double>();
+    if (!std::isfinite(v)) fail(path, "must be finite");
+    return v;
+  }
+  static Vec3 read_vector(const Json& value, const std::string& path) {
+    if (!value.is_array() || value.size() != 3) fail(path, "must be an array of 3 numbers");
+    Vec3 v;
+    for (int k = 0; k < 3; ++k) v[k] = read_number(value[k], path + "[" + std::to_string(k) + "]");
+    return v;
+  }
+
+ private:
+  const Json& json_;
+  std::string path_;
+  std::set<std::string> used_;
+};
+
+double positive(ObjectReader& r, const std::string& key, double fallback) {
+  const double v = r.number(key, fallback);
+  if (!(v > 0)) fail(r.child(key), "must be > 0");
+  return v;
+}
+
+ShapeDef read_shape(ObjectReader& r) {
+  const std::string type = r.string("shape", "");
+  if (type.empty()) fail(r.child("shape"), "missing (box, sphere, capsule, hull or plane)");
+  if (type == "box") {
+    const Json* size = r.find("size");
+    if (size == nullptr) fail(r.child("size"), "missing (full extents x, y, z in m)");
+    const Vec3 v = ObjectReader::read_vector(*size, r.child("size"));
+    for (int k = 0; k < 3; ++k)
+      if (!(v[k] > 0)) fail(r.child("size") + "[" + std::to_string(k) + "]", "must be > 0");
+    return BoxDef{0.5 * v};
+  }
+  if (type == "sphere") return SphereDef{positive(r, "radius", 0.5)};
+  if (type == "capsule") {
+    const double radius = positive(r, "radius", 0.25);
+    return CapsuleDef{radius, 0.5 * positive(r, "length", 1.0)};
+  }
+  if (type == "hull") {
+    const Json* points = r.find("points");
+    const std::string path = r.child("points");
+    if (points == nullptr || !points->is_array() || points->size() < 4)
+      fail(path, "must be an array of at least 4 points [x, y, z]");
+    HullDef hull;
+    for (std::size_t i = 0; i < points->size(); ++i)
+      hull.points.push_back(
+          ObjectReader::read_vector((*points)[i], path + "[" + std::to_string(i) + "]"));
+    return hull;
+  }
+  if (type == "plane") return HalfSpaceDef{};
+  fail(r.child("shape"), "unknown shape '" + type + "' (box, sphere, capsule, hull or plane)");
+}
+
+BodyDef read_body(const Json& json, const std::string& path) {
+  ObjectReader r(json, path);
+  BodyDef def;
+  def.shape = read_shape(r);
+  const bool plane = std::holds_alternative<HalfSpaceDef>(def.shape);
+  def.type = r.boolean("static", plane) ? BodyType::kStatic : BodyType::kDynamic;
+  def.mass = r.number("mass", 0);
+  def.density = r.number("density", def.density);
+  def.position = r.vector("position", def.position);
+  if (const Json* q = r.find("orientation")) {
+    const std::string qpath = r.child("orientation");
+    if (!q->is_array() || q->size() != 4) fail(qpath, "must be a quaternion [w, x, y, z]");
+    double c[4];
+    for (int k = 0; k < 4; ++k)
+      c[k] = ObjectReader::read_number((*q)[k], qpath + "[" + std::to_string(k) + "]");
+    def.orientation = Quat(c[0], c[1], c[2], c[3]);
+  }
+  def.linear_velocity = r.vector("linear_velocity", def.linear_velocity);
+  def.angular_velocity = r.vector("angular_velocity", def.angular_velocity);
+  def.friction = r.number("friction", def.friction);
+  def.restitution = r.number("restitution", def.restitution);
+  r.reject_unknown();
+  // The engine's own checks (mass, friction, orientation, hull degeneracy...) with this path.
+  if (Result<Body> body = make_body(def); !body) throw FieldError{path + "." + body.error()};
+  return def;
+}
+
+SceneDef read_scene(const Json& json) {
+  ObjectReader r(json, "");
+  SceneDef scene;
+  scene.name = r.string("name", scene.name);
+  r.string("description", "");
+  scene.dt = positive(r, "dt", scene.dt);
+  scene.duration = r.number("duration", scene.duration);
+  if (scene.duration < 0) fail("duration", "must be >= 0");
+  WorldSettings& world = scene.world;
+  world.gravity = r.vector("gravity", world.gravity);
+  world.threads = r.integer("threads", world.threads, 0, 1024);
+  SolverSettings& solver = world.solver;
+  const std::string kind = r.string("solver", std::string(solver_name(solver.kind)));
+  const std::optional<SolverKind> parsed = solver_from_name(kind);
+  if (!parsed) fail("solver", "unknown solver '" + kind + "' (exact, pgs, soft or auto)");
+  solver.kind = *parsed;
+  solver.iterations = r.integer("iterations", solver.iterations, 1, 1000);
+  solver.soft_iterations = r.integer("soft_iterations", solver.soft_iterations, 1, 1000);
+  solver.substeps = r.integer("substeps", solver.substeps, 1, 1000);
+  solver.position_iterations = r.integer("position_iterations", solver.position_iterations, 0, 1000);
+  solver.exact_max_points = r.integer("exact_max_points", solver.exact_max_points, 0, 100000);
+  solver.friction_directions = r.integer("friction_directions", solver.friction_directions, 4, 32);
+  solver.slop = r.number("slop", solver.slop);
+  solver.speculative_distance = r.number("speculative_distance", solver.speculative_distance);
+  solver.restitution_threshold = r.number("restitution_threshold", solver.restitution_threshold);
+  solver.contact_hertz = r.number("contact_hertz", solver.contact_hertz);
+  if (Status s = validate(world); !s) throw FieldError{s.message()};
+
+  const Json* bodies = r.find("bodies");
+  if (bodies != nullptr) {
+    if (!bodies->is_array()) fail("bodies", "must be an array");
+    for (std::size_t i = 0; i < bodies->size(); ++i)
+      scene.bodies.push_back(read_body((*bodies)[i], "bodies[" + std::to_string(i) + "]"));
+  }
+  r.reject_unknown();
+  return scene;
+}
+
+Json vector_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json body_json(const BodyDef& def) {
+  Json out = Json::object();
+  std::visit(
+      [&](const auto& shape) {
+        using T = std::decay_t<decltype(shape)>;
+        if constexpr (std::is_same_v<T, BoxDef>) {
+          out["shape"] = "box";
+          out["size"] = vector_json(2 * shape.half_extents);
+        } else if constexpr (std::is_same_v<T, SphereDef>) {
+          out["shape"] = "sphere";
+          out["radius"] = shape.radius;
+        } else if constexpr (std::is_same_v<T, CapsuleDef>) {
+          out["shape"] = "capsule";
+          out["radius"] = shape.radius;
+          out["length"] = 2 * shape.half_height;
+        } else if constexpr (std::is_same_v<T, HullDef>) {
+          out["shape"] = "hull";
+          out["points"] = Json::array();
+          for (const Vec3& p : shape.points) out["points"].push_back(vector_json(p));
+        } else {
+          out["shape"] = "plane";
+        }
+      },
+      def.shape);
+  out["static"] = def.type == BodyType::kStatic;
+  if (def.mass > 0) out["mass"] = def.mass;
+  else out["density"] = def.density;
+  out["position"] = vector_json(def.position);
+  const Quat& q = def.orientation;
+  out["orientation"] = Json::array({q.w(), q.x(), q.y(), q.z()});
+  out["linear_velocity"] = vector_json(def.linear_velocity);
+  out["angular_velocity"] = vector_json(def.angular_velocity);
+  out["friction"] = def.friction;
+  out["restitution"] = def.restitution;
+  return out;
+}
+
+}  // namespace
+
+Result<SceneDef> parse_scene(std::string_view json_text) {
+  Json json;
+  try {
+    json = Json::parse(json_text);
+  } catch (const Json::parse_error& e) {
+    return Status::error(std::string("scene: not valid JSON: ") + e.what());
+  }
+  try {
+    return read_scene(json);
+  } catch (const FieldError& e) {
+    return Status::error(e.message);
+  }
+}
+
+Result<SceneDef> load_scene_file(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) return Status::error(path + ": cannot open");
+  std::stringstream text;
+  text << file.rdbuf();
+  Result<SceneDef> scene = parse_scene(text.str());
+  if (!scene) return scene.status().within(path + ": ");
+  return scene;
+}
+
+std::string scene_to_json(const SceneDef& scene) {
+  const SolverSettings& s = scene.world.solver;
+  Json out = {{"name", scene.name},
+              {"dt", scene.dt},
+              {"duration", scene.duration},
+              {"gravity", vector_json(scene.world.gravity)},
+              {"threads", scene.world.threads},
+              {"solver", std::string(solver_name(s.kind))},
+              {"iterations", s.iterations},
+              {"soft_iterations", s.soft_iterations},
+              {"substeps", s.substeps},
+              {"position_iterations", s.position_iterations},
+              {"exact_max_points", s.exact_max_points},
+              {"friction_directions", s.friction_directions},
+              {"slop", s.slop},
+              {"speculative_distance", s.speculative_distance},
+              {"restitution_threshold", s.restitution_threshold},
+              {"contact_hertz", s.contact_hertz}};
+  out["bodies"] = Json::array();
+  for (const BodyDef& def : scene.bodies) out["bodies"].push_back(body_json(def));
+  return out.dump(1);
+}
+
+Result<World> make_world(const SceneDef& scene) {
+  if (Status s = validate(scene.world); !s) return s;
+  World world(scene.world);
+  if (auto ids = world.create_bodies(scene.bodies); !ids) return ids.status();
+  return world;
+}
+
+}  // namespace tumble

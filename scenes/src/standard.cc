@@ -1,0 +1,166 @@
+#include "scenes/standard.h"
+
+#include <charconv>
+#include <cmath>
+#include <string>
+
+namespace tumble {
+namespace {
+
+BodyDef ground() {
+  BodyDef def;
+  def.shape = HalfSpaceDef{};
+  def.type = BodyType::kStatic;
+  def.friction = 0.5;
+  return def;
+}
+
+BodyDef box(const Vec3& size, double mass, const Vec3& position) {
+  BodyDef def;
+  def.shape = BoxDef{0.5 * size};
+  def.mass = mass;
+  def.position = position;
+  def.friction = 0.5;
+  return def;
+}
+
+SceneDef base_scene(std::string name, double duration) {
+  SceneDef scene;
+  scene.name = std::move(name);
+  scene.duration = duration;
+  scene.dt = 1.0 / 60;
+  return scene;
+}
+
+}  // namespace
+
+SceneDef pile_scene(int count) {
+  SceneDef scene = base_scene("pile-" + std::to_string(count), 10);
+  scene.bodies.push_back(ground());
+  const int side = static_cast<int>(std::ceil(std::cbrt(static_cast<double>(count)) - 1e-9));
+  SceneRandom random;
+  for (int i = 0; i < count; ++i) {
+    const int ix = i % side, iy = (i / side) % side, iz = i / (side * side);
+    const Vec3 centre((ix - (side - 1) / 2.0) * 1.5, (iy - (side - 1) / 2.0) * 1.5, 2.0 + 1.5 * iz);
+    Vec3 r;
+    for (int k = 0; k < 3; ++k) r[k] = 0.2 * (2 * random.uniform() - 1);
+    BodyDef def = box(Vec3::Ones(), 1, centre);
+    const double angle = r.norm();
+    if (angle > 0) def.orientation = Quat(Eigen::AngleAxisd(angle, r / angle));
+    scene.bodies.push_back(def);
+  }
+  return scene;
+}
+
+SceneDef pyramid_scene(int base) {
+  SceneDef scene = base_scene("pyramid-" + std::to_string(base), 20);
+  scene.bodies.push_back(ground());
+  for (int k = 0; k < base; ++k)
+    for (int j = 0; j < base - k; ++j)
+      scene.bodies.push_back(
+          box(Vec3::Ones(), 1, Vec3((j - (base - k - 1) / 2.0) * 1.01, 0, 0.5 + k)));
+  return scene;
+}
+
+SceneDef tower_scene(int height) {
+  SceneDef scene = base_scene("tower-" + std::to_string(height), 20);
+  scene.bodies.push_back(ground());
+  for (int k = 0; k < height; ++k) scene.bodies.push_back(box(Vec3::Ones(), 1, Vec3(0, 0, 0.5 + k)));
+  return scene;
+}
+
+SceneDef mass_ratio_scene(bool inverted) {
+  SceneDef scene = base_scene(inverted ? "mass-ratio-inv" : "mass-ratio", 10);
+  scene.bodies.push_back(ground());
+  const double masses[3] = {inverted ? 1000.0 : 1.0, 1.0, inverted ? 1.0 : 1000.0};
+  for (int k = 0; k < 3; ++k) scene.bodies.push_back(box(Vec3::Ones(), masses[k], Vec3(0, 0, 0.5 + k)));
+  return scene;
+}
+
+SceneDef bullet_scene() {
+  SceneDef scene = base_scene("bullet", 1);
+  scene.world.gravity = Vec3::Zero();
+  BodyDef projectile = box(Vec3::Constant(0.1), 1, Vec3(-6, 0, 0));
+  projectile.linear_velocity = Vec3(300, 0, 0);
+  BodyDef wall = box(Vec3(0.05, 10, 10), 0, Vec3::Zero());
+  wall.type = BodyType::kStatic;
+  scene.bodies = {projectile, wall};
+  return scene;
+}
+
+SceneDef slide_scene(double speed) {
+  SceneDef scene = base_scene("slide", 3);
+  BodyDef slider = box(Vec3::Ones(), 1, Vec3(0, 0, 0.5));
+  slider.linear_velocity = Vec3(speed, 0, 0);
+  scene.bodies = {ground(), slider};
+  return scene;
+}
+
+SceneDef spin_scene() {
+  SceneDef scene = base_scene("spin", 20);
+  scene.world.gravity = Vec3::Zero();
+  BodyDef spinner = box(Vec3(1, 2, 3), 1, Vec3::Zero());
+  spinner.angular_velocity = Vec3(0.01, 5, 0.01);
+  scene.bodies = {spinner};
+  return scene;
+}
+
+SceneDef bounce_scene(double height, double restitution) {
+  SceneDef scene = base_scene("bounce", 3);
+  BodyDef dropped = box(Vec3::Ones(), 1, Vec3(0, 0, 0.5 + height));
+  dropped.restitution = restitution;
+  BodyDef floor = ground();
+  floor.restitution = restitution;
+  scene.bodies = {floor, dropped};
+  return scene;
+}
+
+Result<SceneDef> standard_scene(std::string_view spec) {
+  std::string_view name = spec;
+  std::optional<int> size;
+  if (const std::size_t colon = spec.find(':'); colon != std::string_view::npos) {
+    name = spec.substr(0, colon);
+    const std::string_view digits = spec.substr(colon + 1);
+    int value = 0;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (error != std::errc() || end != digits.data() + digits.size() || value < 1 || value > 1000000)
+      return Status::error("scene '" + std::string(spec) + "': the size after ':' must be an integer in [1, 1000000]");
+    size = value;
+  }
+  auto sized = [&](const char* what) -> Status {
+    if (size) return Status::error("scene '" + std::string(spec) + "': " + what + " takes no size");
+    return Status::ok();
+  };
+  if (name == "pile") return pile_scene(size.value_or(1000));
+  if (name == "pyramid") return pyramid_scene(size.value_or(20));
+  if (name == "tower") return tower_scene(size.value_or(20));
+  if (name == "mass-ratio" || name == "mass-ratio-inv") {
+    if (Status s = sized("mass-ratio"); !s) return s;
+    return mass_ratio_scene(name == "mass-ratio-inv");
+  }
+  if (name == "bullet") {
+    if (Status s = sized("bullet"); !s) return s;
+    return bullet_scene();
+  }
+  if (name == "slide") {
+    if (Status s = sized("slide"); !s) return s;
+    return slide_scene();
+  }
+  if (name == "spin") {
+    if (Status s = sized("spin"); !s) return s;
+    return spin_scene();
+  }
+  if (name == "bounce") {
+    if (Status s = sized("bounce"); !s) return s;
+    return bounce_scene();
+  }
+  if (name == "default") {
+    if (Status s = sized("default"); !s) return s;
+    return parse_scene(default_scene_json());
+  }
+  return Status::error("scene '" + std::string(spec) +
+                       "': unknown; the standard scenes are pile, pyramid, tower, mass-ratio, "
+                       "mass-ratio-inv, bullet, slide, spin, bounce, default");
+}
+
+}  // namespace tumble

@@ -1,0 +1,69 @@
+// Runs scenes for the dynamics tests and measures them the way ../shared/SCENES.md does.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "physics/world.h"
+#include "scenes/scene.h"
+#include "scenes/standard.h"
+
+namespace tumble::testing {
+
+inline World build(const SceneDef& scene) {
+  Result<World> world = make_world(scene);
+  EXPECT_TRUE(world.ok()) << world.error();
+  return std::move(world).value();
+}
+
+// Dynamic bodies in slot order.
+inline std::vector<const Body*> dynamic_bodies(const World& world) {
+  std::vector<const Body*> out;
+  for (std::uint32_t i = 0; i < world.slot_count(); ++i)
+    if (const Body* b = world.body(world.id_at(i)); b != nullptr && !b->is_static()) out.push_back(b);
+  return out;
+}
+
+inline double kinetic_energy(const Body& b) {
+  const Vec3 w_body = b.orientation.conjugate() * b.angular_velocity;
+  return 0.5 * b.mass * b.linear_velocity.squaredNorm() + 0.5 * w_body.dot(b.inertia_body * w_body);
+}
+
+inline double total_energy(const World& world) {
+  double e = 0;
+  for (const Body* b : dynamic_bodies(world))
+    e += kinetic_energy(*b) - b->mass * world.settings().gravity.dot(b->position);
+  return e;
+}
+
+// The lowest point of a box below z = 0 (0 when none is).
+inline double corner_depth(const Body& b) {
+  if (b.shape.type() != ShapeType::kBox) return 0;
+  double lowest = 0;
+  const Vec3 h = b.shape.half_extents();
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z());
+    lowest = std::min(lowest, (b.orientation * corner + b.position).z());
+  }
+  return -lowest;
+}
+
+inline bool all_finite(const World& world) {
+  for (const Body* b : dynamic_bodies(world))
+    if (!is_finite(b->position) || !is_finite(b->linear_velocity) || !is_finite(b->orientation))
+      return false;
+  return true;
+}
+
+// Steps `world` for `steps` steps of `dt`, calling `each` after every step.
+inline void run(World& world, double dt, long steps, const std::function<void(long)>& each = {}) {
+  for (long s = 1; s <= steps; ++s) {
+    ASSERT_TRUE(world.step(dt).is_ok());
+    if (each) each(s);
+  }
+}
+
+}  // namespace tumble::testing
