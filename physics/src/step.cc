@@ -231,8 +231,11 @@ void World::correct_positions() {
 #pragma omp parallel for schedule(dynamic, 1) num_threads(team_size(settings_.threads)) \
     if (islands > 1 && team_size(settings_.threads) > 1)
   for (std::int64_t i = 0; i < islands; ++i) {
-    // Soft islands corrected their penetration inside the substeps.
-    if (s.reports[i].solver == IslandSolver::kSoft) continue;
+    // Soft islands corrected their penetration inside the substeps, exact ones in the LCP.
+    const IslandReport& report = s.reports[i];
+    if (report.solver == IslandSolver::kSoft ||
+        (report.solver == IslandSolver::kExact && !report.exact_failed))
+      continue;
     const auto rows = std::span(s.island_rows)
                           .subspan(s.island_row_begin[i],
                                    s.island_row_begin[i + 1] - s.island_row_begin[i]);

@@ -20,10 +20,10 @@ struct SolverSettings {
   SolverKind kind = SolverKind::kAuto;
   // Velocity iterations: per step for pgs, per substep for soft (the relax pass does as many).
   int iterations = 10;
-  int soft_iterations = 2;
+  int soft_iterations = 3;
   int substeps = 4;  // soft only; the others take one step of dt
-  // Position iterations after the velocity solve (exact, pgs): nonlinear Gauss-Seidel that moves
-  // bodies out of penetration without adding velocity.
+  // Position iterations after the velocity solve (pgs, and exact islands that fell back to it):
+  // nonlinear Gauss-Seidel that moves bodies out of penetration without adding velocity.
   int position_iterations = 3;
   // auto: an island with at most this many contact points goes to the exact solver.
   int exact_max_points = 16;
@@ -38,8 +38,9 @@ struct SolverSettings {
   double contact_hertz = 60;           // soft: stiffness of the contact spring, Hz
   double contact_damping_ratio = 10;   // soft: its damping ratio (strongly over-damped)
   double max_push_velocity = 3;        // m/s: penetration is resolved no faster than this
-  double max_correction = 0.2;         // m: position correction per iteration (exact, pgs)
-  double baumgarte = 0.2;              // fraction of penetration corrected per position iteration
+  double max_correction = 0.2;         // m: position correction per iteration (pgs)
+  // Fraction of the penetration corrected per position iteration (pgs) or per step (exact).
+  double baumgarte = 0.2;
 };
 
 // Wall time of the step's stages, seconds.
