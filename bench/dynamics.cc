@@ -1,0 +1,129 @@
+// Step time and stability on the standard scenes (../shared/SCENES.md): ours with each solver,
+// beside Bullet and ODE (with -DTUMBLE_BENCH_PEERS=ON) in the same run, so ratios compare like
+// for like on a noisy machine. Usage: bench_dynamics [scene ...] (default: pile, pyramid, tower,
+// mass-ratio, slide).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "peers/peer_world.h"
+#include "physics/world.h"
+#include "scenes/standard.h"
+
+namespace tumble::bench {
+
+double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half) {
+  double lowest = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 c((i & 1) ? half.x() : -half.x(), (i & 2) ? half.y() : -half.y(),
+                 (i & 4) ? half.z() : -half.z());
+    lowest = std::min(lowest, (rotation * c + centre).z());
+  }
+  return -lowest;
+}
+
+namespace {
+
+RunResult run_ours(SceneDef scene, SolverKind kind, long steps) {
+  scene.world.solver.kind = kind;
+  scene.world.threads = 1;
+  World world = make_world(scene).value();
+  RunResult result;
+  result.engine = "Tumble " + std::string(solver_name(kind));
+  const SolverSettings& s = scene.world.solver;
+  char settings[160];
+  std::snprintf(settings, sizeof settings, "%s; 1 thread",
+                kind == SolverKind::kSoft   ? ("soft, " + std::to_string(s.substeps) + " substeps x " +
+                                             std::to_string(s.soft_iterations) + " iterations").c_str()
+                : kind == SolverKind::kPgs  ? ("pgs, " + std::to_string(s.iterations) + " iterations").c_str()
+                : kind == SolverKind::kAuto ? ("exact <= " + std::to_string(s.exact_max_points) +
+                                               " points per island, else soft").c_str()
+                                            : "Lemke, 8-sided friction pyramid");
+  result.settings = settings;
+  std::vector<std::uint32_t> slots;
+  for (std::uint32_t i = 0; i < world.slot_count(); ++i)
+    if (const Body* b = world.body(world.id_at(i)); b && !b->is_static()) slots.push_back(i);
+  auto body = [&](std::uint32_t slot) { return world.body(world.id_at(slot)); };
+  for (std::uint32_t slot : slots) result.start.push_back(body(slot)->position);
+  const long last_second = steps - std::lround(1 / scene.dt);
+  for (long step = 0; step < steps; ++step) {
+    const auto start = std::chrono::steady_clock::now();
+    world.step(scene.dt);
+    result.step_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    for (std::uint32_t slot : slots) {
+      const Body* b = body(slot);
+      if (!b->position.allFinite() || b->position.cwiseAbs().maxCoeff() > 1000) result.blew_up = true;
+      if (step >= last_second && scene.world.gravity.norm() > 0 && b->shape.type() == ShapeType::kBox)
+        result.deepest_corner_last_second = std::max(
+            result.deepest_corner_last_second, corner_depth(b->position, b->orientation, b->shape.half_extents()));
+    }
+  }
+  for (std::uint32_t slot : slots) {
+    result.end.push_back(body(slot)->position);
+    result.end_velocity.push_back(body(slot)->linear_velocity);
+  }
+  return result;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+void print(const RunResult& r, double reference_ms) {
+  double largest = 0;
+  int fast = 0;
+  for (std::size_t i = 0; i < r.start.size(); ++i) {
+    largest = std::max(largest, (r.end[i] - r.start[i]).norm());
+    fast += r.end_velocity[i].norm() > 0.1 ? 1 : 0;
+  }
+  const Vec3 top = r.end.back() - r.start.back();
+  const double ms = median(r.step_ms);
+  std::printf("  %-20s %8.3f %6.2f %9.4f %9.4f %9.4f %7.4f %5d %4s  %s\n", r.engine.c_str(), ms,
+              reference_ms > 0 ? ms / reference_ms : 0.0, top.head<2>().norm(), top.z(), largest,
+              r.deepest_corner_last_second, fast, r.blew_up ? "YES" : "no", r.settings.c_str());
+}
+
+}  // namespace
+}  // namespace tumble::bench
+
+int main(int argc, char** argv) {
+  using namespace tumble;
+  using namespace tumble::bench;
+  std::vector<std::string> names = {"pile:1000", "pyramid:20", "tower:20", "mass-ratio", "mass-ratio-inv", "slide"};
+  if (argc > 1) names.assign(argv + 1, argv + argc);
+  std::printf("Standard scenes (../shared/SCENES.md), dt 1/60, one thread. ms/step: median over steps;\n"
+              "ratio: to Bullet in this run; top dxy/dz: the last body's displacement; largest: any body's;\n"
+              "corner: deepest box corner below the ground in the last second; fast: bodies > 0.1 m/s at the end.\n");
+  for (const std::string& name : names) {
+    Result<SceneDef> scene = standard_scene(name);
+    if (!scene) {
+      std::fprintf(stderr, "%s\n", scene.error().c_str());
+      return 2;
+    }
+    const long steps = std::lround(scene.value().duration / scene.value().dt);
+    std::printf("\n%s: %zu bodies, %ld steps\n", scene.value().name.c_str(), scene.value().bodies.size(), steps);
+    std::printf("  %-20s %8s %6s %9s %9s %9s %7s %5s %4s  %s\n", "engine", "ms/step", "ratio", "top dxy", "top dz",
+                "largest", "corner", "fast", "NaN", "settings");
+    std::vector<RunResult> results;
+#ifdef TUMBLE_HAVE_PEERS
+    results.push_back(run_bullet(scene.value(), steps));
+    results.push_back(run_ode(scene.value(), steps));
+#endif
+    const bool small = scene.value().bodies.size() <= 8;
+    for (SolverKind kind : {SolverKind::kAuto, SolverKind::kSoft, SolverKind::kPgs, SolverKind::kExact}) {
+      if (kind == SolverKind::kExact && !small) continue;  // Lemke on one 1000-box island: hours
+      results.push_back(run_ours(scene.value(), kind, steps));
+    }
+#ifdef TUMBLE_HAVE_PEERS
+    const double reference = median(results[0].step_ms);
+#else
+    const double reference = 0;
+#endif
+    for (const RunResult& r : results) print(r, reference);
+  }
+  return 0;
+}

@@ -1,0 +1,29 @@
+// Peer engines running the standard scenes of ../shared/SCENES.md (boxes and a ground plane), with
+// the settings SCENES.md gives for each, so their times and stability sit beside ours.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "physics/math.h"
+#include "scenes/scene.h"
+
+namespace tumble::bench {
+
+// What every engine reports after a run, read the same way from each.
+struct RunResult {
+  std::string engine, settings;
+  std::vector<double> step_ms;            // wall time of each step
+  std::vector<Vec3> start, end;           // dynamic bodies' centres, scene order
+  std::vector<Vec3> end_velocity;
+  double deepest_corner_last_second = 0;  // m below z = 0
+  bool blew_up = false;                   // NaN or a coordinate beyond 1000 m
+};
+
+// A box's deepest corner below z = 0 (0 when above), from its centre, rotation and half extents.
+double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half);
+
+RunResult run_bullet(const SceneDef& scene, long steps);
+RunResult run_ode(const SceneDef& scene, long steps);
+
+}  // namespace tumble::bench
