@@ -75,6 +75,18 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     const double slip_speed = slip.norm();
     row.tangent1 = slip_speed > kSlidingSpeed ? Vec3(slip / slip_speed) : any_perpendicular(n);
     row.tangent2 = n.cross(row.tangent1);
+    row.ra_cross_n = row.ra.cross(n);
+    row.rb_cross_n = row.rb.cross(n);
+    row.angular_a = a.inverse_inertia_world * row.ra_cross_n;
+    row.angular_b = b.inverse_inertia_world * row.rb_cross_n;
+    row.ra_cross_t1 = row.ra.cross(row.tangent1);
+    row.rb_cross_t1 = row.rb.cross(row.tangent1);
+    row.ra_cross_t2 = row.ra.cross(row.tangent2);
+    row.rb_cross_t2 = row.rb.cross(row.tangent2);
+    row.angular_a_t1 = a.inverse_inertia_world * row.ra_cross_t1;
+    row.angular_b_t1 = b.inverse_inertia_world * row.rb_cross_t1;
+    row.angular_a_t2 = a.inverse_inertia_world * row.ra_cross_t2;
+    row.angular_b_t2 = b.inverse_inertia_world * row.rb_cross_t2;
     row.normal_mass = effective_mass(a, b, row.ra, row.rb, n);
     row.tangent_mass1 = effective_mass(a, b, row.ra, row.rb, row.tangent1);
     row.tangent_mass2 = effective_mass(a, b, row.ra, row.rb, row.tangent2);
@@ -106,8 +118,7 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   NormalBlock normal_block;
   const int count = manifold.count;
   if (count > 1) {
-    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 4, 4>;
-    Small k(count, count);
+    Eigen::Matrix4d k = Eigen::Matrix4d::Zero();
     for (int i = 0; i < count; ++i) {
       const ContactRow& ri = (*rows)[first_row + i];
       const Vec3 ai = a.inverse_inertia_world * ri.ra.cross(n);
@@ -117,15 +128,19 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
         k(i, j) = a.inverse_mass + b.inverse_mass + rj.ra.cross(n).dot(ai) + rj.rb.cross(n).dot(bi);
       }
     }
-    const Eigen::SelfAdjointEigenSolver<Small> eigen(k);
-    const double largest = eigen.eigenvalues().maxCoeff();
-    Small inverse = Small::Zero(count, count);
-    for (int e = 0; e < count; ++e) {
-      const double value = eigen.eigenvalues()[e];
-      if (value > 1e-9 * largest)
-        inverse += (eigen.eigenvectors().col(e) / value) * eigen.eigenvectors().col(e).transpose();
+    // K is singular for coplanar points (a face has three degrees of freedom, not four). A
+    // compliance of 1e-6 of the mean diagonal gives a well-posed inverse that, for velocity
+    // errors a rigid face can produce, is the pseudo-inverse to that accuracy: the load spreads
+    // evenly over the face.
+    Eigen::Matrix4d padded = Eigen::Matrix4d::Identity();
+    padded.topLeftCorner(count, count) = k.topLeftCorner(count, count);
+    padded.topLeftCorner(count, count).diagonal().array() += 1e-6 * k.trace() / count;
+    const Eigen::LLT<Eigen::Matrix4d> cholesky(padded);
+    if (cholesky.info() == Eigen::Success) {
+      normal_block.inverse = cholesky.solve(Eigen::Matrix4d::Identity());
+      normal_block.inverse.bottomRows(4 - count).setZero();
+      normal_block.inverse.rightCols(4 - count).setZero();
     }
-    normal_block.inverse.topLeftCorner(count, count) = inverse;
   }
   blocks->push_back(normal_block);
 }
@@ -143,9 +158,10 @@ void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
                 std::span<SolverBody> bodies) {
   for (std::uint32_t id : ids) {
     const ContactRow& row = rows[id];
-    const Vec3 impulse = row.normal_impulse * row.normal + row.tangent_impulse1 * row.tangent1 +
-                         row.tangent_impulse2 * row.tangent2;
-    apply_impulse(row, impulse, bodies);
+    apply_normal_impulse(row, row.normal_impulse, bodies);
+    if (row.tangent_impulse1 != 0 || row.tangent_impulse2 != 0)
+      apply_impulse(row, row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2,
+                    bodies);
   }
 }
 
@@ -167,29 +183,38 @@ NormalTarget normal_target(const ContactRow& row, std::span<const SolverBody> bo
 
 void solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
   if (row.friction <= 0) return;
-  const Vec3 dv = relative_velocity(row, bodies);
+  SolverBody& a = bodies[row.a];
+  SolverBody& b = bodies[row.b];
+  const Vec3 dv = b.v - a.v;
+  const double v1 = row.tangent1.dot(dv) + b.w.dot(row.rb_cross_t1) - a.w.dot(row.ra_cross_t1);
+  const double v2 = row.tangent2.dot(dv) + b.w.dot(row.rb_cross_t2) - a.w.dot(row.ra_cross_t2);
   const double limit = row.friction * row.normal_impulse;
   const double old1 = row.tangent_impulse1, old2 = row.tangent_impulse2;
-  double new1 = old1 - row.tangent_mass1 * dv.dot(row.tangent1);
-  double new2 = old2 - row.tangent_mass2 * dv.dot(row.tangent2);
+  double new1 = old1 - row.tangent_mass1 * v1;
+  double new2 = old2 - row.tangent_mass2 * v2;
   // The circular cone: no direction of sliding is preferred.
-  const double magnitude = std::sqrt(new1 * new1 + new2 * new2);
-  if (magnitude > limit) {
-    const double scale = magnitude > 0 ? limit / magnitude : 0;
+  const double squared = new1 * new1 + new2 * new2;
+  if (squared > limit * limit) {
+    const double scale = limit / std::sqrt(squared);
     new1 *= scale;
     new2 *= scale;
   }
   row.tangent_impulse1 = new1;
   row.tangent_impulse2 = new2;
-  apply_impulse(row, (new1 - old1) * row.tangent1 + (new2 - old2) * row.tangent2, bodies);
+  const double d1 = new1 - old1, d2 = new2 - old2;
+  const Vec3 linear = d1 * row.tangent1 + d2 * row.tangent2;
+  a.v -= a.inverse_mass * linear;
+  a.w -= d1 * row.angular_a_t1 + d2 * row.angular_a_t2;
+  b.v += b.inverse_mass * linear;
+  b.w += d1 * row.angular_b_t1 + d2 * row.angular_b_t2;
 }
 
 void solve_normal(ContactRow& row, std::span<SolverBody> bodies, const NormalTarget& target) {
-  const double vn = relative_velocity(row, bodies).dot(row.normal);
+  const double vn = normal_velocity(row, bodies);
   const double delta = -row.normal_mass * target.mass_scale * (vn + target.bias) -
                        target.impulse_scale * row.normal_impulse;
   const double updated = std::max(row.normal_impulse + delta, 0.0);
-  apply_impulse(row, (updated - row.normal_impulse) * row.normal, bodies);
+  apply_normal_impulse(row, updated - row.normal_impulse, bodies);
   row.normal_impulse = updated;
   row.max_normal_impulse = std::max(row.max_normal_impulse, updated);
 }
@@ -210,7 +235,7 @@ void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int co
   Eigen::Vector4d error = Eigen::Vector4d::Zero();
   for (int i = 0; i < count; ++i) {
     const ContactRow& row = rows[ids[i]];
-    error[i] = relative_velocity(row, bodies).dot(row.normal) + targets[i].bias;
+    error[i] = normal_velocity(row, bodies) + targets[i].bias;
   }
   const Eigen::Matrix4d& inverse = blocks[rows[ids[0]].manifold].inverse;
   const Eigen::Vector4d step = inverse * error;
@@ -228,7 +253,7 @@ void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int co
   }
   for (int i = 0; i < count; ++i) {
     ContactRow& row = rows[ids[i]];
-    apply_impulse(row, (updated[i] - row.normal_impulse) * row.normal, bodies);
+    apply_normal_impulse(row, updated[i] - row.normal_impulse, bodies);
     row.normal_impulse = updated[i];
     row.max_normal_impulse = std::max(row.max_normal_impulse, updated[i]);
   }
@@ -279,7 +304,7 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
       Eigen::Vector4d error = Eigen::Vector4d::Zero();
       for (int i = 0; i < count; ++i) {
         const ContactRow& row = rows[block[i]];
-        error[i] = relative_velocity(row, bodies).dot(row.normal) +
+        error[i] = normal_velocity(row, bodies) +
                    row.restitution * row.relative_velocity;
       }
       const Eigen::Vector4d step = blocks[rows[block[0]].manifold].inverse * error;
@@ -288,7 +313,7 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
       if (feasible) {
         for (int i = 0; i < count; ++i) {
           ContactRow& row = rows[block[i]];
-          apply_impulse(row, -step[i] * row.normal, bodies);
+          apply_normal_impulse(row, -step[i], bodies);
           row.normal_impulse -= step[i];
         }
         continue;
@@ -297,10 +322,10 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
     for (int i = 0; i < count; ++i) {
       ContactRow& row = rows[block[i]];
       if (!bounces(row)) continue;
-      const double vn = relative_velocity(row, bodies).dot(row.normal);
+      const double vn = normal_velocity(row, bodies);
       const double delta = -row.normal_mass * (vn + row.restitution * row.relative_velocity);
       const double updated = std::max(row.normal_impulse + delta, 0.0);
-      apply_impulse(row, (updated - row.normal_impulse) * row.normal, bodies);
+      apply_normal_impulse(row, updated - row.normal_impulse, bodies);
       row.normal_impulse = updated;
     }
   }
@@ -342,7 +367,7 @@ double normal_residual(std::span<const ContactRow> rows, std::span<const std::ui
     if (row.normal_mass <= 0) continue;
     const double separation = current_separation(row, bodies);
     const double target = separation > 0 ? -separation / h : 0;
-    const double gap_velocity = relative_velocity(row, bodies).dot(row.normal) - target;
+    const double gap_velocity = normal_velocity(row, bodies) - target;
     const double impulse_velocity = row.normal_impulse / row.normal_mass;
     residual = std::max(residual, std::abs(std::min(impulse_velocity, gap_velocity)));
   }

@@ -24,9 +24,10 @@ struct SolverBody {
   Vec3 v = Vec3::Zero(), w = Vec3::Zero();
   double inverse_mass = 0;
   Mat3 inverse_inertia = Mat3::Zero();  // world, fixed during the step
-  // Motion since the start of the step, for the separation of moving anchors.
+  // Motion since the start of the step, for the separation of moving anchors: the translation
+  // and the rotation vector (sum of w h over substeps; a step turns a body by little).
   Vec3 delta_position = Vec3::Zero();
-  Quat delta_rotation = Quat::Identity();
+  Vec3 delta_angle = Vec3::Zero();
 };
 
 // One contact point between bodies `a` and `b` (slot indices).
@@ -34,6 +35,11 @@ struct ContactRow {
   std::uint32_t a = 0, b = 0;
   Vec3 normal, tangent1, tangent2;  // world; normal from a to b
   Vec3 ra, rb;                      // lever arms from the centres of mass at the step start
+  // ra x n, rb x n and the inverse inertias applied to them: the normal row's angular parts.
+  Vec3 ra_cross_n, rb_cross_n, angular_a, angular_b;
+  // The same for the two tangent rows.
+  Vec3 ra_cross_t1, rb_cross_t1, ra_cross_t2, rb_cross_t2;
+  Vec3 angular_a_t1, angular_b_t1, angular_a_t2, angular_b_t2;
   Vec3 local_a, local_b;            // the same anchors in body axes, for position correction
   double separation = 0;            // m at the step start; < 0 overlapping
   double normal_mass = 0, tangent_mass1 = 0, tangent_mass2 = 0;
@@ -107,6 +113,12 @@ inline Vec3 relative_velocity(const ContactRow& row, std::span<const SolverBody>
   return b.v + b.w.cross(row.rb) - a.v - a.w.cross(row.ra);
 }
 
+inline double normal_velocity(const ContactRow& row, std::span<const SolverBody> bodies) {
+  const SolverBody& a = bodies[row.a];
+  const SolverBody& b = bodies[row.b];
+  return row.normal.dot(b.v - a.v) + b.w.dot(row.rb_cross_n) - a.w.dot(row.ra_cross_n);
+}
+
 inline void apply_impulse(const ContactRow& row, const Vec3& impulse,
                           std::span<SolverBody> bodies) {
   SolverBody& a = bodies[row.a];
@@ -117,13 +129,23 @@ inline void apply_impulse(const ContactRow& row, const Vec3& impulse,
   b.w += b.inverse_inertia * row.rb.cross(impulse);
 }
 
-// The separation of a row now, from the bodies' motion since the step start.
+inline void apply_normal_impulse(const ContactRow& row, double impulse,
+                                 std::span<SolverBody> bodies) {
+  SolverBody& a = bodies[row.a];
+  SolverBody& b = bodies[row.b];
+  a.v -= (a.inverse_mass * impulse) * row.normal;
+  a.w -= impulse * row.angular_a;
+  b.v += (b.inverse_mass * impulse) * row.normal;
+  b.w += impulse * row.angular_b;
+}
+
+// The separation of a row now, from the bodies' motion since the step start (to first order in
+// the rotation: (dR - 1) r . n ~ (theta x r) . n = theta . (r x n)).
 inline double current_separation(const ContactRow& row, std::span<const SolverBody> bodies) {
   const SolverBody& a = bodies[row.a];
   const SolverBody& b = bodies[row.b];
-  const Vec3 moved = (b.delta_position + b.delta_rotation * row.rb - row.rb) -
-                     (a.delta_position + a.delta_rotation * row.ra - row.ra);
-  return row.separation + moved.dot(row.normal);
+  return row.separation + row.normal.dot(b.delta_position - a.delta_position) +
+         b.delta_angle.dot(row.rb_cross_n) - a.delta_angle.dot(row.ra_cross_n);
 }
 
 }  // namespace tumble

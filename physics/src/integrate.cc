@@ -53,7 +53,7 @@ void integrate_position(double h, SolverBody* state, Pose* pose) {
   state->delta_position += dx;
   const Quat turn = rotation_quaternion(h * state->w);
   pose->orientation = (turn * pose->orientation).normalized();
-  state->delta_rotation = (turn * state->delta_rotation).normalized();
+  state->delta_angle += h * state->w;
 }
 
 }  // namespace tumble

@@ -66,9 +66,9 @@ void advance_island(const IslandContext& c, double dt, IslandReport* report) {
       for (int i = 0; i < solver.soft_iterations; ++i)
         solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, &soft, h, (s + i) % 2 == 1);
       integrate_positions(c, h);
-      for (int i = 0; i < solver.soft_iterations; ++i)
+      for (int i = 0; i < solver.relax_iterations; ++i)
         solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, nullptr, h, (s + i) % 2 == 0);
-      report->velocity_iterations += 2 * solver.soft_iterations;
+      report->velocity_iterations += solver.soft_iterations + solver.relax_iterations;
     }
     report->residual = normal_residual(rows, c.rows, bodies, h);
     apply_restitution(rows, c.rows, c.scratch.blocks, bodies, solver);

@@ -42,6 +42,8 @@ Status validate(const WorldSettings& s) {
   if (v.iterations < 1 || v.iterations > 1000) return Status::error("solver.iterations: must be in [1, 1000]");
   if (v.soft_iterations < 1 || v.soft_iterations > 1000)
     return Status::error("solver.soft_iterations: must be in [1, 1000]");
+  if (v.relax_iterations < 1 || v.relax_iterations > 1000)
+    return Status::error("solver.relax_iterations: must be in [1, 1000]");
   if (v.substeps < 1 || v.substeps > 1000) return Status::error("solver.substeps: must be in [1, 1000]");
   if (v.position_iterations < 0 || v.position_iterations > 1000)
     return Status::error("solver.position_iterations: must be in [0, 1000]");

@@ -172,6 +172,7 @@ SceneDef read_scene(const Json& json) {
   solver.kind = *parsed;
   solver.iterations = r.integer("iterations", solver.iterations, 1, 1000);
   solver.soft_iterations = r.integer("soft_iterations", solver.soft_iterations, 1, 1000);
+  solver.relax_iterations = r.integer("relax_iterations", solver.relax_iterations, 1, 1000);
   solver.substeps = r.integer("substeps", solver.substeps, 1, 1000);
   solver.position_iterations = r.integer("position_iterations", solver.position_iterations, 0, 1000);
   solver.exact_max_points = r.integer("exact_max_points", solver.exact_max_points, 0, 100000);
@@ -267,6 +268,7 @@ std::string scene_to_json(const SceneDef& scene) {
               {"solver", std::string(solver_name(s.kind))},
               {"iterations", s.iterations},
               {"soft_iterations", s.soft_iterations},
+              {"relax_iterations", s.relax_iterations},
               {"substeps", s.substeps},
               {"position_iterations", s.position_iterations},
               {"exact_max_points", s.exact_max_points},
