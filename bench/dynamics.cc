@@ -26,21 +26,22 @@ double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half) 
 
 namespace {
 
-RunResult run_ours(SceneDef scene, SolverKind kind, long steps) {
+RunResult run_ours(SceneDef scene, SolverKind kind, long steps, int threads = 1) {
   scene.world.solver.kind = kind;
-  scene.world.threads = 1;
+  scene.world.threads = threads;
   World world = make_world(scene).value();
   RunResult result;
   result.engine = "Tumble " + std::string(solver_name(kind));
   const SolverSettings& s = scene.world.solver;
   char settings[160];
-  std::snprintf(settings, sizeof settings, "%s; 1 thread",
+  std::snprintf(settings, sizeof settings, "%s; %d thread%s",
                 kind == SolverKind::kSoft   ? ("soft, " + std::to_string(s.substeps) + " substeps x " +
                                              std::to_string(s.soft_iterations) + " iterations").c_str()
                 : kind == SolverKind::kPgs  ? ("pgs, " + std::to_string(s.iterations) + " iterations").c_str()
                 : kind == SolverKind::kAuto ? ("exact <= " + std::to_string(s.exact_max_points) +
                                                " points per island, else soft").c_str()
-                                            : "Lemke, 8-sided friction pyramid");
+                                            : "Lemke, 8-sided friction pyramid",
+                threads, threads > 1 ? "s" : "");
   result.settings = settings;
   std::vector<std::uint32_t> slots;
   for (std::uint32_t i = 0; i < world.slot_count(); ++i)
@@ -90,6 +91,43 @@ void print(const RunResult& r, double reference_ms) {
 }  // namespace
 }  // namespace tumble::bench
 
+namespace tumble::bench {
+namespace {
+
+// S6: error against run time. The stop distance of a box sliding at 5 m/s with mu = 0.5 against
+// the exact v0^2 / (2 mu g), for shrinking dt, beside the wall time of the whole run.
+void slide_accuracy_table() {
+  const double exact = 25.0 / (2 * 0.5 * 9.81);
+  std::printf("\nslide (S6): stop-distance error against the exact %.4f m, and wall time of 3 s simulated\n", exact);
+  std::printf("  %-20s", "engine");
+  const int rates[] = {30, 60, 120, 240, 480};
+  for (int rate : rates) std::printf("   dt 1/%-3d        ", rate);
+  std::printf("\n");
+  auto row = [&](const std::string& name, auto&& runner) {
+    std::printf("  %-20s", name.c_str());
+    for (int rate : rates) {
+      SceneDef scene = slide_scene();
+      scene.dt = 1.0 / rate;
+      const auto start = std::chrono::steady_clock::now();
+      const RunResult r = runner(scene, 3L * rate);
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      const double distance = r.end[0].x() - r.start[0].x();
+      std::printf("  %+6.2f%% %7.2fms ", 100 * (distance / exact - 1), ms);
+    }
+    std::printf("\n");
+  };
+#ifdef TUMBLE_HAVE_PEERS
+  row("Bullet 3.24 float", [](const SceneDef& s, long n) { return run_bullet(s, n); });
+  row("ODE 0.16 double", [](const SceneDef& s, long n) { return run_ode(s, n); });
+#endif
+  for (SolverKind kind : {SolverKind::kExact, SolverKind::kSoft, SolverKind::kPgs})
+    row("Tumble " + std::string(solver_name(kind)),
+        [kind](const SceneDef& s, long n) { return run_ours(s, kind, n); });
+}
+
+}  // namespace
+}  // namespace tumble::bench
+
 int main(int argc, char** argv) {
   using namespace tumble;
   using namespace tumble::bench;
@@ -118,6 +156,10 @@ int main(int argc, char** argv) {
       if (kind == SolverKind::kExact && !small) continue;  // Lemke on one 1000-box island: hours
       results.push_back(run_ours(scene.value(), kind, steps));
     }
+    if (scene.value().bodies.size() > 100) {
+      results.push_back(run_ours(scene.value(), SolverKind::kAuto, steps, 2));
+      results.back().engine += " x2";
+    }
 #ifdef TUMBLE_HAVE_PEERS
     const double reference = median(results[0].step_ms);
 #else
@@ -125,5 +167,6 @@ int main(int argc, char** argv) {
 #endif
     for (const RunResult& r : results) print(r, reference);
   }
+  if (argc == 1) slide_accuracy_table();
   return 0;
 }
