@@ -81,9 +81,10 @@ int main(int argc, char** argv) {
   const long steps = std::lround(def.duration / def.dt);
   const long per_second = std::max(1L, std::lround(1 / def.dt));
   std::printf("scene %s: %zu bodies, dt %.6g s, %ld steps, solver %s\n", def.name.c_str(),
-              world.body_count(), def.dt, steps, std::string(solver_name(def.world.solver.kind)).c_str());
-  std::printf("%7s %9s %8s %8s %10s %12s %12s %10s %9s\n", "t [s]", "contacts", "islands",
-              "exact", "max |v|", "penetration", "energy [J]", "residual", "ms/step");
+              world.body_count(), def.dt, steps,
+              std::string(solver_name(def.world.solver.kind)).c_str());
+  std::printf("%7s %9s %8s %8s %10s %12s %12s %10s %9s\n", "t [s]", "contacts", "islands", "exact",
+              "max |v|", "penetration", "energy [J]", "residual", "ms/step");
   double window_seconds = 0;
   int window_steps = 0;
   const auto start = std::chrono::steady_clock::now();
@@ -104,7 +105,8 @@ int main(int argc, char** argv) {
       window_steps = 0;
     }
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("%ld steps in %.3f s of wall time (%.3f ms per step)\n", steps, wall,
               1e3 * wall / std::max(1L, steps));
   return 0;

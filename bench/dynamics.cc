@@ -34,32 +34,40 @@ RunResult run_ours(SceneDef scene, SolverKind kind, long steps, int threads = 1)
   result.engine = "Tumble " + std::string(solver_name(kind));
   const SolverSettings& s = scene.world.solver;
   char settings[160];
-  std::snprintf(settings, sizeof settings, "%s; %d thread%s",
-                kind == SolverKind::kSoft   ? ("soft, " + std::to_string(s.substeps) + " substeps x " +
-                                             std::to_string(s.soft_iterations) + " iterations").c_str()
-                : kind == SolverKind::kPgs  ? ("pgs, " + std::to_string(s.iterations) + " iterations").c_str()
-                : kind == SolverKind::kAuto ? ("exact <= " + std::to_string(s.exact_max_points) +
-                                               " points per island, else soft").c_str()
-                                            : "Lemke, 8-sided friction pyramid",
-                threads, threads > 1 ? "s" : "");
+  std::snprintf(
+      settings, sizeof settings, "%s; %d thread%s",
+      kind == SolverKind::kSoft ? ("soft, " + std::to_string(s.substeps) + " substeps x " +
+                                   std::to_string(s.soft_iterations) + " iterations")
+                                      .c_str()
+      : kind == SolverKind::kPgs ? ("pgs, " + std::to_string(s.iterations) + " iterations").c_str()
+      : kind == SolverKind::kAuto
+          ? ("exact <= " + std::to_string(s.exact_max_points) + " points per island, else soft")
+                .c_str()
+          : "Lemke, 8-sided friction pyramid",
+      threads, threads > 1 ? "s" : "");
   result.settings = settings;
   std::vector<std::uint32_t> slots;
   for (std::uint32_t i = 0; i < world.slot_count(); ++i)
     if (const Body* b = world.body(world.id_at(i)); b && !b->is_static()) slots.push_back(i);
   auto body = [&](std::uint32_t slot) { return world.body(world.id_at(slot)); };
-  for (std::uint32_t slot : slots) result.start.push_back(body(slot)->position);
+  for (std::uint32_t slot : slots)
+    result.start.push_back(body(slot)->position);
   const long last_second = steps - std::lround(1 / scene.dt);
   for (long step = 0; step < steps; ++step) {
     const auto start = std::chrono::steady_clock::now();
     world.step(scene.dt);
     result.step_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
     for (std::uint32_t slot : slots) {
       const Body* b = body(slot);
-      if (!b->position.allFinite() || b->position.cwiseAbs().maxCoeff() > 1000) result.blew_up = true;
-      if (step >= last_second && scene.world.gravity.norm() > 0 && b->shape.type() == ShapeType::kBox)
-        result.deepest_corner_last_second = std::max(
-            result.deepest_corner_last_second, corner_depth(b->position, b->orientation, b->shape.half_extents()));
+      if (!b->position.allFinite() || b->position.cwiseAbs().maxCoeff() > 1000)
+        result.blew_up = true;
+      if (step >= last_second && scene.world.gravity.norm() > 0 &&
+          b->shape.type() == ShapeType::kBox)
+        result.deepest_corner_last_second =
+            std::max(result.deepest_corner_last_second,
+                     corner_depth(b->position, b->orientation, b->shape.half_extents()));
     }
   }
   for (std::uint32_t slot : slots) {
@@ -98,10 +106,14 @@ namespace {
 // the exact v0^2 / (2 mu g), for shrinking dt, beside the wall time of the whole run.
 void slide_accuracy_table() {
   const double exact = 25.0 / (2 * 0.5 * 9.81);
-  std::printf("\nslide (S6): stop-distance error against the exact %.4f m, and wall time of 3 s simulated\n", exact);
+  std::printf(
+      "\nslide (S6): stop-distance error against the exact %.4f m, and wall time of 3 s "
+      "simulated\n",
+      exact);
   std::printf("  %-20s", "engine");
   const int rates[] = {30, 60, 120, 240, 480};
-  for (int rate : rates) std::printf("   dt 1/%-3d        ", rate);
+  for (int rate : rates)
+    std::printf("   dt 1/%-3d        ", rate);
   std::printf("\n");
   auto row = [&](const std::string& name, auto&& runner) {
     std::printf("  %-20s", name.c_str());
@@ -110,7 +122,9 @@ void slide_accuracy_table() {
       scene.dt = 1.0 / rate;
       const auto start = std::chrono::steady_clock::now();
       const RunResult r = runner(scene, 3L * rate);
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count();
       const double distance = r.end[0].x() - r.start[0].x();
       std::printf("  %+6.2f%% %7.2fms ", 100 * (distance / exact - 1), ms);
     }
@@ -131,11 +145,15 @@ void slide_accuracy_table() {
 int main(int argc, char** argv) {
   using namespace tumble;
   using namespace tumble::bench;
-  std::vector<std::string> names = {"pile:1000", "pyramid:20", "tower:20", "mass-ratio", "mass-ratio-inv", "slide"};
+  std::vector<std::string> names = {"pile:1000",  "pyramid:20",     "tower:20",
+                                    "mass-ratio", "mass-ratio-inv", "slide"};
   if (argc > 1) names.assign(argv + 1, argv + argc);
-  std::printf("Standard scenes (../shared/SCENES.md), dt 1/60, one thread. ms/step: median over steps;\n"
-              "ratio: to Bullet in this run; top dxy/dz: the last body's displacement; largest: any body's;\n"
-              "corner: deepest box corner below the ground in the last second; fast: bodies > 0.1 m/s at the end.\n");
+  std::printf(
+      "Standard scenes (../shared/SCENES.md), dt 1/60, one thread. ms/step: median over steps;\n"
+      "ratio: to Bullet in this run; top dxy/dz: the last body's displacement; largest: any "
+      "body's;\n"
+      "corner: deepest box corner below the ground in the last second; fast: bodies > 0.1 m/s at "
+      "the end.\n");
   for (const std::string& name : names) {
     Result<SceneDef> scene = standard_scene(name);
     if (!scene) {
@@ -143,16 +161,18 @@ int main(int argc, char** argv) {
       return 2;
     }
     const long steps = std::lround(scene.value().duration / scene.value().dt);
-    std::printf("\n%s: %zu bodies, %ld steps\n", scene.value().name.c_str(), scene.value().bodies.size(), steps);
-    std::printf("  %-20s %8s %6s %9s %9s %9s %7s %5s %4s  %s\n", "engine", "ms/step", "ratio", "top dxy", "top dz",
-                "largest", "corner", "fast", "NaN", "settings");
+    std::printf("\n%s: %zu bodies, %ld steps\n", scene.value().name.c_str(),
+                scene.value().bodies.size(), steps);
+    std::printf("  %-20s %8s %6s %9s %9s %9s %7s %5s %4s  %s\n", "engine", "ms/step", "ratio",
+                "top dxy", "top dz", "largest", "corner", "fast", "NaN", "settings");
     std::vector<RunResult> results;
 #ifdef TUMBLE_HAVE_PEERS
     results.push_back(run_bullet(scene.value(), steps));
     results.push_back(run_ode(scene.value(), steps));
 #endif
     const bool small = scene.value().bodies.size() <= 8;
-    for (SolverKind kind : {SolverKind::kAuto, SolverKind::kSoft, SolverKind::kPgs, SolverKind::kExact}) {
+    for (SolverKind kind :
+         {SolverKind::kAuto, SolverKind::kSoft, SolverKind::kPgs, SolverKind::kExact}) {
       if (kind == SolverKind::kExact && !small) continue;  // Lemke on one 1000-box island: hours
       results.push_back(run_ours(scene.value(), kind, steps));
     }
@@ -165,7 +185,8 @@ int main(int argc, char** argv) {
 #else
     const double reference = 0;
 #endif
-    for (const RunResult& r : results) print(r, reference);
+    for (const RunResult& r : results)
+      print(r, reference);
   }
   if (argc == 1) slide_accuracy_table();
   return 0;

@@ -23,7 +23,8 @@ inline World build(const SceneDef& scene) {
 inline std::vector<const Body*> dynamic_bodies(const World& world) {
   std::vector<const Body*> out;
   for (std::uint32_t i = 0; i < world.slot_count(); ++i)
-    if (const Body* b = world.body(world.id_at(i)); b != nullptr && !b->is_static()) out.push_back(b);
+    if (const Body* b = world.body(world.id_at(i)); b != nullptr && !b->is_static())
+      out.push_back(b);
   return out;
 }
 

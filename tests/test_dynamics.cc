@@ -100,7 +100,8 @@ TEST(Bounce, SlowImpactsDoNotBounce) {
   World world = build(scene);
   double highest_after = 0;
   run(world, 1.0 / 60, 120, [&](long s) {
-    if (s > 30) highest_after = std::max(highest_after, dynamic_bodies(world)[0]->position.z() - 0.5);
+    if (s > 30)
+      highest_after = std::max(highest_after, dynamic_bodies(world)[0]->position.z() - 0.5);
   });
   EXPECT_LT(highest_after, 1e-3);
 }
@@ -111,7 +112,10 @@ TEST(Spin, KeepsEnergyAndMomentumAndFlips) {
   for (double dt : {1.0 / 60, 1.0 / 240}) {
     World world = build(spin_scene());
     const Body& box = *dynamic_bodies(world)[0];
-    auto momentum = [&] { return Vec3(box.orientation * (box.inertia_body * (box.orientation.conjugate() * box.angular_velocity))); };
+    auto momentum = [&] {
+      return Vec3(box.orientation *
+                  (box.inertia_body * (box.orientation.conjugate() * box.angular_velocity)));
+    };
     const double ke0 = kinetic_energy(box);
     const Vec3 l0 = momentum();
     double worst_ke = 0, worst_l = 0, previous_c = 1;

@@ -15,7 +15,8 @@ void expect_solution(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, const E
   const double scale = 1e-9 * (1 + q.cwiseAbs().maxCoeff()) * (1 + m.cwiseAbs().maxCoeff());
   EXPECT_GE(z.minCoeff(), 0);
   EXPECT_GE(w.minCoeff(), -scale);
-  for (int i = 0; i < z.size(); ++i) EXPECT_LE(std::abs(z[i] * w[i]), scale * (1 + z.cwiseAbs().maxCoeff()));
+  for (int i = 0; i < z.size(); ++i)
+    EXPECT_LE(std::abs(z[i] * w[i]), scale * (1 + z.cwiseAbs().maxCoeff()));
 }
 
 TEST(Lemke, SolvesPositiveDefiniteProblemsExactly) {
@@ -24,10 +25,12 @@ TEST(Lemke, SolvesPositiveDefiniteProblemsExactly) {
     const int n = random.integer(1, 30);
     Eigen::MatrixXd a(n, n);
     for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) a(i, j) = random.uniform(-1, 1);
+      for (int j = 0; j < n; ++j)
+        a(i, j) = random.uniform(-1, 1);
     const Eigen::MatrixXd m = a * a.transpose() + 0.1 * Eigen::MatrixXd::Identity(n, n);
     Eigen::VectorXd q(n);
-    for (int i = 0; i < n; ++i) q[i] = random.uniform(-1, 1);
+    for (int i = 0; i < n; ++i)
+      q[i] = random.uniform(-1, 1);
     Eigen::VectorXd z;
     const LemkeResult result = solve_lcp_lemke(m, q, 100 * n, &z);
     ASSERT_EQ(result.outcome, LemkeOutcome::kSolved) << "trial " << trial;
@@ -44,7 +47,8 @@ TEST(Lemke, SolvesDegenerateSemidefiniteProblems) {
     const int rank = std::max(1, n / 3);
     Eigen::MatrixXd b(n, rank);
     for (int i = 0; i < n; ++i)
-      for (int j = 0; j < rank; ++j) b(i, j) = random.uniform(-1, 1);
+      for (int j = 0; j < rank; ++j)
+        b(i, j) = random.uniform(-1, 1);
     const Eigen::MatrixXd m = b * b.transpose();
     Eigen::VectorXd x(n), y(n);
     for (int i = 0; i < n; ++i) {
@@ -95,8 +99,10 @@ TEST(Solvers, ExactAndPgsAgreeOnSmallStacks) {
       scene.world.solver.iterations = 100;
       World world = build(scene);
       run(world, 1.0 / 60, 120);
-      for (const Body* b : dynamic_bodies(world)) final_positions[k].push_back(b->position);
-      for (double impulse : world.contact_impulses()) impulses[k] += impulse;
+      for (const Body* b : dynamic_bodies(world))
+        final_positions[k].push_back(b->position);
+      for (double impulse : world.contact_impulses())
+        impulses[k] += impulse;
       EXPECT_EQ(world.last_step().exact_fallbacks, 0u);
       ++k;
     }
@@ -114,7 +120,8 @@ TEST(Solvers, ExactAndPgsAgreeOnSmallStacks) {
 // the normals (a scene pays only for what it uses).
 TEST(Solvers, ExactSolverSkipsFrictionRowsWhenFrictionless) {
   SceneDef scene = tower_scene(2);
-  for (BodyDef& def : scene.bodies) def.friction = 0;
+  for (BodyDef& def : scene.bodies)
+    def.friction = 0;
   scene.world.solver.kind = SolverKind::kExact;
   World world = build(scene);
   run(world, 1.0 / 60, 10);

@@ -9,7 +9,8 @@ namespace {
 
 std::vector<Vec3> positions(const World& world) {
   std::vector<Vec3> out;
-  for (const Body* b : dynamic_bodies(world)) out.push_back(b->position);
+  for (const Body* b : dynamic_bodies(world))
+    out.push_back(b->position);
   return out;
 }
 
@@ -24,7 +25,8 @@ TEST(Tower, TwentyBoxesStandSixtySeconds) {
   EXPECT_LT(horizontal, 0.01);
   // The soft contacts compress under the load: 19 contacts, each a few mm at the bottom.
   EXPECT_LT(std::abs(end.z() - start.z()), 0.05);
-  for (const Body* b : dynamic_bodies(world)) EXPECT_LT(b->linear_velocity.norm(), 1e-3);
+  for (const Body* b : dynamic_bodies(world))
+    EXPECT_LT(b->linear_velocity.norm(), 1e-3);
 }
 
 // S2: 210 boxes, each on two below with 1 cm gaps; 20 s.
@@ -35,7 +37,8 @@ TEST(Pyramid, BaseOfTwentyStandsTwentySeconds) {
   ASSERT_TRUE(all_finite(world));
   const std::vector<Vec3> end = positions(world);
   double largest = 0;
-  for (std::size_t i = 0; i < start.size(); ++i) largest = std::max(largest, (end[i] - start[i]).norm());
+  for (std::size_t i = 0; i < start.size(); ++i)
+    largest = std::max(largest, (end[i] - start[i]).norm());
   EXPECT_LT(largest, 0.02);
 }
 
@@ -50,7 +53,8 @@ TEST(MassRatio, HeavyOnLightHoldsWithTheExactSolver) {
     std::uint32_t fallbacks = 0;
     run(world, 1.0 / 60, 600, [&](long) {
       deepest_contact = std::max(deepest_contact, world.last_step().max_penetration);
-      for (const Body* b : dynamic_bodies(world)) deepest_corner = std::max(deepest_corner, corner_depth(*b));
+      for (const Body* b : dynamic_bodies(world))
+        deepest_corner = std::max(deepest_corner, corner_depth(*b));
       fallbacks += world.last_step().exact_fallbacks;
     });
     SCOPED_TRACE(inverted ? "1000, 1, 1 kg" : "1, 1, 1000 kg");
@@ -58,7 +62,8 @@ TEST(MassRatio, HeavyOnLightHoldsWithTheExactSolver) {
     EXPECT_LT(deepest_corner, 1e-3);
     EXPECT_EQ(fallbacks, 0u);
     const std::vector<Vec3> end = positions(world);
-    for (std::size_t i = 0; i < end.size(); ++i) EXPECT_LT((end[i] - start[i]).norm(), 2e-3);
+    for (std::size_t i = 0; i < end.size(); ++i)
+      EXPECT_LT((end[i] - start[i]).norm(), 2e-3);
   }
 }
 
@@ -84,7 +89,8 @@ TEST(Pile, ThousandBoxesSettle) {
   // Energy: never above the start at any step, and falling from second to second; see
   // docs/DYNAMICS.md for the small rises within a second while layers land.
   EXPECT_LE(highest, initial);
-  for (std::size_t i = 1; i < per_second.size(); ++i) EXPECT_LE(per_second[i], per_second[i - 1] + 1e-5 * initial) << "second " << i;
+  for (std::size_t i = 1; i < per_second.size(); ++i)
+    EXPECT_LE(per_second[i], per_second[i - 1] + 1e-5 * initial) << "second " << i;
 }
 
 // Boxes spawned half inside each other are pushed apart without being thrown.
@@ -97,14 +103,16 @@ TEST(Overlap, HalfOverlappingBoxesSeparateGently) {
     box.position = Vec3(0.5 * (i % 2), 0.1 * i, 0.5 + 0.5 * i);  // each half inside the last
     scene.bodies.push_back(box);
   }
-  for (SolverKind kind : {SolverKind::kAuto, SolverKind::kPgs, SolverKind::kSoft, SolverKind::kExact}) {
+  for (SolverKind kind :
+       {SolverKind::kAuto, SolverKind::kPgs, SolverKind::kSoft, SolverKind::kExact}) {
     scene.world.solver.kind = kind;
     // Lemke's cost grows with the cube of the contacts: the exact solver gets the first three.
     if (kind == SolverKind::kExact) scene.bodies.resize(4);
     World world = build(scene);
     double fastest = 0;
     run(world, 1.0 / 60, 300, [&](long) {
-      for (const Body* b : dynamic_bodies(world)) fastest = std::max(fastest, b->linear_velocity.norm());
+      for (const Body* b : dynamic_bodies(world))
+        fastest = std::max(fastest, b->linear_velocity.norm());
     });
     SCOPED_TRACE(solver_name(kind));
     EXPECT_LT(fastest, 5.0);

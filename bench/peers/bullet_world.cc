@@ -41,13 +41,16 @@ RunResult run_bullet(const SceneDef& scene, long steps) {
     btTransform pose(btQuaternion(q.x(), q.y(), q.z(), q.w()),
                      btVector3(def.position.x(), def.position.y(), def.position.z()));
     states.push_back(std::make_unique<btDefaultMotionState>(pose));
-    btRigidBody::btRigidBodyConstructionInfo info(mass, states.back().get(), shapes.back().get(), inertia);
+    btRigidBody::btRigidBodyConstructionInfo info(mass, states.back().get(), shapes.back().get(),
+                                                  inertia);
     info.m_friction = std::sqrt(def.friction);  // Bullet multiplies the two bodies' values
     info.m_restitution = 0;
     bodies.push_back(std::make_unique<btRigidBody>(info));
     btRigidBody* body = bodies.back().get();
-    body->setLinearVelocity(btVector3(def.linear_velocity.x(), def.linear_velocity.y(), def.linear_velocity.z()));
-    body->setAngularVelocity(btVector3(def.angular_velocity.x(), def.angular_velocity.y(), def.angular_velocity.z()));
+    body->setLinearVelocity(
+        btVector3(def.linear_velocity.x(), def.linear_velocity.y(), def.linear_velocity.z()));
+    body->setAngularVelocity(
+        btVector3(def.angular_velocity.x(), def.angular_velocity.y(), def.angular_velocity.z()));
     world.addRigidBody(body);
     if (!is_static) {
       dynamic.push_back(body);
@@ -71,15 +74,17 @@ RunResult run_bullet(const SceneDef& scene, long steps) {
     const auto start = std::chrono::steady_clock::now();
     world.stepSimulation(scene.dt, 0);
     result.step_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
     for (std::size_t i = 0; i < dynamic.size(); ++i) {
       const btTransform& t = dynamic[i]->getCenterOfMassTransform();
       const btQuaternion r = t.getRotation();
       const Vec3 p(t.getOrigin().x(), t.getOrigin().y(), t.getOrigin().z());
       if (!p.allFinite() || p.cwiseAbs().maxCoeff() > 1000) result.blew_up = true;
       if (s >= last_second && scene.world.gravity.norm() > 0)
-        result.deepest_corner_last_second = std::max(
-            result.deepest_corner_last_second, corner_depth(p, Quat(r.w(), r.x(), r.y(), r.z()), halves[i]));
+        result.deepest_corner_last_second =
+            std::max(result.deepest_corner_last_second,
+                     corner_depth(p, Quat(r.w(), r.x(), r.y(), r.z()), halves[i]));
     }
   }
   read(&result.end);
@@ -87,7 +92,8 @@ RunResult run_bullet(const SceneDef& scene, long steps) {
     const btVector3 v = b->getLinearVelocity();
     result.end_velocity.push_back(Vec3(v.x(), v.y(), v.z()));
   }
-  for (auto& body : bodies) world.removeRigidBody(body.get());
+  for (auto& body : bodies)
+    world.removeRigidBody(body.get());
   return result;
 }
 

@@ -59,8 +59,10 @@ RunResult run_ode(const SceneDef& scene, long steps) {
     dBodySetMass(body, &mass);
     dBodySetPosition(body, def.position.x(), def.position.y(), def.position.z());
     dBodySetQuaternion(body, rotation);
-    dBodySetLinearVel(body, def.linear_velocity.x(), def.linear_velocity.y(), def.linear_velocity.z());
-    dBodySetAngularVel(body, def.angular_velocity.x(), def.angular_velocity.y(), def.angular_velocity.z());
+    dBodySetLinearVel(body, def.linear_velocity.x(), def.linear_velocity.y(),
+                      def.linear_velocity.z());
+    dBodySetAngularVel(body, def.angular_velocity.x(), def.angular_velocity.y(),
+                       def.angular_velocity.z());
     dGeomSetBody(geom, body);
     dynamic.push_back(body);
     halves.push_back(half);
@@ -73,7 +75,8 @@ RunResult run_ode(const SceneDef& scene, long steps) {
     const dReal* p = dBodyGetPosition(b);
     return Vec3(p[0], p[1], p[2]);
   };
-  for (dBodyID b : dynamic) result.start.push_back(position(b));
+  for (dBodyID b : dynamic)
+    result.start.push_back(position(b));
   const long last_second = steps - std::lround(1 / scene.dt);
   for (long s = 0; s < steps; ++s) {
     const auto start = std::chrono::steady_clock::now();
@@ -81,14 +84,16 @@ RunResult run_ode(const SceneDef& scene, long steps) {
     dWorldQuickStep(w.world, scene.dt);
     dJointGroupEmpty(w.contacts);
     result.step_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
     for (std::size_t i = 0; i < dynamic.size(); ++i) {
       const Vec3 p = position(dynamic[i]);
       if (!p.allFinite() || p.cwiseAbs().maxCoeff() > 1000) result.blew_up = true;
       if (s >= last_second && g.norm() > 0) {
         const dReal* q = dBodyGetQuaternion(dynamic[i]);
-        result.deepest_corner_last_second = std::max(
-            result.deepest_corner_last_second, corner_depth(p, Quat(q[0], q[1], q[2], q[3]), halves[i]));
+        result.deepest_corner_last_second =
+            std::max(result.deepest_corner_last_second,
+                     corner_depth(p, Quat(q[0], q[1], q[2], q[3]), halves[i]));
       }
     }
   }

@@ -13,8 +13,8 @@ namespace tumble::bench {
 // What every engine reports after a run, read the same way from each.
 struct RunResult {
   std::string engine, settings;
-  std::vector<double> step_ms;            // wall time of each step
-  std::vector<Vec3> start, end;           // dynamic bodies' centres, scene order
+  std::vector<double> step_ms;   // wall time of each step
+  std::vector<Vec3> start, end;  // dynamic bodies' centres, scene order
   std::vector<Vec3> end_velocity;
   double deepest_corner_last_second = 0;  // m below z = 0
   bool blew_up = false;                   // NaN or a coordinate beyond 1000 m

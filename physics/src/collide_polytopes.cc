@@ -117,8 +117,8 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
     if (gjk.status != GjkStatus::kIntersecting && gjk.distance > gjk_settings.tolerance) {
       if (gjk.distance > margin) return flags;
       const Vec3 normal = (gjk.point_b - gjk.point_a) / gjk.distance;
-      manifold_from_normal(pa, pb, normal, -gjk.distance, gjk.point_a, gjk.point_b, settings,
-                           scale, out);
+      manifold_from_normal(pa, pb, normal, -gjk.distance, gjk.point_a, gjk.point_b, settings, scale,
+                           out);
       return flags;
     }
     EpaSettings epa_settings;

@@ -42,8 +42,9 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   const Vec3& n = manifold.normal;
   const double friction = std::sqrt(a.friction * b.friction);
   const double restitution = std::max(a.restitution, b.restitution);
-  auto first = std::lower_bound(cache.begin(), cache.end(), 0,
-                                [&](const CachedImpulse& c, int) { return less_pair(c, id_a, id_b); });
+  auto first = std::lower_bound(cache.begin(), cache.end(), 0, [&](const CachedImpulse& c, int) {
+    return less_pair(c, id_a, id_b);
+  });
   const Mat3 ra_to_local = a.orientation.conjugate().toRotationMatrix();
   const Mat3 rb_to_local = b.orientation.conjugate().toRotationMatrix();
   const double match_distance = 0.05 * std::min(a.shape.size(), b.shape.size());
@@ -224,7 +225,8 @@ void solve_normal(ContactRow& row, std::span<SolverBody> bodies, const NormalTar
 void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int count,
                     std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
                     const SolverSettings& settings, const Softness* soft, double inverse_h) {
-  for (int i = 0; i < count; ++i) solve_friction(rows[ids[i]], bodies);
+  for (int i = 0; i < count; ++i)
+    solve_friction(rows[ids[i]], bodies);
   NormalTarget targets[4];
   for (int i = 0; i < count; ++i)
     targets[i] = normal_target(rows[ids[i]], bodies, settings, soft, inverse_h);
@@ -248,7 +250,8 @@ void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int co
     feasible &= updated[i] >= 0;
   }
   if (!feasible) {
-    for (int i = 0; i < count; ++i) solve_normal(rows[ids[i]], bodies, targets[i]);
+    for (int i = 0; i < count; ++i)
+      solve_normal(rows[ids[i]], bodies, targets[i]);
     return;
   }
   for (int i = 0; i < count; ++i) {
@@ -263,8 +266,7 @@ void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int co
 
 void solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
                     std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                    const SolverSettings& settings, const Softness* soft, double h,
-                    bool backward) {
+                    const SolverSettings& settings, const Softness* soft, double h, bool backward) {
   const double inverse_h = 1 / h;
   const std::size_t count = ids.size();
   // A manifold's rows are consecutive in `ids`; visit manifolds forwards or backwards.
@@ -296,7 +298,8 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
     const std::uint32_t* block = &ids[k];
     k += count;
     int bouncing = 0;
-    for (int i = 0; i < count; ++i) bouncing += bounces(rows[block[i]]) ? 1 : 0;
+    for (int i = 0; i < count; ++i)
+      bouncing += bounces(rows[block[i]]) ? 1 : 0;
     if (bouncing == 0) continue;
     // A face landing flat bounces as one: the block solve gives every corner its target at
     // once, where single points would each undo part of the others' work.
@@ -304,12 +307,12 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
       Eigen::Vector4d error = Eigen::Vector4d::Zero();
       for (int i = 0; i < count; ++i) {
         const ContactRow& row = rows[block[i]];
-        error[i] = normal_velocity(row, bodies) +
-                   row.restitution * row.relative_velocity;
+        error[i] = normal_velocity(row, bodies) + row.restitution * row.relative_velocity;
       }
       const Eigen::Vector4d step = blocks[rows[block[0]].manifold].inverse * error;
       bool feasible = true;
-      for (int i = 0; i < count; ++i) feasible &= rows[block[i]].normal_impulse - step[i] >= 0;
+      for (int i = 0; i < count; ++i)
+        feasible &= rows[block[i]].normal_impulse - step[i] >= 0;
       if (feasible) {
         for (int i = 0; i < count; ++i) {
           ContactRow& row = rows[block[i]];
@@ -354,8 +357,10 @@ void correct_positions(std::span<const ContactRow> rows, std::span<const std::ui
     const Vec3 push = (-error / k) * row.normal;
     pa.position -= a.inverse_mass * push;
     pb.position += b.inverse_mass * push;
-    if (a.inverse_mass > 0) pa.orientation = rotated(pa.orientation, -(a.inverse_inertia * ra.cross(push)));
-    if (b.inverse_mass > 0) pb.orientation = rotated(pb.orientation, b.inverse_inertia * rb.cross(push));
+    if (a.inverse_mass > 0)
+      pa.orientation = rotated(pa.orientation, -(a.inverse_inertia * ra.cross(push)));
+    if (b.inverse_mass > 0)
+      pb.orientation = rotated(pb.orientation, b.inverse_inertia * rb.cross(push));
   }
 }
 

@@ -40,15 +40,15 @@ struct ContactRow {
   // The same for the two tangent rows.
   Vec3 ra_cross_t1, rb_cross_t1, ra_cross_t2, rb_cross_t2;
   Vec3 angular_a_t1, angular_b_t1, angular_a_t2, angular_b_t2;
-  Vec3 local_a, local_b;            // the same anchors in body axes, for position correction
-  double separation = 0;            // m at the step start; < 0 overlapping
+  Vec3 local_a, local_b;  // the same anchors in body axes, for position correction
+  double separation = 0;  // m at the step start; < 0 overlapping
   double normal_mass = 0, tangent_mass1 = 0, tangent_mass2 = 0;
   double friction = 0, restitution = 0;
   double relative_velocity = 0;  // normal velocity at the step start, m/s
   double normal_impulse = 0, tangent_impulse1 = 0, tangent_impulse2 = 0;
   double max_normal_impulse = 0;
   std::uint64_t feature = 0;
-  std::uint32_t manifold = 0;  // index of its NormalBlock
+  std::uint32_t manifold = 0;                    // index of its NormalBlock
   std::uint8_t block_index = 0, block_size = 1;  // place among its manifold's rows
 };
 
@@ -89,8 +89,7 @@ void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
 // alternate direction (`backward`), so that no end of a stack is always solved last.
 void solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
                     std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                    const SolverSettings& settings, const Softness* soft, double h,
-                    bool backward);
+                    const SolverSettings& settings, const Softness* soft, double h, bool backward);
 
 // Gives bouncing contacts their outgoing velocity, e times the approach velocity.
 void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,

@@ -52,11 +52,12 @@ double velocity_along(const Jacobian& jac, std::span<const SolverBody> bodies) {
 
 ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
                                       std::span<const std::uint32_t> ids,
-                                      std::span<SolverBody> bodies,
-                                      const SolverSettings& settings, double h) {
+                                      std::span<SolverBody> bodies, const SolverSettings& settings,
+                                      double h) {
   const int points = static_cast<int>(ids.size());
   bool any_friction = false;
-  for (std::uint32_t id : ids) any_friction |= rows[id].friction > 0;
+  for (std::uint32_t id : ids)
+    any_friction |= rows[id].friction > 0;
   // Frictionless islands need no tangent rows at all.
   const int k = any_friction ? std::clamp(settings.friction_directions, 4, 32) : 0;
   const int velocity_rows = points * (1 + k);
@@ -65,7 +66,8 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
   // Velocity rows: the normals first, then each point's k directions.
   std::vector<Jacobian> jac;
   jac.reserve(velocity_rows);
-  for (std::uint32_t id : ids) jac.push_back(make_jacobian(rows[id], rows[id].normal, bodies));
+  for (std::uint32_t id : ids)
+    jac.push_back(make_jacobian(rows[id], rows[id].normal, bodies));
   for (std::uint32_t id : ids) {
     const ContactRow& row = rows[id];
     for (int j = 0; j < k; ++j) {
@@ -111,7 +113,17 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
   // velocity block singular; Lemke then pivots on round-off and can stop on a false ray. A
   // compliance of 1e-6 of each row's own stiffness keeps the pivots well defined and leaves a
   // velocity error of one millionth of what the row's impulse does.
-  for (int r = 0; r < velocity_rows; ++r) m(r, r) *= 1 + 1e-6;
+  for (int r = 0; r < velocity_rows; ++r)
+    m(r, r) *= 1 + 1e-6;
+
+  // Resting contacts make the problem degenerate (many rows of q exactly 0: the sliding rows,
+  // the friction of still contacts), and round-off then decides ties that the lexicographic rule
+  // is meant to decide. A distinct perturbation of each row, 1e-11 of q's scale at most (Charnes'
+  // perturbation method, of which the lexicographic rule is the symbolic form), makes the ties
+  // real numbers again; it changes velocities by 1e-11 m/s.
+  const double perturbation = 1e-11 * std::max(1.0, q.cwiseAbs().maxCoeff());
+  for (int i = 0; i < n; ++i)
+    q[i] += perturbation * (i + 1) / n;
 
   ExactSolveResult result;
   Eigen::VectorXd z;
@@ -120,10 +132,21 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
   if (!result.solved()) {
     // Rarely the pivots still meet round-off: once more with a hundred times the compliance
     // (1e-4, still far below what a step shows) before giving the island to PGS.
-    for (int r = 0; r < velocity_rows; ++r) m(r, r) *= 1 + 1e-4;
+    for (int r = 0; r < velocity_rows; ++r)
+      m(r, r) *= 1 + 1e-4;
     const int spent = result.lemke.pivots;
     result.lemke = solve_lcp_lemke(m, q, max_pivots, &z);
     result.lemke.pivots += spent;
+  }
+  if (result.solved()) {
+    // Trust but verify: a path that ended on round-off can report success with a wrong basis.
+    const Eigen::VectorXd w = m * z + q;
+    const double scale = 1e-4 * std::max({1.0, q.cwiseAbs().maxCoeff(),
+                                          m.cwiseAbs().maxCoeff() * z.cwiseAbs().maxCoeff()});
+    double worst = 0;
+    for (int i = 0; i < n; ++i)
+      worst = std::max({worst, -w[i], std::min(w[i], z[i] * m(i, i))});
+    if (!(worst <= scale)) result.lemke.outcome = LemkeOutcome::kInaccurate;
   }
   if (!result.solved() || !z.allFinite()) {
     if (result.solved()) result.lemke.outcome = LemkeOutcome::kNotFinite;

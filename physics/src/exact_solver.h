@@ -27,7 +27,7 @@ struct ExactSolveResult {
 // failure nothing is changed.
 ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
                                       std::span<const std::uint32_t> ids,
-                                      std::span<SolverBody> bodies,
-                                      const SolverSettings& settings, double h);
+                                      std::span<SolverBody> bodies, const SolverSettings& settings,
+                                      double h);
 
 }  // namespace tumble

@@ -24,8 +24,10 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
     if (!dynamic[link.a] || !dynamic[link.b]) continue;
     const std::uint32_t ra = find_root(parent, link.a), rb = find_root(parent, link.b);
     // The lower slot becomes the root, so roots are the islands' lowest bodies.
-    if (ra < rb) parent[rb] = ra;
-    else if (rb < ra) parent[ra] = rb;
+    if (ra < rb)
+      parent[rb] = ra;
+    else if (rb < ra)
+      parent[ra] = rb;
   }
 
   constexpr std::uint32_t kNone = UINT32_MAX;
@@ -45,7 +47,8 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
   const std::size_t count = body_counts.size();
 
   out->body_begin.assign(count + 1, 0);
-  for (std::size_t i = 0; i < count; ++i) out->body_begin[i + 1] = out->body_begin[i] + body_counts[i];
+  for (std::size_t i = 0; i < count; ++i)
+    out->body_begin[i + 1] = out->body_begin[i] + body_counts[i];
   out->bodies.resize(out->body_begin[count]);
   std::vector<std::uint32_t> cursor(out->body_begin.begin(), out->body_begin.end() - 1);
   for (std::uint32_t s = 0; s < slots; ++s)
@@ -55,9 +58,11 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
   auto island_of_link = [&](const IslandLink& link) {
     return island_of[dynamic[link.a] ? link.a : link.b];
   };
-  for (const IslandLink& link : links) ++link_counts[island_of_link(link)];
+  for (const IslandLink& link : links)
+    ++link_counts[island_of_link(link)];
   out->link_begin.assign(count + 1, 0);
-  for (std::size_t i = 0; i < count; ++i) out->link_begin[i + 1] = out->link_begin[i] + link_counts[i];
+  for (std::size_t i = 0; i < count; ++i)
+    out->link_begin[i + 1] = out->link_begin[i] + link_counts[i];
   out->links.resize(out->link_begin[count]);
   cursor.assign(out->link_begin.begin(), out->link_begin.end() - 1);
   for (std::uint32_t l = 0; l < links.size(); ++l)

@@ -65,7 +65,8 @@ LemkeResult solve_lcp_lemke(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, 
 
   const int artificial = 2 * n;
   Tableau t{n, Eigen::MatrixXd::Identity(n, n), q, std::vector<int>(n)};
-  for (int i = 0; i < n; ++i) t.basic[i] = i;
+  for (int i = 0; i < n; ++i)
+    t.basic[i] = i;
 
   // z0 enters at the level that makes every w non-negative; the most negative w leaves.
   int row = 0;

@@ -13,7 +13,8 @@ enum class LemkeOutcome : std::uint8_t {
   kSolved,
   kRayTermination,  // no solution found along the path (the problem may have none)
   kPivotLimit,      // stopped at the bound on pivots
-  kNotFinite,       // a NaN or infinity in the input
+  kNotFinite,       // a NaN or infinity in the input (or the answer)
+  kInaccurate,      // set by callers that check the answer and find it off (round-off)
 };
 
 struct LemkeResult {

@@ -17,7 +17,9 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-int team_size(int requested) { return requested > 0 ? requested : omp_get_max_threads(); }
+int team_size(int requested) {
+  return requested > 0 ? requested : omp_get_max_threads();
+}
 
 // Everything one island needs to advance, independent of every other island.
 struct IslandContext {
@@ -58,8 +60,8 @@ void advance_island(const IslandContext& c, double dt, IslandReport* report) {
     const int substeps = solver.substeps;
     const double h = dt / substeps;
     // The spring may not be stiffer than the substep can follow (a quarter of its rate).
-    const Softness soft = contact_softness(std::min(solver.contact_hertz, 0.25 / h),
-                                           solver.contact_damping_ratio, h);
+    const Softness soft =
+        contact_softness(std::min(solver.contact_hertz, 0.25 / h), solver.contact_damping_ratio, h);
     for (int s = 0; s < substeps; ++s) {
       integrate_velocities(c, h, report);
       warm_start(rows, c.rows, bodies);
@@ -67,7 +69,8 @@ void advance_island(const IslandContext& c, double dt, IslandReport* report) {
         solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, &soft, h, (s + i) % 2 == 1);
       integrate_positions(c, h);
       for (int i = 0; i < solver.relax_iterations; ++i)
-        solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, nullptr, h, (s + i) % 2 == 0);
+        solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, nullptr, h,
+                       (s + i) % 2 == 0);
       report->velocity_iterations += solver.soft_iterations + solver.relax_iterations;
     }
     report->residual = normal_residual(rows, c.rows, bodies, h);
@@ -177,12 +180,18 @@ void World::prepare_contacts(double /*dt*/) {
     const std::uint32_t points = s.island_row_begin[i + 1] - s.island_row_begin[i];
     IslandSolver kind = IslandSolver::kSoft;
     switch (solver.kind) {
-      case SolverKind::kExact: kind = IslandSolver::kExact; break;
-      case SolverKind::kPgs: kind = IslandSolver::kPgs; break;
-      case SolverKind::kSoft: kind = IslandSolver::kSoft; break;
+      case SolverKind::kExact:
+        kind = IslandSolver::kExact;
+        break;
+      case SolverKind::kPgs:
+        kind = IslandSolver::kPgs;
+        break;
+      case SolverKind::kSoft:
+        kind = IslandSolver::kSoft;
+        break;
       case SolverKind::kAuto:
         kind = points <= static_cast<std::uint32_t>(solver.exact_max_points) ? IslandSolver::kExact
-                                                                              : IslandSolver::kSoft;
+                                                                             : IslandSolver::kSoft;
         break;
     }
     s.reports[i].solver = kind;
@@ -199,23 +208,27 @@ void World::prepare_contacts(double /*dt*/) {
 void World::solve_islands(double dt) {
   StepScratch& s = *scratch_;
   std::vector<const Body*> body_of_slot(bodies_.size());
-  for (std::size_t i = 0; i < bodies_.size(); ++i) body_of_slot[i] = &bodies_[i].body;
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    body_of_slot[i] = &bodies_[i].body;
   const std::int64_t islands = static_cast<std::int64_t>(s.islands.count());
   // Islands share no body and no row: any order and any thread gives the same bits.
-#pragma omp parallel for schedule(dynamic, 1) num_threads(team_size(settings_.threads)) \
-    if (islands > 1 && team_size(settings_.threads) > 1)
+#pragma omp parallel for schedule(dynamic, 1) \
+    num_threads(team_size(settings_.threads)) if (islands > 1 && team_size(settings_.threads) > 1)
   for (std::int64_t i = 0; i < islands; ++i) {
     const IslandContext context{
-        std::span(s.islands.bodies).subspan(s.islands.body_begin[i],
-                                            s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
-        std::span(s.island_rows).subspan(s.island_row_begin[i],
-                                         s.island_row_begin[i + 1] - s.island_row_begin[i]),
+        std::span(s.islands.bodies)
+            .subspan(s.islands.body_begin[i],
+                     s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
+        std::span(s.island_rows)
+            .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]),
         s, settings_, body_of_slot};
     advance_island(context, dt, &s.reports[i]);
   }
   for (const IslandReport& report : s.reports) {
-    if (report.solver == IslandSolver::kExact) ++stats_.exact_islands;
-    else ++stats_.iterative_islands;
+    if (report.solver == IslandSolver::kExact)
+      ++stats_.exact_islands;
+    else
+      ++stats_.iterative_islands;
     stats_.exact_fallbacks += report.exact_failed ? 1 : 0;
     stats_.lemke_pivots += report.lemke_pivots;
     stats_.velocity_iterations += report.velocity_iterations;
@@ -228,17 +241,17 @@ void World::correct_positions() {
   StepScratch& s = *scratch_;
   const int iterations = settings_.solver.position_iterations;
   const std::int64_t islands = static_cast<std::int64_t>(s.islands.count());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(team_size(settings_.threads)) \
-    if (islands > 1 && team_size(settings_.threads) > 1)
+#pragma omp parallel for schedule(dynamic, 1) \
+    num_threads(team_size(settings_.threads)) if (islands > 1 && team_size(settings_.threads) > 1)
   for (std::int64_t i = 0; i < islands; ++i) {
     // Soft islands corrected their penetration inside the substeps, exact ones in the LCP.
     const IslandReport& report = s.reports[i];
     if (report.solver == IslandSolver::kSoft ||
         (report.solver == IslandSolver::kExact && !report.exact_failed))
       continue;
-    const auto rows = std::span(s.island_rows)
-                          .subspan(s.island_row_begin[i],
-                                   s.island_row_begin[i + 1] - s.island_row_begin[i]);
+    const auto rows =
+        std::span(s.island_rows)
+            .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]);
     for (int k = 0; k < iterations; ++k)
       tumble::correct_positions(s.rows, rows, s.bodies, s.poses, settings_.solver);
   }
@@ -261,8 +274,9 @@ void World::finish_step(double dt) {
   for (std::size_t m = 0; m < contacts_.size(); ++m) {
     for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r) {
       const ContactRow& row = s.rows[r];
-      s.cache.push_back({contacts_[m].a, contacts_[m].b, row.feature, row.local_a, row.normal_impulse,
-                         row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2});
+      s.cache.push_back(
+          {contacts_[m].a, contacts_[m].b, row.feature, row.local_a, row.normal_impulse,
+           row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2});
       impulses_.push_back(row.normal_impulse);
     }
   }
@@ -275,16 +289,21 @@ namespace tumble {
 
 std::string_view solver_name(SolverKind kind) {
   switch (kind) {
-    case SolverKind::kExact: return "exact";
-    case SolverKind::kPgs: return "pgs";
-    case SolverKind::kSoft: return "soft";
-    case SolverKind::kAuto: return "auto";
+    case SolverKind::kExact:
+      return "exact";
+    case SolverKind::kPgs:
+      return "pgs";
+    case SolverKind::kSoft:
+      return "soft";
+    case SolverKind::kAuto:
+      return "auto";
   }
   return "auto";
 }
 
 std::optional<SolverKind> solver_from_name(std::string_view name) {
-  for (SolverKind kind : {SolverKind::kExact, SolverKind::kPgs, SolverKind::kSoft, SolverKind::kAuto})
+  for (SolverKind kind :
+       {SolverKind::kExact, SolverKind::kPgs, SolverKind::kSoft, SolverKind::kAuto})
     if (solver_name(kind) == name) return kind;
   return std::nullopt;
 }

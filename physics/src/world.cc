@@ -39,12 +39,14 @@ Status validate(const WorldSettings& s) {
   if (!(s.collision.margin >= 0) || !std::isfinite(s.collision.margin))
     return Status::error("collision.margin: must be finite and >= 0");
   const SolverSettings& v = s.solver;
-  if (v.iterations < 1 || v.iterations > 1000) return Status::error("solver.iterations: must be in [1, 1000]");
+  if (v.iterations < 1 || v.iterations > 1000)
+    return Status::error("solver.iterations: must be in [1, 1000]");
   if (v.soft_iterations < 1 || v.soft_iterations > 1000)
     return Status::error("solver.soft_iterations: must be in [1, 1000]");
   if (v.relax_iterations < 1 || v.relax_iterations > 1000)
     return Status::error("solver.relax_iterations: must be in [1, 1000]");
-  if (v.substeps < 1 || v.substeps > 1000) return Status::error("solver.substeps: must be in [1, 1000]");
+  if (v.substeps < 1 || v.substeps > 1000)
+    return Status::error("solver.substeps: must be in [1, 1000]");
   if (v.position_iterations < 0 || v.position_iterations > 1000)
     return Status::error("solver.position_iterations: must be in [0, 1000]");
   if (v.exact_max_points < 0) return Status::error("solver.exact_max_points: must be >= 0");
@@ -64,8 +66,10 @@ Status validate(const WorldSettings& s) {
     return Status::error("solver.contact_damping_ratio: must be finite and >= 0");
   if (!(v.max_push_velocity > 0) || !std::isfinite(v.max_push_velocity))
     return Status::error("solver.max_push_velocity: must be finite and > 0");
-  if (!non_negative(v.max_correction)) return Status::error("solver.max_correction: must be finite and >= 0");
-  if (!(v.baumgarte >= 0 && v.baumgarte <= 1)) return Status::error("solver.baumgarte: must be in [0, 1]");
+  if (!non_negative(v.max_correction))
+    return Status::error("solver.max_correction: must be finite and >= 0");
+  if (!(v.baumgarte >= 0 && v.baumgarte <= 1))
+    return Status::error("solver.baumgarte: must be in [0, 1]");
   return Status::ok();
 }
 
@@ -161,8 +165,8 @@ void World::compute_bounds(double dt) {
     const Aabb local = body.shape.local_bounds();
     if (dt > 0 && !body.is_static()) {
       const double reach = 0.5 * local.extent().norm();
-      speculative_[i] = (body.linear_velocity.norm() + gravity * dt +
-                         body.angular_velocity.norm() * reach) * dt;
+      speculative_[i] =
+          (body.linear_velocity.norm() + gravity * dt + body.angular_velocity.norm() * reach) * dt;
     }
     bounds_[i] = transform_aabb(local, body.pose()).expanded(base_margin + speculative_[i]);
     movable_[i] = body.is_static() ? 0 : 1;

@@ -33,7 +33,9 @@ class ObjectReader {
     const auto it = json_.find(key);
     return it == json_.end() ? nullptr : &*it;
   }
-  std::string child(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  std::string child(const std::string& key) const {
+    return path_.empty() ? key : path_ + "." + key;
+  }
 
   double number(const std::string& key, double fallback) {
     const Json* value = find(key);
@@ -80,7 +82,8 @@ class ObjectReader {
   static Vec3 read_vector(const Json& value, const std::string& path) {
     if (!value.is_array() || value.size() != 3) fail(path, "must be an array of 3 numbers");
     Vec3 v;
-    for (int k = 0; k < 3; ++k) v[k] = read_number(value[k], path + "[" + std::to_string(k) + "]");
+    for (int k = 0; k < 3; ++k)
+      v[k] = read_number(value[k], path + "[" + std::to_string(k) + "]");
     return v;
   }
 
@@ -174,7 +177,8 @@ SceneDef read_scene(const Json& json) {
   solver.soft_iterations = r.integer("soft_iterations", solver.soft_iterations, 1, 1000);
   solver.relax_iterations = r.integer("relax_iterations", solver.relax_iterations, 1, 1000);
   solver.substeps = r.integer("substeps", solver.substeps, 1, 1000);
-  solver.position_iterations = r.integer("position_iterations", solver.position_iterations, 0, 1000);
+  solver.position_iterations =
+      r.integer("position_iterations", solver.position_iterations, 0, 1000);
   solver.exact_max_points = r.integer("exact_max_points", solver.exact_max_points, 0, 100000);
   solver.friction_directions = r.integer("friction_directions", solver.friction_directions, 4, 32);
   solver.slop = r.number("slop", solver.slop);
@@ -193,7 +197,9 @@ SceneDef read_scene(const Json& json) {
   return scene;
 }
 
-Json vector_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+Json vector_json(const Vec3& v) {
+  return Json::array({v.x(), v.y(), v.z()});
+}
 
 Json body_json(const BodyDef& def) {
   Json out = Json::object();
@@ -213,15 +219,18 @@ Json body_json(const BodyDef& def) {
         } else if constexpr (std::is_same_v<T, HullDef>) {
           out["shape"] = "hull";
           out["points"] = Json::array();
-          for (const Vec3& p : shape.points) out["points"].push_back(vector_json(p));
+          for (const Vec3& p : shape.points)
+            out["points"].push_back(vector_json(p));
         } else {
           out["shape"] = "plane";
         }
       },
       def.shape);
   out["static"] = def.type == BodyType::kStatic;
-  if (def.mass > 0) out["mass"] = def.mass;
-  else out["density"] = def.density;
+  if (def.mass > 0)
+    out["mass"] = def.mass;
+  else
+    out["density"] = def.density;
   out["position"] = vector_json(def.position);
   const Quat& q = def.orientation;
   out["orientation"] = Json::array({q.w(), q.x(), q.y(), q.z()});
@@ -278,7 +287,8 @@ std::string scene_to_json(const SceneDef& scene) {
               {"restitution_threshold", s.restitution_threshold},
               {"contact_hertz", s.contact_hertz}};
   out["bodies"] = Json::array();
-  for (const BodyDef& def : scene.bodies) out["bodies"].push_back(body_json(def));
+  for (const BodyDef& def : scene.bodies)
+    out["bodies"].push_back(body_json(def));
   return out.dump(1);
 }
 

@@ -43,7 +43,8 @@ SceneDef pile_scene(int count) {
     const int ix = i % side, iy = (i / side) % side, iz = i / (side * side);
     const Vec3 centre((ix - (side - 1) / 2.0) * 1.5, (iy - (side - 1) / 2.0) * 1.5, 2.0 + 1.5 * iz);
     Vec3 r;
-    for (int k = 0; k < 3; ++k) r[k] = 0.2 * (2 * random.uniform() - 1);
+    for (int k = 0; k < 3; ++k)
+      r[k] = 0.2 * (2 * random.uniform() - 1);
     BodyDef def = box(Vec3::Ones(), 1, centre);
     const double angle = r.norm();
     if (angle > 0) def.orientation = Quat(Eigen::AngleAxisd(angle, r / angle));
@@ -65,7 +66,8 @@ SceneDef pyramid_scene(int base) {
 SceneDef tower_scene(int height) {
   SceneDef scene = base_scene("tower-" + std::to_string(height), 20);
   scene.bodies.push_back(ground());
-  for (int k = 0; k < height; ++k) scene.bodies.push_back(box(Vec3::Ones(), 1, Vec3(0, 0, 0.5 + k)));
+  for (int k = 0; k < height; ++k)
+    scene.bodies.push_back(box(Vec3::Ones(), 1, Vec3(0, 0, 0.5 + k)));
   return scene;
 }
 
@@ -73,7 +75,8 @@ SceneDef mass_ratio_scene(bool inverted) {
   SceneDef scene = base_scene(inverted ? "mass-ratio-inv" : "mass-ratio", 10);
   scene.bodies.push_back(ground());
   const double masses[3] = {inverted ? 1000.0 : 1.0, 1.0, inverted ? 1.0 : 1000.0};
-  for (int k = 0; k < 3; ++k) scene.bodies.push_back(box(Vec3::Ones(), masses[k], Vec3(0, 0, 0.5 + k)));
+  for (int k = 0; k < 3; ++k)
+    scene.bodies.push_back(box(Vec3::Ones(), masses[k], Vec3(0, 0, 0.5 + k)));
   return scene;
 }
 
@@ -123,8 +126,10 @@ Result<SceneDef> standard_scene(std::string_view spec) {
     const std::string_view digits = spec.substr(colon + 1);
     int value = 0;
     const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-    if (error != std::errc() || end != digits.data() + digits.size() || value < 1 || value > 1000000)
-      return Status::error("scene '" + std::string(spec) + "': the size after ':' must be an integer in [1, 1000000]");
+    if (error != std::errc() || end != digits.data() + digits.size() || value < 1 ||
+        value > 1000000)
+      return Status::error("scene '" + std::string(spec) +
+                           "': the size after ':' must be an integer in [1, 1000000]");
     size = value;
   }
   auto sized = [&](const char* what) -> Status {

@@ -22,7 +22,7 @@ struct SolverSettings {
   int iterations = 10;
   int soft_iterations = 3;
   int relax_iterations = 3;  // soft: sweeps without bias after each substep's move
-  int substeps = 4;  // soft only; the others take one step of dt
+  int substeps = 4;          // soft only; the others take one step of dt
   // Position iterations after the velocity solve (pgs, and exact islands that fell back to it):
   // nonlinear Gauss-Seidel that moves bodies out of penetration without adding velocity.
   int position_iterations = 3;

@@ -25,16 +25,17 @@ class SceneRandom {
 
 // Every scene has the conventions of SCENES.md: unit boxes of 1 kg, mu = 0.5, restitution 0,
 // dt = 1/60, gravity -9.81 z (none in bullet and spin), the ground a static plane z = 0.
-SceneDef pile_scene(int count = 1000);          // S1: a lattice of tilted boxes falling, 10 s
-SceneDef pyramid_scene(int base = 20);          // S2: base boxes at the bottom, 20 s
-SceneDef tower_scene(int height = 20);          // S3: 20 s
+SceneDef pile_scene(int count = 1000);             // S1: a lattice of tilted boxes falling, 10 s
+SceneDef pyramid_scene(int base = 20);             // S2: base boxes at the bottom, 20 s
+SceneDef tower_scene(int height = 20);             // S3: 20 s
 SceneDef mass_ratio_scene(bool inverted = false);  // S4: 1, 1, 1000 kg bottom to top (inverted:
                                                    // 1000, 1, 1), 10 s
-SceneDef bullet_scene();                        // S5: 0.1 m box at 300 m/s at a 5 cm wall, 1 s
-SceneDef slide_scene(double speed = 5);         // S6: a box sliding on the ground, 3 s
-SceneDef spin_scene();                          // S7: a 1x2x3 box spinning near its middle axis
-SceneDef bounce_scene(double height = 1, double restitution = 0.5);  // dropped from `height`
-                                                   // (bottom face above ground), 3 s
+SceneDef bullet_scene();                           // S5: 0.1 m box at 300 m/s at a 5 cm wall, 1 s
+SceneDef slide_scene(double speed = 5);            // S6: a box sliding on the ground, 3 s
+SceneDef spin_scene();                             // S7: a 1x2x3 box spinning near its middle axis
+SceneDef bounce_scene(double height = 1,
+                      double restitution = 0.5);  // dropped from `height`
+                                                  // (bottom face above ground), 3 s
 
 // A standard scene by name, with an optional size: "pile", "pile:250", "pyramid:10", "tower:5",
 // "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "default".
