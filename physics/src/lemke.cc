@@ -11,7 +11,8 @@ namespace {
 // Variables are numbered w_0..w_{n-1}, z_0..z_{n-1}, then the artificial z0 (index 2n).
 struct Tableau {
   int n;
-  Eigen::MatrixXd basis_inverse;  // B^-1 of the current basis
+  // B^-1 of the current basis, row-major: every pivot subtracts whole rows.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> basis_inverse;
   Eigen::VectorXd values;         // values of the basic variables, B^-1 q
   std::vector<int> basic;         // which variable each row holds
 

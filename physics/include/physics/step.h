@@ -27,7 +27,7 @@ struct SolverSettings {
   // nonlinear Gauss-Seidel that moves bodies out of penetration without adding velocity.
   int position_iterations = 3;
   // auto: an island with at most this many contact points goes to the exact solver.
-  int exact_max_points = 16;
+  int exact_max_points = 12;
   // Directions of the friction pyramid in the exact solver (its facets); 4 to 32. The first one
   // follows the sliding direction, so a sliding body feels the full Coulomb force.
   int friction_directions = 8;
