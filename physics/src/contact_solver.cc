@@ -182,8 +182,8 @@ NormalTarget normal_target(const ContactRow& row, std::span<const SolverBody> bo
   return {};
 }
 
-void solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
-  if (row.friction <= 0) return;
+double solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
+  if (row.friction <= 0) return 0;
   SolverBody& a = bodies[row.a];
   SolverBody& b = bodies[row.b];
   const Vec3 dv = b.v - a.v;
@@ -208,32 +208,34 @@ void solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
   a.w -= d1 * row.angular_a_t1 + d2 * row.angular_a_t2;
   b.v += b.inverse_mass * linear;
   b.w += d1 * row.angular_b_t1 + d2 * row.angular_b_t2;
+  // The velocity change this gave the contact, m/s.
+  return std::max(std::abs(d1) / row.tangent_mass1, std::abs(d2) / row.tangent_mass2);
 }
 
-void solve_normal(ContactRow& row, std::span<SolverBody> bodies, const NormalTarget& target) {
+double solve_normal(ContactRow& row, std::span<SolverBody> bodies, const NormalTarget& target) {
   const double vn = normal_velocity(row, bodies);
   const double delta = -row.normal_mass * target.mass_scale * (vn + target.bias) -
                        target.impulse_scale * row.normal_impulse;
   const double updated = std::max(row.normal_impulse + delta, 0.0);
+  const double change = std::abs(updated - row.normal_impulse) / row.normal_mass;
   apply_normal_impulse(row, updated - row.normal_impulse, bodies);
   row.normal_impulse = updated;
   row.max_normal_impulse = std::max(row.max_normal_impulse, updated);
+  return change;
 }
 
 // The manifold's rows rows[ids[0..count)]: friction point by point, then the normals as a block
 // when the block solution keeps every impulse non-negative, else point by point.
-void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int count,
-                    std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                    const SolverSettings& settings, const Softness* soft, double inverse_h) {
-  for (int i = 0; i < count; ++i)
-    solve_friction(rows[ids[i]], bodies);
+// Returns the largest velocity change it gave a contact (m/s).
+double solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int count,
+                      std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                      const SolverSettings& settings, const Softness* soft, double inverse_h) {
+  double change = 0;
+  for (int i = 0; i < count; ++i) change = std::max(change, solve_friction(rows[ids[i]], bodies));
   NormalTarget targets[4];
   for (int i = 0; i < count; ++i)
     targets[i] = normal_target(rows[ids[i]], bodies, settings, soft, inverse_h);
-  if (count == 1) {
-    solve_normal(rows[ids[0]], bodies, targets[0]);
-    return;
-  }
+  if (count == 1) return std::max(change, solve_normal(rows[ids[0]], bodies, targets[0]));
   Eigen::Vector4d error = Eigen::Vector4d::Zero();
   for (int i = 0; i < count; ++i) {
     const ContactRow& row = rows[ids[i]];
@@ -251,39 +253,45 @@ void solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int co
   }
   if (!feasible) {
     for (int i = 0; i < count; ++i)
-      solve_normal(rows[ids[i]], bodies, targets[i]);
-    return;
+      change = std::max(change, solve_normal(rows[ids[i]], bodies, targets[i]));
+    return change;
   }
   for (int i = 0; i < count; ++i) {
     ContactRow& row = rows[ids[i]];
+    change = std::max(change, std::abs(updated[i] - row.normal_impulse) / row.normal_mass);
     apply_normal_impulse(row, updated[i] - row.normal_impulse, bodies);
     row.normal_impulse = updated[i];
     row.max_normal_impulse = std::max(row.max_normal_impulse, updated[i]);
   }
+  return change;
 }
 
 }  // namespace
 
-void solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                    std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                    const SolverSettings& settings, const Softness* soft, double h, bool backward) {
+double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                      std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                      const SolverSettings& settings, const Softness* soft, double h,
+                      bool backward) {
   const double inverse_h = 1 / h;
+  double change = 0;
   const std::size_t count = ids.size();
   // A manifold's rows are consecutive in `ids`; visit manifolds forwards or backwards.
   if (!backward) {
     for (std::size_t k = 0; k < count;) {
       const int size = rows[ids[k]].block_size;
-      solve_manifold(rows, &ids[k], size, blocks, bodies, settings, soft, inverse_h);
+      change = std::max(change, solve_manifold(rows, &ids[k], size, blocks, bodies, settings, soft, inverse_h));
       k += size;
     }
   } else {
     for (std::size_t end = count; end > 0;) {
       const ContactRow& last = rows[ids[end - 1]];
       const std::size_t start = end - 1 - last.block_index;
-      solve_manifold(rows, &ids[start], last.block_size, blocks, bodies, settings, soft, inverse_h);
+      change = std::max(change, solve_manifold(rows, &ids[start], last.block_size, blocks, bodies,
+                                               settings, soft, inverse_h));
       end = start;
     }
   }
+  return change;
 }
 
 void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,

@@ -86,8 +86,9 @@ void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
 
 // One Gauss-Seidel sweep. With `soft` set, penetration beyond the slop is pushed out through the
 // spring; without it contacts are rigid and only gaps (speculative contacts) add bias. Sweeps
-// alternate direction (`backward`), so that no end of a stack is always solved last.
-void solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+// alternate direction (`backward`), so that no end of a stack is always solved last. Returns the
+// largest velocity change the sweep gave any contact (m/s): a converged sweep changes nothing.
+double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
                     std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
                     const SolverSettings& settings, const Softness* soft, double h, bool backward);
 

@@ -45,10 +45,13 @@ void integrate_positions(const IslandContext& c, double h) {
 
 void solve_pgs(const IslandContext& c, double h, IslandReport* report) {
   warm_start(c.scratch.rows, c.rows, c.scratch.bodies);
-  for (int i = 0; i < c.settings.solver.iterations; ++i)
-    solve_contacts(c.scratch.rows, c.rows, c.scratch.blocks, c.scratch.bodies, c.settings.solver,
-                   nullptr, h, i % 2 == 1);
-  report->velocity_iterations += c.settings.solver.iterations;
+  const SolverSettings& solver = c.settings.solver;
+  for (int i = 0; i < solver.iterations; ++i) {
+    ++report->velocity_iterations;
+    if (solve_contacts(c.scratch.rows, c.rows, c.scratch.blocks, c.scratch.bodies, solver, nullptr,
+                       h, i % 2 == 1) <= solver.velocity_tolerance)
+      break;
+  }
 }
 
 // One step of dt for an island with the solver chosen for it.
@@ -65,13 +68,19 @@ void advance_island(const IslandContext& c, double dt, IslandReport* report) {
     for (int s = 0; s < substeps; ++s) {
       integrate_velocities(c, h, report);
       warm_start(rows, c.rows, bodies);
-      for (int i = 0; i < solver.soft_iterations; ++i)
-        solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, &soft, h, (s + i) % 2 == 1);
+      for (int i = 0; i < solver.soft_iterations; ++i) {
+        ++report->velocity_iterations;
+        if (solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, &soft, h,
+                           (s + i) % 2 == 1) <= solver.velocity_tolerance)
+          break;
+      }
       integrate_positions(c, h);
-      for (int i = 0; i < solver.relax_iterations; ++i)
-        solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, nullptr, h,
-                       (s + i) % 2 == 0);
-      report->velocity_iterations += solver.soft_iterations + solver.relax_iterations;
+      for (int i = 0; i < solver.relax_iterations; ++i) {
+        ++report->velocity_iterations;
+        if (solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, nullptr, h,
+                           (s + i) % 2 == 0) <= solver.velocity_tolerance)
+          break;
+      }
     }
     report->residual = normal_residual(rows, c.rows, bodies, h);
     apply_restitution(rows, c.rows, c.scratch.blocks, bodies, solver);

@@ -55,6 +55,8 @@ Status validate(const WorldSettings& s) {
   if (v.lemke_pivots_per_unknown < 1)
     return Status::error("solver.lemke_pivots_per_unknown: must be >= 1");
   auto non_negative = [](double x) { return std::isfinite(x) && x >= 0; };
+  if (!non_negative(v.velocity_tolerance))
+    return Status::error("solver.velocity_tolerance: must be finite and >= 0");
   if (!non_negative(v.slop)) return Status::error("solver.slop: must be finite and >= 0");
   if (!non_negative(v.speculative_distance))
     return Status::error("solver.speculative_distance: must be finite and >= 0");

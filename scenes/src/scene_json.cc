@@ -181,6 +181,7 @@ SceneDef read_scene(const Json& json) {
       r.integer("position_iterations", solver.position_iterations, 0, 1000);
   solver.exact_max_points = r.integer("exact_max_points", solver.exact_max_points, 0, 100000);
   solver.friction_directions = r.integer("friction_directions", solver.friction_directions, 4, 32);
+  solver.velocity_tolerance = r.number("velocity_tolerance", solver.velocity_tolerance);
   solver.slop = r.number("slop", solver.slop);
   solver.speculative_distance = r.number("speculative_distance", solver.speculative_distance);
   solver.restitution_threshold = r.number("restitution_threshold", solver.restitution_threshold);
@@ -282,6 +283,7 @@ std::string scene_to_json(const SceneDef& scene) {
               {"position_iterations", s.position_iterations},
               {"exact_max_points", s.exact_max_points},
               {"friction_directions", s.friction_directions},
+              {"velocity_tolerance", s.velocity_tolerance},
               {"slop", s.slop},
               {"speculative_distance", s.speculative_distance},
               {"restitution_threshold", s.restitution_threshold},

@@ -22,6 +22,9 @@ struct SolverSettings {
   int iterations = 10;
   int soft_iterations = 3;
   int relax_iterations = 3;  // soft: sweeps without bias after each substep's move
+  // pgs and soft stop sweeping once a sweep changes no contact velocity by more than this (m/s);
+  // resting scenes, warm-started, then need one sweep. 0 always runs every iteration.
+  double velocity_tolerance = 1e-4;
   int substeps = 4;          // soft only; the others take one step of dt
   // Position iterations after the velocity solve (pgs, and exact islands that fell back to it):
   // nonlinear Gauss-Seidel that moves bodies out of penetration without adding velocity.
