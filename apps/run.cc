@@ -98,9 +98,10 @@ int main(int argc, char** argv) {
     if (s % per_second == 0 || s == steps) {
       const StepStats& st = world.last_step();
       const Totals t = measure(world);
-      std::printf("%7.2f %9u %8u %8u %10.4f %12.2e %12.4f %10.2e %9.3f\n", world.time(),
-                  st.contact_points, st.islands, st.exact_islands, t.max_speed, st.max_penetration,
-                  t.kinetic + t.potential, st.residual, 1e3 * window_seconds / window_steps);
+      std::printf("%7.2f %9u %8u %8u %7u %10.4f %12.2e %12.4f %10.2e %9.3f\n", world.time(),
+                  st.contact_points, st.islands, st.exact_islands, st.sleeping_bodies, t.max_speed,
+                  st.max_penetration, t.kinetic + t.potential, st.residual,
+                  1e3 * window_seconds / window_steps);
       window_seconds = 0;
       window_steps = 0;
     }

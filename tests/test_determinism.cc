@@ -26,7 +26,8 @@ std::uint64_t state_hash(const World& world) {
       mix(b->linear_velocity[k]);
       mix(b->angular_velocity[k]);
     }
-    for (int k = 0; k < 4; ++k) mix(b->orientation.coeffs()[k]);
+    for (int k = 0; k < 4; ++k)
+      mix(b->orientation.coeffs()[k]);
   }
   return hash;
 }

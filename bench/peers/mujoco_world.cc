@@ -17,15 +17,17 @@ RunResult run_mujoco(const SceneDef& scene, long steps) {
   result.engine = "MuJoCo 2.2.2";
   result.settings = "Newton, 100 iterations, pyramidal cone, Euler, soft contacts";
   std::size_t dynamic_count = 0;
-  for (const BodyDef& def : scene.bodies) dynamic_count += def.type == BodyType::kDynamic ? 1 : 0;
+  for (const BodyDef& def : scene.bodies)
+    dynamic_count += def.type == BodyType::kDynamic ? 1 : 0;
   // SCENES.md: 12 contacts per body + 64 (pile: 6), njmax 4 x nconmax.
   const std::size_t contacts = (scene.bodies.size() > 500 ? 6 : 12) * dynamic_count + 64;
 
   std::ostringstream xml;
   xml.precision(17);
   const Vec3 g = scene.world.gravity;
-  xml << "<mujoco><option timestep=\"" << scene.dt << "\" gravity=\"" << g.x() << ' ' << g.y() << ' '
-      << g.z() << "\" integrator=\"Euler\" cone=\"pyramidal\" solver=\"Newton\" iterations=\"100\"/>"
+  xml << "<mujoco><option timestep=\"" << scene.dt << "\" gravity=\"" << g.x() << ' ' << g.y()
+      << ' ' << g.z()
+      << "\" integrator=\"Euler\" cone=\"pyramidal\" solver=\"Newton\" iterations=\"100\"/>"
       << "<size nconmax=\"" << contacts << "\" njmax=\"" << 4 * contacts << "\"/><worldbody>";
   const char* material = "friction=\"0.5 0.005 0.0001\" condim=\"3\"";
   std::vector<Vec3> halves;
@@ -39,8 +41,8 @@ RunResult run_mujoco(const SceneDef& scene, long steps) {
     const Vec3& p = def.position;
     std::ostringstream pose;
     pose.precision(17);
-    pose << "pos=\"" << p.x() << ' ' << p.y() << ' ' << p.z() << "\" quat=\"" << q.w() << ' ' << q.x()
-         << ' ' << q.y() << ' ' << q.z() << "\"";
+    pose << "pos=\"" << p.x() << ' ' << p.y() << ' ' << p.z() << "\" quat=\"" << q.w() << ' '
+         << q.x() << ' ' << q.y() << ' ' << q.z() << "\"";
     std::ostringstream box;
     box.precision(17);
     box << "type=\"box\" size=\"" << h.x() << ' ' << h.y() << ' ' << h.z() << "\" " << material;
@@ -84,27 +86,31 @@ RunResult run_mujoco(const SceneDef& scene, long steps) {
     const mjtNum* p = data->xpos + 3 * (i + 1);
     return Vec3(p[0], p[1], p[2]);
   };
-  for (std::size_t i = 0; i < dynamic_count; ++i) result.start.push_back(position(i));
+  for (std::size_t i = 0; i < dynamic_count; ++i)
+    result.start.push_back(position(i));
   const long last_second = steps - std::lround(1 / scene.dt);
   for (long s = 0; s < steps; ++s) {
     const auto start = std::chrono::steady_clock::now();
     mj_step(model, data);
     result.step_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
     for (std::size_t i = 0; i < dynamic_count; ++i) {
       const Vec3 p = position(i);
       if (!p.allFinite() || p.cwiseAbs().maxCoeff() > 1000) result.blew_up = true;
       if (s >= last_second && g.norm() > 0) {
         const mjtNum* q = data->xquat + 4 * (i + 1);
         result.deepest_corner_last_second =
-            std::max(result.deepest_corner_last_second, corner_depth(p, Quat(q[0], q[1], q[2], q[3]), halves[i]));
+            std::max(result.deepest_corner_last_second,
+                     corner_depth(p, Quat(q[0], q[1], q[2], q[3]), halves[i]));
       }
     }
   }
   if (data->warning[mjWARN_CONTACTFULL].number > 0) result.settings += "; CONTACT BUFFER FULL";
   for (std::size_t i = 0; i < dynamic_count; ++i) {
     result.end.push_back(position(i));
-    result.end_velocity.push_back(Vec3(data->qvel[6 * i], data->qvel[6 * i + 1], data->qvel[6 * i + 2]));
+    result.end_velocity.push_back(
+        Vec3(data->qvel[6 * i], data->qvel[6 * i + 1], data->qvel[6 * i + 2]));
   }
   mj_deleteData(data);
   mj_deleteModel(model);

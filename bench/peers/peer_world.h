@@ -25,6 +25,7 @@ double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half);
 
 RunResult run_bullet(const SceneDef& scene, long steps);
 RunResult run_ode(const SceneDef& scene, long steps);
-RunResult run_mujoco(const SceneDef& scene, long steps);  // boxes and a plane; no pile of 1000 (see PEERS.md)
+RunResult run_mujoco(const SceneDef& scene,
+                     long steps);  // boxes and a plane; no pile of 1000 (see PEERS.md)
 
 }  // namespace tumble::bench

@@ -231,7 +231,8 @@ double solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int 
                       std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
                       const SolverSettings& settings, const Softness* soft, double inverse_h) {
   double change = 0;
-  for (int i = 0; i < count; ++i) change = std::max(change, solve_friction(rows[ids[i]], bodies));
+  for (int i = 0; i < count; ++i)
+    change = std::max(change, solve_friction(rows[ids[i]], bodies));
   NormalTarget targets[4];
   for (int i = 0; i < count; ++i)
     targets[i] = normal_target(rows[ids[i]], bodies, settings, soft, inverse_h);
@@ -279,7 +280,8 @@ double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t>
   if (!backward) {
     for (std::size_t k = 0; k < count;) {
       const int size = rows[ids[k]].block_size;
-      change = std::max(change, solve_manifold(rows, &ids[k], size, blocks, bodies, settings, soft, inverse_h));
+      change = std::max(
+          change, solve_manifold(rows, &ids[k], size, blocks, bodies, settings, soft, inverse_h));
       k += size;
     }
   } else {

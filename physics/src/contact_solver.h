@@ -89,8 +89,9 @@ void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
 // alternate direction (`backward`), so that no end of a stack is always solved last. Returns the
 // largest velocity change the sweep gave any contact (m/s): a converged sweep changes nothing.
 double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                    std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                    const SolverSettings& settings, const Softness* soft, double h, bool backward);
+                      std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                      const SolverSettings& settings, const Softness* soft, double h,
+                      bool backward);
 
 // Gives bouncing contacts their outgoing velocity, e times the approach velocity.
 void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,

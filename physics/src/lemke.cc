@@ -13,8 +13,8 @@ struct Tableau {
   int n;
   // B^-1 of the current basis, row-major: every pivot subtracts whole rows.
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> basis_inverse;
-  Eigen::VectorXd values;         // values of the basic variables, B^-1 q
-  std::vector<int> basic;         // which variable each row holds
+  Eigen::VectorXd values;  // values of the basic variables, B^-1 q
+  std::vector<int> basic;  // which variable each row holds
 
   // The entering variable's column in the current basis: B^-1 a, with the original columns
   // a(w_i) = e_i, a(z_j) = -M e_j, a(z0) = -1.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "exact_solver.h"
 #include "integrate.h"
@@ -123,6 +124,17 @@ Status World::step(double dt) {
   find_contacts(dt);
   stats_.time.narrow_phase = seconds_since(stage);
 
+  // Sleepers touched by moving bodies wake with their islands, and the woken need their own
+  // contacts this step. Islands that touch fall asleep together, so one more pass finds them all.
+  if (const std::uint32_t woken = wake_touched(); woken > 0) {
+    stats_.woken_bodies = woken;
+    stage = std::chrono::steady_clock::now();
+    compute_bounds(dt);
+    run_broad_phase();
+    find_contacts(dt);
+    stats_.time.narrow_phase += seconds_since(stage);
+  }
+
   stage = std::chrono::steady_clock::now();
   prepare_contacts(dt);
   stats_.time.prepare = seconds_since(stage);
@@ -136,6 +148,7 @@ Status World::step(double dt) {
   stats_.time.correct_positions = seconds_since(stage);
 
   finish_step(dt);
+  update_sleep(dt);
   stats_.time.total = seconds_since(start);
   return Status::ok();
 }
@@ -150,7 +163,7 @@ void World::prepare_contacts(double /*dt*/) {
     const Slot& slot = bodies_[i];
     SolverBody& sb = s.bodies[i];
     sb = SolverBody{};
-    s.dynamic[i] = slot.alive && !slot.body.is_static();
+    s.dynamic[i] = slot.alive && slot.body.is_moving();
     if (!slot.alive) continue;
     s.poses[i] = slot.body.pose();
     if (!s.dynamic[i]) continue;
@@ -264,6 +277,43 @@ void World::correct_positions() {
     for (int k = 0; k < iterations; ++k)
       tumble::correct_positions(s.rows, rows, s.bodies, s.poses, settings_.solver);
   }
+}
+
+std::uint32_t World::wake_touched() {
+  std::uint32_t woken = 0;
+  for (const Contact& contact : contacts_) {
+    const Body& a = bodies_[contact.a.index].body;
+    const Body& b = bodies_[contact.b.index].body;
+    if (a.asleep && b.is_moving()) woken += wake_island(a.sleep_island);
+    if (b.asleep && a.is_moving()) woken += wake_island(b.sleep_island);
+  }
+  return woken;
+}
+
+void World::update_sleep(double dt) {
+  StepScratch& s = *scratch_;
+  const SolverSettings& solver = settings_.solver;
+  for (std::size_t i = 0; i < s.islands.count(); ++i) {
+    double shortest = std::numeric_limits<double>::infinity();
+    for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
+      Body& body = bodies_[s.islands.bodies[k]].body;
+      const bool slow = body.linear_velocity.norm() < solver.sleep_linear_speed &&
+                        body.angular_velocity.norm() < solver.sleep_angular_speed;
+      body.sleep_timer = slow ? body.sleep_timer + dt : 0.0;
+      shortest = std::min(shortest, body.sleep_timer);
+    }
+    if (!solver.sleeping || shortest < solver.sleep_delay) continue;
+    const std::uint32_t island = s.islands.bodies[s.islands.body_begin[i]];
+    for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
+      Body& body = bodies_[s.islands.bodies[k]].body;
+      body.asleep = true;
+      body.sleep_island = island;
+      body.linear_velocity.setZero();
+      body.angular_velocity.setZero();
+    }
+  }
+  for (const Slot& slot : bodies_)
+    stats_.sleeping_bodies += slot.alive && slot.body.asleep ? 1 : 0;
 }
 
 void World::finish_step(double dt) {

@@ -57,6 +57,12 @@ Status validate(const WorldSettings& s) {
   auto non_negative = [](double x) { return std::isfinite(x) && x >= 0; };
   if (!non_negative(v.velocity_tolerance))
     return Status::error("solver.velocity_tolerance: must be finite and >= 0");
+  if (!non_negative(v.sleep_linear_speed))
+    return Status::error("solver.sleep_linear_speed: must be finite and >= 0");
+  if (!non_negative(v.sleep_angular_speed))
+    return Status::error("solver.sleep_angular_speed: must be finite and >= 0");
+  if (!non_negative(v.sleep_delay))
+    return Status::error("solver.sleep_delay: must be finite and >= 0");
   if (!non_negative(v.slop)) return Status::error("solver.slop: must be finite and >= 0");
   if (!non_negative(v.speculative_distance))
     return Status::error("solver.speculative_distance: must be finite and >= 0");
@@ -123,11 +129,38 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
 Status World::remove_body(BodyId id) {
   if (!contains(id)) return Status::error("body: no body with this id");
   Slot& slot = bodies_[id.index];
+  // Whatever rested on it must fall: wake every sleeping island near it.
+  const Aabb near = transform_aabb(slot.body.shape.local_bounds(), slot.body.pose())
+                        .expanded(settings_.solver.speculative_distance + 0.05);
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const Body& other = bodies_[i].body;
+    if (bodies_[i].alive && other.asleep &&
+        transform_aabb(other.shape.local_bounds(), other.pose()).overlaps(near))
+      wake_island(other.sleep_island);
+  }
   slot.alive = false;
   ++slot.generation;
   slot.body = Body();
   free_slots_.push_back(id.index);
   --live_count_;
+  return Status::ok();
+}
+
+std::uint32_t World::wake_island(std::uint32_t island) {
+  std::uint32_t woken = 0;
+  for (Slot& slot : bodies_) {
+    if (!slot.alive || !slot.body.asleep || slot.body.sleep_island != island) continue;
+    slot.body.asleep = false;
+    slot.body.sleep_timer = 0;
+    ++woken;
+  }
+  return woken;
+}
+
+Status World::wake(BodyId id) {
+  if (!contains(id)) return Status::error("body: no body with this id");
+  const Body& body = bodies_[id.index].body;
+  if (body.asleep) wake_island(body.sleep_island);
   return Status::ok();
 }
 
@@ -165,13 +198,14 @@ void World::compute_bounds(double dt) {
     }
     const Body& body = slot.body;
     const Aabb local = body.shape.local_bounds();
-    if (dt > 0 && !body.is_static()) {
+    if (dt > 0 && body.is_moving()) {
       const double reach = 0.5 * local.extent().norm();
       speculative_[i] =
           (body.linear_velocity.norm() + gravity * dt + body.angular_velocity.norm() * reach) * dt;
     }
     bounds_[i] = transform_aabb(local, body.pose()).expanded(base_margin + speculative_[i]);
-    movable_[i] = body.is_static() ? 0 : 1;
+    // Sleepers pair only with moving bodies, as statics do.
+    movable_[i] = body.is_moving() ? 1 : 0;
   }
 }
 

@@ -182,6 +182,10 @@ SceneDef read_scene(const Json& json) {
   solver.exact_max_points = r.integer("exact_max_points", solver.exact_max_points, 0, 100000);
   solver.friction_directions = r.integer("friction_directions", solver.friction_directions, 4, 32);
   solver.velocity_tolerance = r.number("velocity_tolerance", solver.velocity_tolerance);
+  solver.sleeping = r.boolean("sleeping", solver.sleeping);
+  solver.sleep_linear_speed = r.number("sleep_linear_speed", solver.sleep_linear_speed);
+  solver.sleep_angular_speed = r.number("sleep_angular_speed", solver.sleep_angular_speed);
+  solver.sleep_delay = r.number("sleep_delay", solver.sleep_delay);
   solver.slop = r.number("slop", solver.slop);
   solver.speculative_distance = r.number("speculative_distance", solver.speculative_distance);
   solver.restitution_threshold = r.number("restitution_threshold", solver.restitution_threshold);
@@ -284,6 +288,10 @@ std::string scene_to_json(const SceneDef& scene) {
               {"exact_max_points", s.exact_max_points},
               {"friction_directions", s.friction_directions},
               {"velocity_tolerance", s.velocity_tolerance},
+              {"sleeping", s.sleeping},
+              {"sleep_linear_speed", s.sleep_linear_speed},
+              {"sleep_angular_speed", s.sleep_angular_speed},
+              {"sleep_delay", s.sleep_delay},
               {"slop", s.slop},
               {"speculative_distance", s.speculative_distance},
               {"restitution_threshold", s.restitution_threshold},

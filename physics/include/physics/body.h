@@ -62,8 +62,14 @@ struct Body {
   double restitution = 0;
   // The inertia is a multiple of the identity (sphere, cube): no gyroscopic torque.
   bool spherical_inertia = false;
+  // Sleeping: how long the body has been slower than the sleep thresholds (s), whether it sleeps,
+  // and the island it fell asleep with (its lowest slot), which wakes as one.
+  double sleep_timer = 0;
+  bool asleep = false;
+  std::uint32_t sleep_island = 0;
 
   bool is_static() const { return type == BodyType::kStatic; }
+  bool is_moving() const { return type == BodyType::kDynamic && !asleep; }
   Pose pose() const { return {position, orientation}; }
   void update_world_inertia() {
     const Mat3 r = orientation.toRotationMatrix();

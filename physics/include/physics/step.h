@@ -25,7 +25,7 @@ struct SolverSettings {
   // pgs and soft stop sweeping once a sweep changes no contact velocity by more than this (m/s);
   // resting scenes, warm-started, then need one sweep. 0 always runs every iteration.
   double velocity_tolerance = 1e-4;
-  int substeps = 4;          // soft only; the others take one step of dt
+  int substeps = 4;  // soft only; the others take one step of dt
   // Position iterations after the velocity solve (pgs, and exact islands that fell back to it):
   // nonlinear Gauss-Seidel that moves bodies out of penetration without adding velocity.
   int position_iterations = 3;
@@ -36,6 +36,12 @@ struct SolverSettings {
   int friction_directions = 8;
   // Lemke: pivots allowed per unknown before the island falls back to pgs.
   int lemke_pivots_per_unknown = 20;
+  // Islands whose bodies all stay below both speeds for `sleep_delay` fall asleep and cost nothing
+  // until a moving body touches them or a body they rest on is removed.
+  bool sleeping = true;
+  double sleep_linear_speed = 0.05;    // m/s
+  double sleep_angular_speed = 0.05;   // rad/s
+  double sleep_delay = 0.5;            // s
   double slop = 1e-4;                  // m: penetration left alone, so resting contacts keep still
   double speculative_distance = 0.02;  // m: gap below which contacts exist even at rest
   double restitution_threshold = 1.0;  // m/s: slower impacts do not bounce
@@ -64,6 +70,7 @@ struct StepStats {
   // Largest complementarity residual of a normal contact row after the solve, m/s:
   // |min(impulse / effective mass, normal velocity - target)|; 0 when exactly solved.
   double residual = 0;
+  std::uint32_t sleeping_bodies = 0, woken_bodies = 0;
   double max_penetration = 0;  // m, the deepest contact point found this step
   std::uint32_t collision_flags = 0;
   // Bodies whose implicit gyroscopic step hit its Newton iteration bound.

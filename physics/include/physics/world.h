@@ -55,7 +55,10 @@ class World {
   Result<BodyId> create_body(const BodyDef& def);
   // Creates all bodies or none; a failure names the definition ("bodies[3].mass: must be > 0").
   Result<std::vector<BodyId>> create_bodies(std::span<const BodyDef> defs);
+  // Removes a body; sleeping bodies that may have rested on it wake.
   Status remove_body(BodyId id);
+  // Wakes a sleeping body and the island it fell asleep with.
+  Status wake(BodyId id);
 
   bool contains(BodyId id) const;
   // The body, or null when `id` is stale or was never made.
@@ -95,6 +98,11 @@ class World {
     std::uint32_t generation = 0;
     bool alive = false;
   };
+  std::uint32_t wake_island(std::uint32_t island);
+  // After the narrow phase: sleepers touched by moving bodies wake with their islands; returns
+  // how many woke.
+  std::uint32_t wake_touched();
+  void update_sleep(double dt);
   void compute_bounds(double dt);
   void run_broad_phase();
   void find_contacts(double dt);

@@ -1,0 +1,71 @@
+// Sleeping: resting islands stop costing anything, and wake when touched or undermined.
+#include <gtest/gtest.h>
+
+#include "scene_runner.h"
+
+namespace tumble::testing {
+namespace {
+
+bool all_asleep(const World& world) {
+  for (const Body* b : dynamic_bodies(world))
+    if (!b->asleep) return false;
+  return true;
+}
+
+TEST(Sleeping, SettledStackSleepsAndCostsNothing) {
+  World world = build(tower_scene(5));
+  double fell_asleep = -1;
+  run(world, 1.0 / 60, 300, [&](long s) {
+    if (fell_asleep < 0 && all_asleep(world)) fell_asleep = s / 60.0;
+  });
+  ASSERT_GT(fell_asleep, 0);
+  EXPECT_LT(fell_asleep, 2.0);  // at rest from the start: the delay (0.5 s) and settling
+  const StepStats& stats = world.last_step();
+  EXPECT_EQ(stats.sleeping_bodies, 5u);
+  EXPECT_EQ(stats.pairs, 0u);  // sleepers pair with nothing but moving bodies
+  EXPECT_EQ(stats.contact_points, 0u);
+  EXPECT_EQ(stats.islands, 0u);
+}
+
+TEST(Sleeping, RemovingTheBottomBoxWakesTheStackAndItFalls) {
+  World world = build(tower_scene(3));
+  run(world, 1.0 / 60, 120);
+  ASSERT_TRUE(all_asleep(world));
+  const BodyId bottom = world.id_at(1);
+  const BodyId top = world.id_at(3);
+  const double top_before = world.body(top)->position.z();
+  ASSERT_TRUE(world.remove_body(bottom).is_ok());
+  EXPECT_FALSE(world.body(top)->asleep);
+  run(world, 1.0 / 60, 90);
+  EXPECT_NEAR(world.body(top)->position.z(), top_before - 1.0, 0.01);
+}
+
+TEST(Sleeping, SleeperHitByANewBoxWakes) {
+  World world = build(tower_scene(1));
+  run(world, 1.0 / 60, 90);
+  ASSERT_TRUE(all_asleep(world));
+  BodyDef dropped;
+  dropped.shape = BoxDef{Vec3::Constant(0.5)};
+  dropped.mass = 1;
+  dropped.position = Vec3(0.3, 0, 3);
+  ASSERT_TRUE(world.create_body(dropped).ok());
+  std::uint32_t woken = 0;
+  run(world, 1.0 / 60, 120, [&](long) { woken += world.last_step().woken_bodies; });
+  EXPECT_EQ(woken, 1u);
+  // The new box came to rest on the old one (which did not let it through).
+  const Body& top = *dynamic_bodies(world)[1];
+  EXPECT_NEAR(top.position.z(), 1.5, 0.01);
+  EXPECT_TRUE(all_finite(world));
+}
+
+TEST(Sleeping, CanBeSwitchedOff) {
+  SceneDef scene = tower_scene(2);
+  scene.world.solver.sleeping = false;
+  World world = build(scene);
+  run(world, 1.0 / 60, 120);
+  EXPECT_EQ(world.last_step().sleeping_bodies, 0u);
+  EXPECT_GT(world.last_step().contact_points, 0u);
+}
+
+}  // namespace
+}  // namespace tumble::testing
