@@ -1,7 +1,7 @@
 // Step time and stability on the standard scenes (../shared/SCENES.md): ours with each solver,
 // beside Bullet and ODE (with -DTUMBLE_BENCH_PEERS=ON) in the same run, so ratios compare like
-// for like on a noisy machine. Usage: bench_dynamics [scene ...] (default: pile, pyramid, tower,
-// mass-ratio, slide).
+// for like on a noisy machine. Usage: bench_dynamics [--nosleep] [scene ...] (default: pile,
+// pyramid, tower, mass-ratio, slide; --nosleep keeps every body awake in Bullet and in ours).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -26,8 +26,11 @@ double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half) 
 
 namespace {
 
+bool g_sleeping = true;  // --nosleep: every engine keeps every body awake
+
 RunResult run_ours(SceneDef scene, SolverKind kind, long steps, int threads = 1) {
   scene.world.solver.kind = kind;
+  scene.world.solver.sleeping = g_sleeping;
   scene.world.threads = threads;
   World world = make_world(scene).value();
   RunResult result;
@@ -148,7 +151,12 @@ int main(int argc, char** argv) {
   using namespace tumble::bench;
   std::vector<std::string> names = {"pile:1000",  "pyramid:20",     "tower:20",
                                     "mass-ratio", "mass-ratio-inv", "slide"};
-  if (argc > 1) names.assign(argv + 1, argv + argc);
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (!args.empty() && args[0] == "--nosleep") {
+    g_sleeping = false;  // ODE and MuJoCo never sleep in these runs
+    args.erase(args.begin());
+  }
+  if (!args.empty()) names = args;
   std::printf(
       "Standard scenes (../shared/SCENES.md), dt 1/60, one thread. ms/step: median over steps;\n"
       "ratio: to Bullet in this run; top dxy/dz: the last body's displacement; largest: any "
@@ -168,7 +176,7 @@ int main(int argc, char** argv) {
                 "top dxy", "top dz", "largest", "corner", "fast", "NaN", "settings");
     std::vector<RunResult> results;
 #ifdef TUMBLE_HAVE_PEERS
-    results.push_back(run_bullet(scene.value(), steps));
+    results.push_back(run_bullet(scene.value(), steps, g_sleeping));
     results.push_back(run_ode(scene.value(), steps));
     // MuJoCo 2.2's preallocated arena cannot hold the pile of 1000's contacts (PEERS.md).
     if (scene.value().bodies.size() <= 500) results.push_back(run_mujoco(scene.value(), steps));
@@ -191,6 +199,6 @@ int main(int argc, char** argv) {
     for (const RunResult& r : results)
       print(r, reference);
   }
-  if (argc == 1) slide_accuracy_table();
+  if (args.empty() && g_sleeping) slide_accuracy_table();
   return 0;
 }

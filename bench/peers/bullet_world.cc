@@ -8,7 +8,7 @@
 
 namespace tumble::bench {
 
-RunResult run_bullet(const SceneDef& scene, long steps) {
+RunResult run_bullet(const SceneDef& scene, long steps, bool sleeping) {
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher(&configuration);
   btDbvtBroadphase broadphase;
@@ -51,6 +51,7 @@ RunResult run_bullet(const SceneDef& scene, long steps) {
         btVector3(def.linear_velocity.x(), def.linear_velocity.y(), def.linear_velocity.z()));
     body->setAngularVelocity(
         btVector3(def.angular_velocity.x(), def.angular_velocity.y(), def.angular_velocity.z()));
+    if (!sleeping) body->setActivationState(DISABLE_DEACTIVATION);
     world.addRigidBody(body);
     if (!is_static) {
       dynamic.push_back(body);
@@ -60,7 +61,8 @@ RunResult run_bullet(const SceneDef& scene, long steps) {
 
   RunResult result;
   result.engine = "Bullet 3.24 float";
-  result.settings = "sequential impulse, 10 iterations, split impulse, sleeping on";
+  result.settings = std::string("sequential impulse, 10 iterations, split impulse, sleeping ") +
+                    (sleeping ? "on" : "off");
   auto read = [&](std::vector<Vec3>* out) {
     out->clear();
     for (btRigidBody* b : dynamic) {

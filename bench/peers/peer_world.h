@@ -23,7 +23,8 @@ struct RunResult {
 // A box's deepest corner below z = 0 (0 when above), from its centre, rotation and half extents.
 double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half);
 
-RunResult run_bullet(const SceneDef& scene, long steps);
+// `sleeping` false keeps every body awake (Bullet: DISABLE_DEACTIVATION; ours: solver.sleeping).
+RunResult run_bullet(const SceneDef& scene, long steps, bool sleeping = true);
 RunResult run_ode(const SceneDef& scene, long steps);
 RunResult run_mujoco(const SceneDef& scene,
                      long steps);  // boxes and a plane; no pile of 1000 (see PEERS.md)
