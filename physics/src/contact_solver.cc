@@ -13,12 +13,11 @@ namespace {
 // contacts keep one basis from step to step.
 constexpr double kSlidingSpeed = 1e-3;
 
-double effective_mass(const Body& a, const Body& b, const Vec3& ra, const Vec3& rb,
-                      const Vec3& direction) {
-  const Vec3 ca = ra.cross(direction);
-  const Vec3 cb = rb.cross(direction);
-  const double k = a.inverse_mass + b.inverse_mass + ca.dot(a.inverse_inertia_world * ca) +
-                   cb.dot(b.inverse_inertia_world * cb);
+// 1 / (J M^-1 J^T) of a row from its precomputed angular parts: r x d and I^-1 (r x d).
+double effective_mass(const Body& a, const Body& b, const Vec3& ra_cross, const Vec3& angular_a,
+                      const Vec3& rb_cross, const Vec3& angular_b) {
+  const double k =
+      a.inverse_mass + b.inverse_mass + ra_cross.dot(angular_a) + rb_cross.dot(angular_b);
   return k > 0 ? 1.0 / k : 0.0;
 }
 
@@ -88,9 +87,12 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     row.angular_b_t1 = b.inverse_inertia_world * row.rb_cross_t1;
     row.angular_a_t2 = a.inverse_inertia_world * row.ra_cross_t2;
     row.angular_b_t2 = b.inverse_inertia_world * row.rb_cross_t2;
-    row.normal_mass = effective_mass(a, b, row.ra, row.rb, n);
-    row.tangent_mass1 = effective_mass(a, b, row.ra, row.rb, row.tangent1);
-    row.tangent_mass2 = effective_mass(a, b, row.ra, row.rb, row.tangent2);
+    row.normal_mass =
+        effective_mass(a, b, row.ra_cross_n, row.angular_a, row.rb_cross_n, row.angular_b);
+    row.tangent_mass1 =
+        effective_mass(a, b, row.ra_cross_t1, row.angular_a_t1, row.rb_cross_t1, row.angular_b_t1);
+    row.tangent_mass2 =
+        effective_mass(a, b, row.ra_cross_t2, row.angular_a_t2, row.rb_cross_t2, row.angular_b_t2);
 
     // Feature ids change when a vertex of a face resting on an equal face moves across the
     // other's edge by a nanometre; the point has not moved, so its impulse still applies
@@ -122,11 +124,10 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     Eigen::Matrix4d k = Eigen::Matrix4d::Zero();
     for (int i = 0; i < count; ++i) {
       const ContactRow& ri = (*rows)[first_row + i];
-      const Vec3 ai = a.inverse_inertia_world * ri.ra.cross(n);
-      const Vec3 bi = b.inverse_inertia_world * ri.rb.cross(n);
       for (int j = 0; j < count; ++j) {
         const ContactRow& rj = (*rows)[first_row + j];
-        k(i, j) = a.inverse_mass + b.inverse_mass + rj.ra.cross(n).dot(ai) + rj.rb.cross(n).dot(bi);
+        k(i, j) = a.inverse_mass + b.inverse_mass + rj.ra_cross_n.dot(ri.angular_a) +
+                  rj.rb_cross_n.dot(ri.angular_b);
       }
     }
     // K is singular for coplanar points (a face has three degrees of freedom, not four). A

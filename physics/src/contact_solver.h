@@ -52,8 +52,8 @@ struct ContactRow {
   std::uint8_t block_index = 0, block_size = 1;  // place among its manifold's rows
 };
 
-// The normal rows of one manifold solved together: K = J A J^T over its points and K's
-// pseudo-inverse. Four points on a face make K singular; the pseudo-inverse spreads the load
+// The normal rows of one manifold solved together: K = J A J^T over its points and the inverse of
+// K slightly regularised. Four points on a face make K singular; that inverse spreads the load
 // evenly instead of by the order in which single points would be visited, which is what keeps
 // a tall stack from tilting (sequential single points push one corner, then the next).
 struct NormalBlock {
@@ -107,12 +107,6 @@ void correct_positions(std::span<const ContactRow> rows, std::span<const std::ui
 // |min(impulse / effective mass, normal velocity - target)| over the normal rows, m/s.
 double normal_residual(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
                        std::span<const SolverBody> bodies, double h);
-
-inline Vec3 relative_velocity(const ContactRow& row, std::span<const SolverBody> bodies) {
-  const SolverBody& a = bodies[row.a];
-  const SolverBody& b = bodies[row.b];
-  return b.v + b.w.cross(row.rb) - a.v - a.w.cross(row.ra);
-}
 
 inline double normal_velocity(const ContactRow& row, std::span<const SolverBody> bodies) {
   const SolverBody& a = bodies[row.a];

@@ -229,9 +229,9 @@ void World::prepare_contacts(double /*dt*/) {
 
 void World::solve_islands(double dt) {
   StepScratch& s = *scratch_;
-  std::vector<const Body*> body_of_slot(bodies_.size());
+  s.body_of_slot.resize(bodies_.size());  // reused: no allocation once warmed up
   for (std::size_t i = 0; i < bodies_.size(); ++i)
-    body_of_slot[i] = &bodies_[i].body;
+    s.body_of_slot[i] = &bodies_[i].body;
   const std::int64_t islands = static_cast<std::int64_t>(s.islands.count());
   // Islands share no body and no row: any order and any thread gives the same bits.
 #pragma omp parallel for schedule(dynamic, 1) \
@@ -243,7 +243,7 @@ void World::solve_islands(double dt) {
                      s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
         std::span(s.island_rows)
             .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]),
-        s, settings_, body_of_slot};
+        s, settings_, s.body_of_slot};
     advance_island(context, dt, &s.reports[i]);
   }
   for (const IslandReport& report : s.reports) {

@@ -30,6 +30,7 @@ struct StepScratch {
   std::vector<std::uint32_t> island_rows;  // row ids, island by island
   std::vector<std::uint32_t> island_row_begin;
   std::vector<IslandReport> reports;
+  std::vector<const Body*> body_of_slot;
   std::vector<CachedImpulse> cache;  // last step's impulses, sorted by body pair
 };
 
