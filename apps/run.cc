@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
   app.add_option("--solver", solver, "exact, pgs, soft or auto (default: the scene's)");
   app.add_option("--duration", duration, "simulated seconds (default: the scene's)");
   app.add_option("--threads", threads, "OpenMP threads (0 = all; default: the scene's)");
+  bool no_sleep = false;
+  app.add_flag("--no-sleep", no_sleep, "keep every body awake");
   CLI11_PARSE(app, argc, argv);
 
   Result<SceneDef> scene = !scene_file.empty() ? load_scene_file(scene_file)
@@ -71,6 +73,7 @@ int main(int argc, char** argv) {
   }
   if (duration >= 0) def.duration = duration;
   if (threads >= 0) def.world.threads = threads;
+  if (no_sleep) def.world.solver.sleeping = false;
   Result<World> made = make_world(def);
   if (!made) {
     std::fprintf(stderr, "tumble-run: %s\n", made.error().c_str());
@@ -83,8 +86,9 @@ int main(int argc, char** argv) {
   std::printf("scene %s: %zu bodies, dt %.6g s, %ld steps, solver %s\n", def.name.c_str(),
               world.body_count(), def.dt, steps,
               std::string(solver_name(def.world.solver.kind)).c_str());
-  std::printf("%7s %9s %8s %8s %10s %12s %12s %10s %9s\n", "t [s]", "contacts", "islands", "exact",
-              "max |v|", "penetration", "energy [J]", "residual", "ms/step");
+  std::printf("%7s %9s %8s %8s %7s %10s %12s %12s %10s %9s\n", "t [s]", "contacts", "islands",
+              "exact", "asleep", "max |v|", "penetration", "energy [J]", "residual", "ms/step");
+  StageTimes stage_sums;
   double window_seconds = 0;
   int window_steps = 0;
   const auto start = std::chrono::steady_clock::now();
@@ -93,7 +97,15 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "tumble-run: %s\n", status.message().c_str());
       return 1;
     }
-    window_seconds += world.last_step().time.total;
+    const StageTimes& times = world.last_step().time;
+    window_seconds += times.total;
+    stage_sums.broad_phase += times.broad_phase;
+    stage_sums.narrow_phase += times.narrow_phase;
+    stage_sums.prepare += times.prepare;
+    stage_sums.solve += times.solve;
+    stage_sums.correct_positions += times.correct_positions;
+    stage_sums.continuous += times.continuous;
+    stage_sums.total += times.total;
     ++window_steps;
     if (s % per_second == 0 || s == steps) {
       const StepStats& st = world.last_step();
@@ -110,5 +122,15 @@ int main(int argc, char** argv) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("%ld steps in %.3f s of wall time (%.3f ms per step)\n", steps, wall,
               1e3 * wall / std::max(1L, steps));
+  const double per_step = 1e3 / std::max(1L, steps);
+  std::printf(
+      "mean ms per step by stage: broad %.3f, narrow %.3f, prepare %.3f, solve %.3f, "
+      "correct %.3f, continuous %.3f, other %.3f\n",
+      per_step * stage_sums.broad_phase, per_step * stage_sums.narrow_phase,
+      per_step * stage_sums.prepare, per_step * stage_sums.solve,
+      per_step * stage_sums.correct_positions, per_step * stage_sums.continuous,
+      per_step * (stage_sums.total - stage_sums.broad_phase - stage_sums.narrow_phase -
+                  stage_sums.prepare - stage_sums.solve - stage_sums.correct_positions -
+                  stage_sums.continuous));
   return 0;
 }

@@ -27,6 +27,18 @@ bool is_dead(const Aabb& box) {
   return !(box.min.x() <= box.max.x());
 }
 
+// The sorted runs[0 .. count) merged into one sorted `out`; `buffer` is scratch.
+template <class T>
+void merge_sorted(const std::vector<std::vector<T>>& runs, int count, std::vector<T>* out,
+                  std::vector<T>* buffer) {
+  out->clear();
+  for (int t = 0; t < count; ++t) {
+    buffer->swap(*out);
+    out->resize(buffer->size() + runs[t].size());
+    std::merge(buffer->begin(), buffer->end(), runs[t].begin(), runs[t].end(), out->begin());
+  }
+}
+
 }  // namespace
 
 void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
@@ -85,12 +97,10 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
                ++z)
             out.push_back({cell_key(level, x, y, z), static_cast<std::uint32_t>(i)});
     }
+    std::sort(out.begin(), out.end());
   }
-  // (2) One sorted array.
-  entries_.clear();
-  for (const auto& buffer : thread_entries_)
-    entries_.insert(entries_.end(), buffer.begin(), buffer.end());
-  std::sort(entries_.begin(), entries_.end());
+  // (2) One sorted array: the threads' sorted runs merged in thread order.
+  merge_sorted(thread_entries_, threads, &entries_, &merge_buffer_);
 
   const auto emit = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
     if (a == b || !(input.movable[a] || input.movable[b])) return;
@@ -138,17 +148,17 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
       }
     }
     // Unbounded bodies meet everyone.
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
       if (is_dead(bounds[i])) continue;
       for (std::uint32_t u : unbounded_)
         if (!bounds[i].is_bounded() ? u < i : true) emit(static_cast<std::uint32_t>(i), u, out);
     }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
   }
-  // (4) Reduction.
-  for (const auto& buffer : thread_pairs_)
-    pairs->insert(pairs->end(), buffer.begin(), buffer.end());
-  std::sort(pairs->begin(), pairs->end());
+  // (4) Reduction: merge the threads' sorted lists, then drop pairs found by several threads.
+  merge_sorted(thread_pairs_, threads, pairs, &pair_buffer_);
   pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
 }
 

@@ -7,11 +7,12 @@
 // ground half-space) stay out of the grid and are paired with every body directly.
 //
 // Steps: (1) level and cells of every body, in parallel, into per-thread buffers of
-// (cell key, body) entries; (2) one sorted array of entries; (3) pairs within each cell, and each
-// body against the cells of coarser levels it covers (binary search), in parallel into per-thread
-// pair buffers, keeping only pairs whose boxes really overlap and that have a dynamic body;
-// (4) the reduction: concatenate, sort, drop duplicates (a pair shared by several cells). The
-// result is the same for any thread count because it is sorted and unique.
+// (cell key, body) entries, each sorted by its thread; (2) one sorted array of entries, merged;
+// (3) pairs within each cell, and each body against the cells of coarser levels it covers
+// (binary search), in parallel into per-thread pair buffers, keeping only pairs whose boxes
+// really overlap and that have a dynamic body, each buffer sorted and unique; (4) the reduction:
+// merge, drop duplicates (a pair shared by several cells and threads). The result is the same
+// for any thread count because it is sorted and unique.
 #pragma once
 
 #include <span>
@@ -39,7 +40,8 @@ class HashGrid {
   };
   std::vector<std::vector<Entry>> thread_entries_;
   std::vector<std::vector<BodyPair>> thread_pairs_;
-  std::vector<Entry> entries_;
+  std::vector<Entry> entries_, merge_buffer_;
+  std::vector<BodyPair> pair_buffer_;
   std::vector<std::int8_t> level_;
   std::vector<double> sizes_;
   std::vector<std::uint32_t> unbounded_;

@@ -34,10 +34,8 @@ bool less_pair(const CachedImpulse& c, BodyId a, BodyId b) {
 }  // namespace
 
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
-                  const Body& b, std::span<const CachedImpulse> cache,
-                  std::vector<ContactRow>* rows, std::vector<NormalBlock>* blocks) {
-  const std::size_t first_row = rows->size();
-  const std::uint32_t block = static_cast<std::uint32_t>(blocks->size());
+                  const Body& b, std::span<const CachedImpulse> cache, std::uint32_t block_index,
+                  ContactRow* rows, NormalBlock* block) {
   const Vec3& n = manifold.normal;
   const double friction = std::sqrt(a.friction * b.friction);
   const double restitution = std::max(a.restitution, b.restitution);
@@ -62,7 +60,7 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     row.friction = friction;
     row.restitution = restitution;
     row.feature = point.feature_id;
-    row.manifold = block;
+    row.manifold = block_index;
     row.block_index = static_cast<std::uint8_t>(i);
     row.block_size = static_cast<std::uint8_t>(manifold.count);
 
@@ -115,7 +113,7 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
       row.tangent_impulse1 = match->friction.dot(row.tangent1);
       row.tangent_impulse2 = match->friction.dot(row.tangent2);
     }
-    rows->push_back(row);
+    rows[i] = row;
   }
 
   NormalBlock normal_block;
@@ -123,9 +121,9 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   if (count > 1) {
     Eigen::Matrix4d k = Eigen::Matrix4d::Zero();
     for (int i = 0; i < count; ++i) {
-      const ContactRow& ri = (*rows)[first_row + i];
+      const ContactRow& ri = rows[i];
       for (int j = 0; j < count; ++j) {
-        const ContactRow& rj = (*rows)[first_row + j];
+        const ContactRow& rj = rows[j];
         k(i, j) = a.inverse_mass + b.inverse_mass + rj.ra_cross_n.dot(ri.angular_a) +
                   rj.rb_cross_n.dot(ri.angular_b);
       }
@@ -144,7 +142,7 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
       normal_block.inverse.rightCols(4 - count).setZero();
     }
   }
-  blocks->push_back(normal_block);
+  *block = normal_block;
 }
 
 Softness contact_softness(double hertz, double damping_ratio, double h) {
@@ -205,10 +203,14 @@ double solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
   row.tangent_impulse2 = new2;
   const double d1 = new1 - old1, d2 = new2 - old2;
   const Vec3 linear = d1 * row.tangent1 + d2 * row.tangent2;
-  a.v -= a.inverse_mass * linear;
-  a.w -= d1 * row.angular_a_t1 + d2 * row.angular_a_t2;
-  b.v += b.inverse_mass * linear;
-  b.w += d1 * row.angular_b_t1 + d2 * row.angular_b_t2;
+  if (a.inverse_mass > 0) {
+    a.v -= a.inverse_mass * linear;
+    a.w -= d1 * row.angular_a_t1 + d2 * row.angular_a_t2;
+  }
+  if (b.inverse_mass > 0) {
+    b.v += b.inverse_mass * linear;
+    b.w += d1 * row.angular_b_t1 + d2 * row.angular_b_t2;
+  }
   // The velocity change this gave the contact, m/s.
   return std::max(std::abs(d1) / row.tangent_mass1, std::abs(d2) / row.tangent_mass2);
 }
@@ -366,12 +368,14 @@ void correct_positions(std::span<const ContactRow> rows, std::span<const std::ui
                      cb.dot(b.inverse_inertia * cb);
     if (k <= 0) continue;
     const Vec3 push = (-error / k) * row.normal;
-    pa.position -= a.inverse_mass * push;
-    pb.position += b.inverse_mass * push;
-    if (a.inverse_mass > 0)
+    if (a.inverse_mass > 0) {
+      pa.position -= a.inverse_mass * push;
       pa.orientation = rotated(pa.orientation, -(a.inverse_inertia * ra.cross(push)));
-    if (b.inverse_mass > 0)
+    }
+    if (b.inverse_mass > 0) {
+      pb.position += b.inverse_mass * push;
       pb.orientation = rotated(pb.orientation, b.inverse_inertia * rb.cross(push));
+    }
   }
 }
 

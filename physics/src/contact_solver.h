@@ -69,11 +69,12 @@ struct CachedImpulse {
   Vec3 friction = Vec3::Zero();  // world
 };
 
-// Builds the rows of one manifold. `cache` is sorted by (a, b); a row starts from the impulse of
-// the cached point with its feature id, or else of the nearest cached point close enough.
+// Writes the manifold.count rows of one manifold to `rows` and its block to `block`, which is
+// blocks[block_index]. `cache` is sorted by (a, b); a row starts from the impulse of the cached
+// point with its feature id, or else of the nearest cached point close enough.
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
-                  const Body& b, std::span<const CachedImpulse> cache,
-                  std::vector<ContactRow>* rows, std::vector<NormalBlock>* blocks);
+                  const Body& b, std::span<const CachedImpulse> cache, std::uint32_t block_index,
+                  ContactRow* rows, NormalBlock* block);
 
 // Spring parameters of a soft contact over a substep h (Catto 2011, "Soft constraints").
 struct Softness {
@@ -114,24 +115,34 @@ inline double normal_velocity(const ContactRow& row, std::span<const SolverBody>
   return row.normal.dot(b.v - a.v) + b.w.dot(row.rb_cross_n) - a.w.dot(row.ra_cross_n);
 }
 
+// Static bodies (inverse mass 0) are never written: islands and colours solved in parallel
+// share them.
 inline void apply_impulse(const ContactRow& row, const Vec3& impulse,
                           std::span<SolverBody> bodies) {
   SolverBody& a = bodies[row.a];
   SolverBody& b = bodies[row.b];
-  a.v -= a.inverse_mass * impulse;
-  a.w -= a.inverse_inertia * row.ra.cross(impulse);
-  b.v += b.inverse_mass * impulse;
-  b.w += b.inverse_inertia * row.rb.cross(impulse);
+  if (a.inverse_mass > 0) {
+    a.v -= a.inverse_mass * impulse;
+    a.w -= a.inverse_inertia * row.ra.cross(impulse);
+  }
+  if (b.inverse_mass > 0) {
+    b.v += b.inverse_mass * impulse;
+    b.w += b.inverse_inertia * row.rb.cross(impulse);
+  }
 }
 
 inline void apply_normal_impulse(const ContactRow& row, double impulse,
                                  std::span<SolverBody> bodies) {
   SolverBody& a = bodies[row.a];
   SolverBody& b = bodies[row.b];
-  a.v -= (a.inverse_mass * impulse) * row.normal;
-  a.w -= impulse * row.angular_a;
-  b.v += (b.inverse_mass * impulse) * row.normal;
-  b.w += impulse * row.angular_b;
+  if (a.inverse_mass > 0) {
+    a.v -= (a.inverse_mass * impulse) * row.normal;
+    a.w -= impulse * row.angular_a;
+  }
+  if (b.inverse_mass > 0) {
+    b.v += (b.inverse_mass * impulse) * row.normal;
+    b.w += impulse * row.angular_b;
+  }
 }
 
 // The separation of a row now, from the bodies' motion since the step start (to first order in

@@ -106,6 +106,139 @@ void advance_island(const IslandContext& c, double dt, IslandReport* report) {
   apply_restitution(rows, c.rows, c.scratch.blocks, bodies, solver);
 }
 
+IslandContext island_context(StepScratch& s, const WorldSettings& settings, std::size_t i) {
+  return {
+      std::span(s.islands.bodies)
+          .subspan(s.islands.body_begin[i], s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
+      std::span(s.island_rows)
+          .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]),
+      s, settings, s.body_of_slot};
+}
+
+// --- Islands solved by the whole team, colour by colour. Every function below is called by
+// every thread of the team (or by one thread outside any team) and contains the worksharing.
+
+std::span<const std::uint32_t> manifold_rows(const StepScratch& s, std::uint32_t manifold) {
+  return std::span(s.row_ids).subspan(s.row_begin[manifold],
+                                      s.row_begin[manifold + 1] - s.row_begin[manifold]);
+}
+
+// The largest of the threads' values, returned to every thread.
+double team_max(double local, std::vector<double>& values) {
+  const int threads = omp_get_num_threads();
+  if (threads == 1) return local;
+  values[omp_get_thread_num()] = local;
+#pragma omp barrier
+  double largest = 0;
+  for (int t = 0; t < threads; ++t)
+    largest = std::max(largest, values[t]);
+#pragma omp barrier
+  return largest;
+}
+
+// Calls fn(row ids of a manifold) for colours [first, last), forwards or backwards. Manifolds
+// of one colour share no moving body, so the team splits them; the overflow colour runs on one
+// thread. Returns the largest value fn returned, on every thread.
+template <class Fn>
+double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
+                     Fn&& fn) {
+  const Colouring& colouring = s.colouring;
+  double local = 0;
+  for (std::uint32_t k = first; k < last; ++k) {
+    const std::uint32_t c = backward ? first + last - 1 - k : k;
+    const std::int64_t begin = colouring.colour_begin[c], end = colouring.colour_begin[c + 1];
+    if (colouring.serial[c]) {
+#pragma omp single
+      for (std::int64_t i = begin; i < end; ++i) {
+        const std::int64_t at = backward ? begin + end - 1 - i : i;
+        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[at])));
+      }
+    } else {
+#pragma omp for schedule(static)
+      for (std::int64_t i = begin; i < end; ++i)
+        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[i])));
+    }
+  }
+  return team_max(local, s.team_values);
+}
+
+std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
+  std::uint32_t hits = 0;
+  const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
+#pragma omp for schedule(static)
+  for (std::int64_t k = 0; k < n; ++k) {
+    const std::uint32_t slot = c.bodies[k];
+    if (!integrate_velocity(*c.body_of_slot[slot], c.scratch.poses[slot].orientation,
+                            c.settings.gravity, h, &c.scratch.bodies[slot]))
+      ++hits;
+  }
+  return hits;
+}
+
+void team_integrate_positions(const IslandContext& c, double h) {
+  const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
+#pragma omp for schedule(static)
+  for (std::int64_t k = 0; k < n; ++k) {
+    const std::uint32_t slot = c.bodies[k];
+    integrate_position(h, &c.scratch.bodies[slot], &c.scratch.poses[slot]);
+  }
+}
+
+// advance_island for a coloured island (soft or pgs), the same scheme split over the team.
+void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint32_t last, double dt,
+                         IslandReport* report) {
+  StepScratch& s = c.scratch;
+  const SolverSettings& solver = c.settings.solver;
+  const bool lead = omp_get_thread_num() == 0;
+  std::uint64_t iterations = 0;
+  std::uint32_t hits = 0;
+  auto warm = [&](std::span<const std::uint32_t> ids) {
+    warm_start(s.rows, ids, s.bodies);
+    return 0.0;
+  };
+  auto sweep = [&](const Softness* soft, double h, bool backward) {
+    ++iterations;
+    return sweep_colours(s, first, last, backward, [&](std::span<const std::uint32_t> ids) {
+      return solve_contacts(s.rows, ids, s.blocks, s.bodies, solver, soft, h, false);
+    });
+  };
+  double h = dt;
+  if (report->solver == IslandSolver::kSoft) {
+    h = dt / solver.substeps;
+    const Softness soft =
+        contact_softness(std::min(solver.contact_hertz, 0.25 / h), solver.contact_damping_ratio, h);
+    for (int sub = 0; sub < solver.substeps; ++sub) {
+      hits += team_integrate_velocities(c, h);
+      sweep_colours(s, first, last, false, warm);
+      for (int i = 0; i < solver.soft_iterations; ++i)
+        if (sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
+      team_integrate_positions(c, h);
+      for (int i = 0; i < solver.relax_iterations; ++i)
+        if (sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
+    }
+  } else {
+    hits += team_integrate_velocities(c, dt);
+    sweep_colours(s, first, last, false, warm);
+    for (int i = 0; i < solver.iterations; ++i)
+      if (sweep(nullptr, dt, i % 2 == 1) <= solver.velocity_tolerance) break;
+  }
+  const double residual =
+      sweep_colours(s, first, last, false, [&](std::span<const std::uint32_t> ids) {
+        return normal_residual(s.rows, ids, s.bodies, h);
+      });
+  if (report->solver != IslandSolver::kSoft) team_integrate_positions(c, dt);
+  sweep_colours(s, first, last, false, [&](std::span<const std::uint32_t> ids) {
+    apply_restitution(s.rows, ids, s.blocks, s.bodies, solver);
+    return 0.0;
+  });
+#pragma omp atomic
+  report->gyroscopic_limit_hits += hits;
+  if (lead) {
+    report->velocity_iterations = iterations;
+    report->residual = residual;
+  }
+}
+
 }  // namespace
 
 Status World::step(double dt) {
@@ -159,7 +292,10 @@ void World::prepare_contacts(double /*dt*/) {
   s.bodies.resize(slots);
   s.poses.resize(slots);
   s.dynamic.resize(slots);
-  for (std::size_t i = 0; i < slots; ++i) {
+  const int threads = team_size(settings_.threads);
+  const std::int64_t slot_count = static_cast<std::int64_t>(slots);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && slots > 256)
+  for (std::int64_t i = 0; i < slot_count; ++i) {
     const Slot& slot = bodies_[i];
     SolverBody& sb = s.bodies[i];
     sb = SolverBody{};
@@ -173,17 +309,33 @@ void World::prepare_contacts(double /*dt*/) {
     sb.inverse_inertia = slot.body.inverse_inertia_world;
   }
 
-  s.rows.clear();
-  s.blocks.clear();
-  s.row_begin.assign(1, 0);
-  s.links.clear();
+  // Every manifold's rows have a place known in advance, so they are built in parallel.
+  const std::size_t manifolds = contacts_.size();
+  s.row_begin.resize(manifolds + 1);
+  s.row_begin[0] = 0;
+  s.links.resize(manifolds);
   double deepest = 0;
-  for (const Contact& contact : contacts_) {
-    prepare_rows(contact.manifold, contact.a, bodies_[contact.a.index].body, contact.b,
-                 bodies_[contact.b.index].body, s.cache, &s.rows, &s.blocks);
-    s.row_begin.push_back(static_cast<std::uint32_t>(s.rows.size()));
-    s.links.push_back({contact.a.index, contact.b.index});
+  for (std::size_t m = 0; m < manifolds; ++m) {
+    const Contact& contact = contacts_[m];
+    s.row_begin[m + 1] = s.row_begin[m] + static_cast<std::uint32_t>(contact.manifold.count);
+    s.links[m] = {contact.a.index, contact.b.index};
     deepest = std::max(deepest, contact.manifold.depth);
+  }
+  s.rows.resize(s.row_begin[manifolds]);
+  s.blocks.resize(manifolds);
+  if (s.row_ids.size() < s.rows.size()) {
+    const std::size_t from = s.row_ids.size();
+    s.row_ids.resize(s.rows.size());
+    for (std::size_t r = from; r < s.row_ids.size(); ++r)
+      s.row_ids[r] = static_cast<std::uint32_t>(r);
+  }
+  const std::int64_t count = static_cast<std::int64_t>(manifolds);
+#pragma omp parallel for schedule(static) num_threads(threads) if (count > 64 && threads > 1)
+  for (std::int64_t m = 0; m < count; ++m) {
+    const Contact& contact = contacts_[m];
+    prepare_rows(contact.manifold, contact.a, bodies_[contact.a.index].body, contact.b,
+                 bodies_[contact.b.index].body, s.cache, static_cast<std::uint32_t>(m),
+                 &s.rows[s.row_begin[m]], &s.blocks[m]);
   }
   build_islands(s.dynamic, s.links, &s.islands);
 
@@ -219,10 +371,32 @@ void World::prepare_contacts(double /*dt*/) {
     s.reports[i].solver = kind;
   }
 
+  // Large iterative islands are coloured for the team; the others go one island per thread.
+  s.colouring.clear();
+  s.island_colour_begin.assign(1, 0);
+  s.team_islands.clear();
+  s.single_islands.clear();
+  for (std::size_t i = 0; i < islands; ++i) {
+    const std::uint32_t links = s.islands.link_begin[i + 1] - s.islands.link_begin[i];
+    if (links >= kColouredIsland && s.reports[i].solver != IslandSolver::kExact) {
+      colour_manifolds(std::span(s.islands.links).subspan(s.islands.link_begin[i], links), s.links,
+                       s.dynamic, &s.colouring_scratch, &s.colouring);
+      s.team_islands.push_back(static_cast<std::uint32_t>(i));
+    } else {
+      s.single_islands.push_back(static_cast<std::uint32_t>(i));
+    }
+    s.island_colour_begin.push_back(static_cast<std::uint32_t>(s.colouring.colour_count()));
+  }
+
   stats_.pairs = static_cast<std::uint32_t>(pairs_.size());
   stats_.manifolds = static_cast<std::uint32_t>(contacts_.size());
   stats_.contact_points = static_cast<std::uint32_t>(s.rows.size());
   stats_.islands = static_cast<std::uint32_t>(islands);
+  stats_.coloured_islands = static_cast<std::uint32_t>(s.team_islands.size());
+  stats_.colours = static_cast<std::uint32_t>(s.colouring.colour_count());
+  for (std::size_t c = 0; c < s.colouring.colour_count(); ++c)
+    if (s.colouring.serial[c])
+      stats_.overflow_manifolds += s.colouring.colour_begin[c + 1] - s.colouring.colour_begin[c];
   stats_.max_penetration = deepest;
   stats_.collision_flags = collision_flags_;
 }
@@ -232,19 +406,23 @@ void World::solve_islands(double dt) {
   s.body_of_slot.resize(bodies_.size());  // reused: no allocation once warmed up
   for (std::size_t i = 0; i < bodies_.size(); ++i)
     s.body_of_slot[i] = &bodies_[i].body;
-  const std::int64_t islands = static_cast<std::int64_t>(s.islands.count());
-  // Islands share no body and no row: any order and any thread gives the same bits.
-#pragma omp parallel for schedule(dynamic, 1) \
-    num_threads(team_size(settings_.threads)) if (islands > 1 && team_size(settings_.threads) > 1)
-  for (std::int64_t i = 0; i < islands; ++i) {
-    const IslandContext context{
-        std::span(s.islands.bodies)
-            .subspan(s.islands.body_begin[i],
-                     s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
-        std::span(s.island_rows)
-            .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]),
-        s, settings_, s.body_of_slot};
-    advance_island(context, dt, &s.reports[i]);
+  const int threads = team_size(settings_.threads);
+  if (s.team_values.size() < static_cast<std::size_t>(threads)) s.team_values.resize(threads);
+  const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
+  const bool parallel = threads > 1 && (singles > 1 || !s.team_islands.empty());
+  // Large islands one after the other with the whole team, then the rest one island per thread:
+  // islands share no body and no row, and colours share no moving body, so any thread count gives
+  // the same bits.
+#pragma omp parallel num_threads(threads) if (parallel)
+  {
+    for (std::uint32_t i : s.team_islands)
+      team_advance_island(island_context(s, settings_, i), s.island_colour_begin[i],
+                          s.island_colour_begin[i + 1], dt, &s.reports[i]);
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t k = 0; k < singles; ++k) {
+      const std::uint32_t i = s.single_islands[k];
+      advance_island(island_context(s, settings_, i), dt, &s.reports[i]);
+    }
   }
   for (const IslandReport& report : s.reports) {
     if (report.solver == IslandSolver::kExact)
@@ -261,21 +439,38 @@ void World::solve_islands(double dt) {
 
 void World::correct_positions() {
   StepScratch& s = *scratch_;
-  const int iterations = settings_.solver.position_iterations;
-  const std::int64_t islands = static_cast<std::int64_t>(s.islands.count());
-#pragma omp parallel for schedule(dynamic, 1) \
-    num_threads(team_size(settings_.threads)) if (islands > 1 && team_size(settings_.threads) > 1)
-  for (std::int64_t i = 0; i < islands; ++i) {
-    // Soft islands corrected their penetration inside the substeps, exact ones in the LCP.
+  const SolverSettings& solver = settings_.solver;
+  // Soft islands corrected their penetration inside the substeps, exact ones in the LCP.
+  auto needs_correction = [&](std::uint32_t i) {
     const IslandReport& report = s.reports[i];
-    if (report.solver == IslandSolver::kSoft ||
-        (report.solver == IslandSolver::kExact && !report.exact_failed))
-      continue;
-    const auto rows =
-        std::span(s.island_rows)
-            .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]);
-    for (int k = 0; k < iterations; ++k)
-      tumble::correct_positions(s.rows, rows, s.bodies, s.poses, settings_.solver);
+    return report.solver == IslandSolver::kPgs ||
+           (report.solver == IslandSolver::kExact && report.exact_failed);
+  };
+  bool any = false;
+  for (const IslandReport& report : s.reports)
+    any |= report.solver == IslandSolver::kPgs || report.exact_failed;
+  if (!any || solver.position_iterations == 0) return;
+  const int threads = team_size(settings_.threads);
+  const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    for (std::uint32_t i : s.team_islands) {
+      if (!needs_correction(i)) continue;
+      for (int k = 0; k < solver.position_iterations; ++k)
+        sweep_colours(s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
+                      [&](std::span<const std::uint32_t> ids) {
+                        tumble::correct_positions(s.rows, ids, s.bodies, s.poses, solver);
+                        return 0.0;
+                      });
+    }
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t k = 0; k < singles; ++k) {
+      const std::uint32_t i = s.single_islands[k];
+      if (!needs_correction(i)) continue;
+      const auto rows = island_context(s, settings_, i).rows;
+      for (int n = 0; n < solver.position_iterations; ++n)
+        tumble::correct_positions(s.rows, rows, s.bodies, s.poses, solver);
+    }
   }
 }
 
@@ -318,25 +513,36 @@ void World::update_sleep(double dt) {
 
 void World::finish_step(double dt) {
   StepScratch& s = *scratch_;
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    if (!s.dynamic[i]) continue;
-    Body& body = bodies_[i].body;
-    body.position = s.poses[i].position;
-    body.orientation = s.poses[i].orientation;
-    body.linear_velocity = s.bodies[i].v;
-    body.angular_velocity = s.bodies[i].w;
-    body.update_world_inertia();
-  }
+  const int threads = team_size(settings_.threads);
+  const std::int64_t slots = static_cast<std::int64_t>(bodies_.size());
+  const std::int64_t manifolds = static_cast<std::int64_t>(contacts_.size());
   // Impulses for the next step's warm start, sorted by body pair as the contacts are.
-  s.cache.clear();
-  impulses_.clear();
-  for (std::size_t m = 0; m < contacts_.size(); ++m) {
-    for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r) {
-      const ContactRow& row = s.rows[r];
-      s.cache.push_back(
-          {contacts_[m].a, contacts_[m].b, row.feature, row.local_a, row.normal_impulse,
-           row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2});
-      impulses_.push_back(row.normal_impulse);
+  s.cache.resize(s.rows.size());
+  impulses_.resize(s.rows.size());
+#pragma omp parallel num_threads(threads) if (threads > 1 && slots > 256)
+  {
+#pragma omp for schedule(static) nowait
+    for (std::int64_t i = 0; i < slots; ++i) {
+      if (!s.dynamic[i]) continue;
+      Body& body = bodies_[i].body;
+      body.position = s.poses[i].position;
+      body.orientation = s.poses[i].orientation;
+      body.linear_velocity = s.bodies[i].v;
+      body.angular_velocity = s.bodies[i].w;
+      body.update_world_inertia();
+    }
+#pragma omp for schedule(static)
+    for (std::int64_t m = 0; m < manifolds; ++m) {
+      for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r) {
+        const ContactRow& row = s.rows[r];
+        s.cache[r] = {contacts_[m].a,
+                      contacts_[m].b,
+                      row.feature,
+                      row.local_a,
+                      row.normal_impulse,
+                      row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2};
+        impulses_[r] = row.normal_impulse;
+      }
     }
   }
   time_ += dt;

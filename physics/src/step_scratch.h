@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "colouring.h"
 #include "contact_solver.h"
 #include "islands.h"
 
@@ -18,6 +19,10 @@ struct IslandReport {
   double residual = 0;
 };
 
+// An island this large is worth splitting over threads (and is split with one thread too, so the
+// answer does not depend on the thread count).
+constexpr std::uint32_t kColouredIsland = 64;
+
 struct StepScratch {
   std::vector<SolverBody> bodies;  // by slot
   std::vector<Pose> poses;         // by slot
@@ -30,6 +35,14 @@ struct StepScratch {
   std::vector<std::uint32_t> island_rows;  // row ids, island by island
   std::vector<std::uint32_t> island_row_begin;
   std::vector<IslandReport> reports;
+  std::vector<std::uint32_t> row_ids;  // 0, 1, 2, ...: a manifold's rows as an id span
+  // Islands with at least kColouredIsland manifolds are solved by the whole team, colour by
+  // colour: island i has colours [island_colour_begin[i], island_colour_begin[i+1]).
+  Colouring colouring;
+  ColouringScratch colouring_scratch;
+  std::vector<std::uint32_t> island_colour_begin;
+  std::vector<std::uint32_t> team_islands, single_islands;
+  std::vector<double> team_values;  // one per thread, for reductions inside a team
   std::vector<const Body*> body_of_slot;
   std::vector<CachedImpulse> cache;  // last step's impulses, sorted by body pair
 };

@@ -239,8 +239,8 @@ void World::find_contacts(double dt) {
   // result for any thread count.
   contacts_.resize(pairs_.size());
   std::uint32_t flags = 0;
-#pragma omp parallel for schedule(static) num_threads(thread_count(settings_.threads)) \
-    reduction(|                                                                        \
+#pragma omp parallel for schedule(dynamic, 32) num_threads(thread_count(settings_.threads)) \
+    reduction(|                                                                             \
               : flags) if (n > 64)
   for (std::int64_t i = 0; i < n; ++i) {
     const Body& a = bodies_[pairs_[i].a].body;

@@ -56,13 +56,16 @@ struct SolverSettings {
 // Wall time of the step's stages, seconds.
 struct StageTimes {
   double broad_phase = 0, narrow_phase = 0, prepare = 0, solve = 0, correct_positions = 0,
-         total = 0;
+         continuous = 0, total = 0;
 };
 
 struct StepStats {
   std::uint64_t step = 0;  // steps taken so far, this one included
   std::uint32_t pairs = 0, manifolds = 0, contact_points = 0;
   std::uint32_t islands = 0, exact_islands = 0, iterative_islands = 0;
+  // Large islands split over the team by graph colouring: how many, their colours in all, and
+  // the manifolds left to the serial overflow colour.
+  std::uint32_t coloured_islands = 0, colours = 0, overflow_manifolds = 0;
   // Islands the exact solver could not finish (pivot bound, ray termination): solved by pgs.
   std::uint32_t exact_fallbacks = 0;
   std::uint64_t lemke_pivots = 0;
