@@ -165,8 +165,10 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
 void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
   const auto& bounds = input.bounds;
-  std::vector<std::uint32_t> order;
-  std::vector<std::uint32_t> unbounded;
+  // Kept per thread and reused, so that stepping small worlds allocates nothing.
+  thread_local std::vector<std::uint32_t> order, unbounded;
+  order.clear();
+  unbounded.clear();
   for (std::uint32_t i = 0; i < bounds.size(); ++i) {
     if (is_dead(bounds[i])) continue;
     (bounds[i].is_bounded() ? order : unbounded).push_back(i);

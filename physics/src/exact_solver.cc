@@ -48,6 +48,19 @@ double velocity_along(const Jacobian& jac, std::span<const SolverBody> bodies) {
   return v;
 }
 
+// The LCP's memory, one per thread (islands are solved on any thread), reused from island to
+// island and step to step.
+struct ExactWorkspace {
+  std::vector<Jacobian> jacobians;
+  std::vector<double> m, q, z, w;
+  LemkeWorkspace lemke;
+};
+
+ExactWorkspace& thread_workspace() {
+  thread_local ExactWorkspace workspace;
+  return workspace;
+}
+
 }  // namespace
 
 ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
@@ -64,8 +77,9 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
   const int n = velocity_rows + (k > 0 ? points : 0);
 
   // Velocity rows: the normals first, then each point's k directions.
-  std::vector<Jacobian> jac;
-  jac.reserve(velocity_rows);
+  ExactWorkspace& workspace = thread_workspace();
+  std::vector<Jacobian>& jac = workspace.jacobians;
+  jac.clear();
   for (std::uint32_t id : ids)
     jac.push_back(make_jacobian(rows[id], rows[id].normal, bodies));
   for (std::uint32_t id : ids) {
@@ -77,8 +91,16 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
     }
   }
 
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  workspace.m.resize(static_cast<std::size_t>(n) * n);
+  workspace.q.resize(n);
+  workspace.z.resize(n);
+  workspace.w.resize(n);
+  Eigen::Map<Eigen::MatrixXd> m(workspace.m.data(), n, n);
+  Eigen::Map<Eigen::VectorXd> q(workspace.q.data(), n);
+  Eigen::Map<Eigen::VectorXd> z(workspace.z.data(), n);
+  Eigen::Map<Eigen::VectorXd> w(workspace.w.data(), n);
+  m.setZero();
+  q.setZero();
   for (int r = 0; r < velocity_rows; ++r) {
     for (int c = r; c < velocity_rows; ++c) {
       const double value = coupling(jac[r], jac[c], bodies);
@@ -126,21 +148,21 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
     q[i] += perturbation * (i + 1) / n;
 
   ExactSolveResult result;
-  Eigen::VectorXd z;
   const int max_pivots = std::max(100, settings.lemke_pivots_per_unknown * n);
-  result.lemke = solve_lcp_lemke(m, q, max_pivots, &z);
+  result.lemke = solve_lcp_lemke(m, q, max_pivots, z, &workspace.lemke);
   if (!result.solved()) {
     // Rarely the pivots still meet round-off: once more with a hundred times the compliance
     // (1e-4, still far below what a step shows) before giving the island to PGS.
     for (int r = 0; r < velocity_rows; ++r)
       m(r, r) *= 1 + 1e-4;
     const int spent = result.lemke.pivots;
-    result.lemke = solve_lcp_lemke(m, q, max_pivots, &z);
+    result.lemke = solve_lcp_lemke(m, q, max_pivots, z, &workspace.lemke);
     result.lemke.pivots += spent;
   }
   if (result.solved()) {
     // Trust but verify: a path that ended on round-off can report success with a wrong basis.
-    const Eigen::VectorXd w = m * z + q;
+    w.noalias() = m * z;
+    w += q;
     const double scale = 1e-4 * std::max({1.0, q.cwiseAbs().maxCoeff(),
                                           m.cwiseAbs().maxCoeff() * z.cwiseAbs().maxCoeff()});
     double worst = 0;

@@ -18,7 +18,8 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
 void build_islands(std::span<const std::uint8_t> dynamic, std::span<const IslandLink> links,
                    Islands* out) {
   const std::uint32_t slots = static_cast<std::uint32_t>(dynamic.size());
-  std::vector<std::uint32_t> parent(slots);
+  std::vector<std::uint32_t>& parent = out->parent;
+  parent.resize(slots);
   std::iota(parent.begin(), parent.end(), 0u);
   for (const IslandLink& link : links) {
     if (!dynamic[link.a] || !dynamic[link.b]) continue;
@@ -31,8 +32,10 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
   }
 
   constexpr std::uint32_t kNone = UINT32_MAX;
-  std::vector<std::uint32_t> island_of(slots, kNone);
-  std::vector<std::uint32_t> body_counts;
+  std::vector<std::uint32_t>& island_of = out->island_of;
+  island_of.assign(slots, kNone);
+  std::vector<std::uint32_t>& body_counts = out->body_counts;
+  body_counts.clear();
   for (std::uint32_t s = 0; s < slots; ++s) {
     if (!dynamic[s]) continue;
     const std::uint32_t root = find_root(parent, s);
@@ -50,11 +53,13 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
   for (std::size_t i = 0; i < count; ++i)
     out->body_begin[i + 1] = out->body_begin[i] + body_counts[i];
   out->bodies.resize(out->body_begin[count]);
-  std::vector<std::uint32_t> cursor(out->body_begin.begin(), out->body_begin.end() - 1);
+  std::vector<std::uint32_t>& cursor = out->cursor;
+  cursor.assign(out->body_begin.begin(), out->body_begin.end() - 1);
   for (std::uint32_t s = 0; s < slots; ++s)
     if (dynamic[s]) out->bodies[cursor[island_of[s]]++] = s;
 
-  std::vector<std::uint32_t> link_counts(count, 0);
+  std::vector<std::uint32_t>& link_counts = out->link_counts;
+  link_counts.assign(count, 0);
   auto island_of_link = [&](const IslandLink& link) {
     return island_of[dynamic[link.a] ? link.a : link.b];
   };

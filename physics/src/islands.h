@@ -18,6 +18,9 @@ struct Islands {
   std::vector<std::uint32_t> bodies, body_begin;
   std::vector<std::uint32_t> links, link_begin;
   std::size_t count() const { return body_begin.empty() ? 0 : body_begin.size() - 1; }
+
+  // Working memory of build_islands, kept to be reused.
+  std::vector<std::uint32_t> parent, island_of, body_counts, link_counts, cursor;
 };
 
 // `dynamic[slot]` marks the bodies that move; every link touches at least one of them. Islands

@@ -8,23 +8,30 @@
 namespace tumble {
 namespace {
 
-// Variables are numbered w_0..w_{n-1}, z_0..z_{n-1}, then the artificial z0 (index 2n).
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Variables are numbered w_0..w_{n-1}, z_0..z_{n-1}, then the artificial z0 (index 2n). The
+// tableau lives in the caller's workspace, so repeated solves allocate nothing.
 struct Tableau {
   int n;
   // B^-1 of the current basis, row-major: every pivot subtracts whole rows.
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> basis_inverse;
-  Eigen::VectorXd values;  // values of the basic variables, B^-1 q
-  std::vector<int> basic;  // which variable each row holds
+  Eigen::Map<RowMajorMatrix> basis_inverse;
+  Eigen::Map<Eigen::VectorXd> values;  // values of the basic variables, B^-1 q
+  int* basic;                          // which variable each row holds
 
   // The entering variable's column in the current basis: B^-1 a, with the original columns
   // a(w_i) = e_i, a(z_j) = -M e_j, a(z0) = -1.
-  Eigen::VectorXd column(const Eigen::MatrixXd& m, int variable) const {
-    if (variable < n) return basis_inverse.col(variable);
-    if (variable < 2 * n) return -(basis_inverse * m.col(variable - n));
-    return -basis_inverse.rowwise().sum();
+  void column(const Eigen::Ref<const Eigen::MatrixXd>& m, int variable,
+              Eigen::Map<Eigen::VectorXd>& out) const {
+    if (variable < n)
+      out = basis_inverse.col(variable);
+    else if (variable < 2 * n)
+      out.noalias() = -(basis_inverse * m.col(variable - n));
+    else
+      out = -basis_inverse.rowwise().sum();
   }
 
-  void pivot(int row, int entering, const Eigen::VectorXd& column) {
+  void pivot(int row, int entering, const Eigen::Map<Eigen::VectorXd>& column) {
     const double p = column[row];
     basis_inverse.row(row) /= p;
     values[row] /= p;
@@ -39,7 +46,8 @@ struct Tableau {
 
 // True when row i's ratio vector (value, B^-1 row) / column[i] is lexicographically smaller
 // than row j's.
-bool lexicographically_smaller(const Tableau& t, const Eigen::VectorXd& column, int i, int j) {
+bool lexicographically_smaller(const Tableau& t, const Eigen::Map<Eigen::VectorXd>& column, int i,
+                               int j) {
   const double ri = t.values[i] / column[i], rj = t.values[j] / column[j];
   const double scale = 1e-12 * std::max({1.0, std::abs(ri), std::abs(rj)});
   if (std::abs(ri - rj) > scale) return ri < rj;
@@ -55,8 +63,16 @@ bool lexicographically_smaller(const Tableau& t, const Eigen::VectorXd& column, 
 
 LemkeResult solve_lcp_lemke(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, int max_pivots,
                             Eigen::VectorXd* z) {
+  LemkeWorkspace workspace;
+  z->resize(q.size());
+  return solve_lcp_lemke(m, q, max_pivots, *z, &workspace);
+}
+
+LemkeResult solve_lcp_lemke(const Eigen::Ref<const Eigen::MatrixXd>& m,
+                            const Eigen::Ref<const Eigen::VectorXd>& q, int max_pivots,
+                            Eigen::Ref<Eigen::VectorXd> z, LemkeWorkspace* workspace) {
   const int n = static_cast<int>(q.size());
-  z->setZero(n);
+  z.setZero();
   LemkeResult result;
   if (!m.allFinite() || !q.allFinite()) {
     result.outcome = LemkeOutcome::kNotFinite;
@@ -65,16 +81,24 @@ LemkeResult solve_lcp_lemke(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, 
   if (n == 0 || q.minCoeff() >= 0) return result;  // z = 0 already complements w = q
 
   const int artificial = 2 * n;
-  Tableau t{n, Eigen::MatrixXd::Identity(n, n), q, std::vector<int>(n)};
+  workspace->basis_inverse.resize(static_cast<std::size_t>(n) * n);
+  workspace->values.resize(n);
+  workspace->column.resize(n);
+  workspace->basic.resize(n);
+  Tableau t{n, Eigen::Map<RowMajorMatrix>(workspace->basis_inverse.data(), n, n),
+            Eigen::Map<Eigen::VectorXd>(workspace->values.data(), n), workspace->basic.data()};
+  t.basis_inverse.setIdentity();
+  t.values = q;
   for (int i = 0; i < n; ++i)
     t.basic[i] = i;
+  Eigen::Map<Eigen::VectorXd> column(workspace->column.data(), n);
 
   // z0 enters at the level that makes every w non-negative; the most negative w leaves.
   int row = 0;
   for (int i = 1; i < n; ++i)
     if (q[i] < q[row]) row = i;
   int entering = artificial;
-  Eigen::VectorXd column = t.column(m, entering);
+  t.column(m, entering, column);
   int leaving = t.basic[row];
   t.pivot(row, entering, column);
   ++result.pivots;
@@ -82,7 +106,7 @@ LemkeResult solve_lcp_lemke(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, 
   while (true) {
     // The complement of the variable that just left enters.
     entering = leaving < n ? leaving + n : leaving - n;
-    column = t.column(m, entering);
+    t.column(m, entering, column);
     const double tolerance = 1e-12 * std::max(1.0, column.cwiseAbs().maxCoeff());
     double min_ratio = std::numeric_limits<double>::infinity();
     for (int i = 0; i < n; ++i)
@@ -116,7 +140,7 @@ LemkeResult solve_lcp_lemke(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, 
 
   for (int i = 0; i < n; ++i) {
     const int variable = t.basic[i];
-    if (variable >= n && variable < 2 * n) (*z)[variable - n] = std::max(t.values[i], 0.0);
+    if (variable >= n && variable < 2 * n) z[variable - n] = std::max(t.values[i], 0.0);
   }
   return result;
 }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 #include <cstdint>
+#include <vector>
 
 namespace tumble {
 
@@ -22,7 +23,17 @@ struct LemkeResult {
   int pivots = 0;
 };
 
-// Solves into `z` (resized to q's size). `max_pivots` bounds the work.
+// Memory of the pivoting, kept by the caller so that repeated solves allocate nothing.
+struct LemkeWorkspace {
+  std::vector<double> basis_inverse, values, column;
+  std::vector<int> basic;
+};
+
+// Solves into `z` (q's size). `max_pivots` bounds the work.
+LemkeResult solve_lcp_lemke(const Eigen::Ref<const Eigen::MatrixXd>& m,
+                            const Eigen::Ref<const Eigen::VectorXd>& q, int max_pivots,
+                            Eigen::Ref<Eigen::VectorXd> z, LemkeWorkspace* workspace);
+// The same with a workspace of its own; `z` is resized.
 LemkeResult solve_lcp_lemke(const Eigen::MatrixXd& m, const Eigen::VectorXd& q, int max_pivots,
                             Eigen::VectorXd* z);
 
