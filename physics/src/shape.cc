@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -62,6 +64,7 @@ Result<Shape> Shape::create(const ShapeDef& def) {
   } else {
     shape.type_ = ShapeType::kHalfSpace;
   }
+  shape.update_radii();
   return shape;
 }
 
@@ -160,6 +163,57 @@ double Shape::size() const {
   return 1.0;
 }
 
+namespace {
+
+double compute_inner_radius(ShapeType type, double radius, const Vec3& half_extents,
+                            const ConvexPolyhedron* polyhedron) {
+  switch (type) {
+    case ShapeType::kSphere:
+    case ShapeType::kCapsule:
+      return radius;
+    case ShapeType::kBox:
+      return half_extents.minCoeff();
+    case ShapeType::kHull: {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const ConvexPolyhedron::Face& face : polyhedron->faces)
+        nearest = std::min(nearest, face.offset);
+      return std::max(nearest, 0.0);
+    }
+    case ShapeType::kHalfSpace:
+      return std::numeric_limits<double>::infinity();
+  }
+  return 0;
+}
+
+double compute_outer_radius(ShapeType type, double radius, double half_height,
+                            const Vec3& half_extents, const ConvexPolyhedron* polyhedron) {
+  switch (type) {
+    case ShapeType::kSphere:
+      return radius;
+    case ShapeType::kCapsule:
+      return radius + half_height;
+    case ShapeType::kBox:
+      return half_extents.norm();
+    case ShapeType::kHull: {
+      double farthest = 0;
+      for (const Vec3& v : polyhedron->vertices)
+        farthest = std::max(farthest, v.norm());
+      return farthest;
+    }
+    case ShapeType::kHalfSpace:
+      return std::numeric_limits<double>::infinity();
+  }
+  return 0;
+}
+
+}  // namespace
+
+void Shape::update_radii() {
+  inner_radius_ = compute_inner_radius(type_, radius_, half_extents_, polyhedron_.get());
+  outer_radius_ =
+      compute_outer_radius(type_, radius_, half_height_, half_extents_, polyhedron_.get());
+}
+
 Vec3 Shape::support(const Vec3& d) const {
   switch (type_) {
     case ShapeType::kSphere: {
@@ -194,6 +248,7 @@ Shape Shape::recentred(const Vec3& offset) const {
   moved->centroid -= offset;
   Shape shape = *this;
   shape.polyhedron_ = std::move(moved);
+  shape.update_radii();
   return shape;
 }
 

@@ -280,6 +280,12 @@ Status World::step(double dt) {
   correct_positions();
   stats_.time.correct_positions = seconds_since(stage);
 
+  if (fast_count_ > 0) {
+    stage = std::chrono::steady_clock::now();
+    sweep_fast_bodies(dt);
+    stats_.time.continuous = seconds_since(stage);
+  }
+
   finish_step(dt);
   update_sleep(dt);
   stats_.time.total = seconds_since(start);

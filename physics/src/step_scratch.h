@@ -5,6 +5,7 @@
 
 #include "colouring.h"
 #include "contact_solver.h"
+#include "continuous.h"
 #include "islands.h"
 
 namespace tumble {
@@ -43,6 +44,10 @@ struct StepScratch {
   std::vector<std::uint32_t> island_colour_begin;
   std::vector<std::uint32_t> team_islands, single_islands;
   std::vector<double> team_values;  // one per thread, for reductions inside a team
+  // Continuous collision: pairs with a fast body, their results, and each slot's first impact.
+  std::vector<std::uint32_t> swept_pairs;
+  std::vector<ImpactResult> impacts;
+  std::vector<double> first_impact;
   std::vector<const Body*> body_of_slot;
   std::vector<CachedImpulse> cache;  // last step's impulses, sorted by body pair
 };

@@ -190,6 +190,8 @@ SceneDef read_scene(const Json& json) {
   solver.speculative_distance = r.number("speculative_distance", solver.speculative_distance);
   solver.restitution_threshold = r.number("restitution_threshold", solver.restitution_threshold);
   solver.contact_hertz = r.number("contact_hertz", solver.contact_hertz);
+  solver.continuous = r.boolean("continuous", solver.continuous);
+  solver.continuous_fraction = r.number("continuous_fraction", solver.continuous_fraction);
   if (Status s = validate(world); !s) throw FieldError{s.message()};
 
   const Json* bodies = r.find("bodies");
@@ -295,7 +297,9 @@ std::string scene_to_json(const SceneDef& scene) {
               {"slop", s.slop},
               {"speculative_distance", s.speculative_distance},
               {"restitution_threshold", s.restitution_threshold},
-              {"contact_hertz", s.contact_hertz}};
+              {"contact_hertz", s.contact_hertz},
+              {"continuous", s.continuous},
+              {"continuous_fraction", s.continuous_fraction}};
   out["bodies"] = Json::array();
   for (const BodyDef& def : scene.bodies)
     out["bodies"].push_back(body_json(def));

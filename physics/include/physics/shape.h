@@ -66,6 +66,12 @@ class Shape {
   MassProperties mass_properties(double density) const;
   // A length that sets the scale of numerical tolerances: the largest half extent.
   double size() const;
+  // m: the radius of the largest sphere about the shape's origin that fits inside it (the
+  // smallest half extent of a box); a body moving less than this per step cannot jump over a
+  // wall of its own thickness. 0 when the origin is outside; infinite for a half-space.
+  double inner_radius() const { return inner_radius_; }
+  // m: the largest distance of a point of the shape from its origin; infinite for a half-space.
+  double outer_radius() const { return outer_radius_; }
   // The point of the shape farthest along `direction` (shape frame).
   Vec3 support(const Vec3& direction) const;
   // The same shape moved so that `offset` (shape frame) becomes the origin.
@@ -77,6 +83,8 @@ class Shape {
   double half_height_ = 0;
   Vec3 half_extents_ = Vec3::Zero();
   std::shared_ptr<const ConvexPolyhedron> polyhedron_;
+  double inner_radius_ = 0, outer_radius_ = 0;
+  void update_radii();
 };
 
 }  // namespace tumble

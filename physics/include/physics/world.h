@@ -110,6 +110,7 @@ class World {
   void prepare_contacts(double dt);
   void solve_islands(double dt);
   void correct_positions();
+  void sweep_fast_bodies(double dt);
   void finish_step(double dt);
 
   WorldSettings settings_;
@@ -121,7 +122,10 @@ class World {
   std::vector<BodyPair> pairs_;
   std::vector<Contact> contacts_;
   std::uint32_t collision_flags_ = 0;
-  std::vector<double> speculative_;  // m, how far each body may move in the step
+  std::vector<double> speculative_;  // m: the gap within which each body gets contacts
+  std::vector<double> motion_;       // m: how far each body can move in the step
+  std::vector<std::uint8_t> fast_;   // bodies swept by continuous collision this step
+  std::uint32_t fast_count_ = 0;
   std::vector<double> impulses_;
   std::unique_ptr<StepScratch> scratch_;
   StepStats stats_;

@@ -1,0 +1,66 @@
+// The continuous-collision stage of World::step: fast bodies swept through their motion.
+#include <omp.h>
+
+#include <algorithm>
+
+#include "continuous.h"
+#include "physics/world.h"
+#include "step_scratch.h"
+
+namespace tumble {
+
+// After the solve, every pair with a fast body (the broad phase already grew its bounds by the
+// whole motion) is swept from the start pose to the solved end pose; each fast body then ends
+// the step at its first impact. Only fast bodies are moved back: a slow body keeps its solved
+// pose, and its speculative contacts already covered its own motion.
+void World::sweep_fast_bodies(double /*dt*/) {
+  StepScratch& s = *scratch_;
+  const SolverSettings& solver = settings_.solver;
+  s.swept_pairs.clear();
+  for (std::uint32_t k = 0; k < pairs_.size(); ++k)
+    if (fast_[pairs_[k].a] || fast_[pairs_[k].b]) s.swept_pairs.push_back(k);
+  s.impacts.resize(s.swept_pairs.size());
+
+  auto motion_of = [&](std::uint32_t slot) {
+    const Body& body = bodies_[slot].body;
+    SweptMotion motion;
+    motion.start = body.pose();
+    if (s.dynamic[slot]) {
+      motion.translation = s.poses[slot].position - body.position;
+      motion.rotation = s.bodies[slot].delta_angle;  // not wrapped at pi, unlike the end pose
+      motion.outer_radius = body.shape.outer_radius();
+    }
+    return motion;
+  };
+  // Half the speculative distance: the next step's narrow phase still sees the contact.
+  const double target = std::max(0.5 * solver.speculative_distance, solver.slop);
+  const std::int64_t count = static_cast<std::int64_t>(s.swept_pairs.size());
+  const int threads = settings_.threads > 0 ? settings_.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) if (threads > 1 && count > 8)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const BodyPair& pair = pairs_[s.swept_pairs[k]];
+    s.impacts[k] = time_of_impact(bodies_[pair.a].body.shape, motion_of(pair.a),
+                                  bodies_[pair.b].body.shape, motion_of(pair.b), target,
+                                  0.25 * target, solver.continuous_iterations);
+  }
+
+  s.first_impact.assign(bodies_.size(), 1.0);
+  for (std::size_t k = 0; k < s.impacts.size(); ++k) {
+    const ImpactResult& impact = s.impacts[k];
+    if (impact.status == ImpactStatus::kIterationLimit) ++stats_.continuous_limit_hits;
+    if (impact.status != ImpactStatus::kHit && impact.status != ImpactStatus::kIterationLimit)
+      continue;
+    const BodyPair& pair = pairs_[s.swept_pairs[k]];
+    for (std::uint32_t slot : {pair.a, pair.b})
+      if (fast_[slot]) s.first_impact[slot] = std::min(s.first_impact[slot], impact.t);
+  }
+  for (std::uint32_t slot = 0; slot < bodies_.size(); ++slot) {
+    if (!fast_[slot]) continue;
+    ++stats_.swept_bodies;
+    if (s.first_impact[slot] >= 1) continue;
+    ++stats_.continuous_impacts;
+    s.poses[slot] = pose_at(motion_of(slot), s.first_impact[slot]);
+  }
+}
+
+}  // namespace tumble
