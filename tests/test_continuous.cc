@@ -9,7 +9,9 @@
 namespace tumble::testing {
 namespace {
 
-Shape make_shape(const ShapeDef& def) { return Shape::create(def).value(); }
+Shape make_shape(const ShapeDef& def) {
+  return Shape::create(def).value();
+}
 
 SweptMotion moving(const Vec3& start, const Vec3& translation) {
   SweptMotion motion;
@@ -98,8 +100,8 @@ SceneDef wall_scene(const Vec3& start, double speed) {
 // A 10 cm box at 1000 m/s (16.7 m per step) against a 1 cm wall, with each solver and from
 // several starting offsets (so that the wall falls anywhere within a step).
 TEST(Continuous, BoxAt1000MetresPerSecondStopsAtA1CentimetreWall) {
-  for (SolverKind kind : {SolverKind::kAuto, SolverKind::kPgs, SolverKind::kSoft,
-                          SolverKind::kExact}) {
+  for (SolverKind kind :
+       {SolverKind::kAuto, SolverKind::kPgs, SolverKind::kSoft, SolverKind::kExact}) {
     for (double start : {-20.0, -13.3, -7.77, -1.0}) {
       SceneDef scene = wall_scene(Vec3(start, 0, 0), 1000);
       scene.world.solver.kind = kind;

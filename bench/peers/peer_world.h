@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "physics/math.h"
+#include "physics/step.h"
 #include "scenes/scene.h"
 
 namespace tumble::bench {
@@ -22,6 +23,12 @@ struct RunResult {
 
 // A box's deepest corner below z = 0 (0 when above), from its centre, rotation and half extents.
 double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half);
+
+// Ours with one solver, `threads` OpenMP threads; `sleeping` as below.
+RunResult run_ours(SceneDef scene, SolverKind kind, long steps, int threads, bool sleeping);
+
+// The median of a list (0 when empty).
+double median(std::vector<double> values);
 
 // `sleeping` false keeps every body awake (Bullet: DISABLE_DEACTIVATION; ours: solver.sleeping).
 RunResult run_bullet(const SceneDef& scene, long steps, bool sleeping = true);

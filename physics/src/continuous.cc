@@ -10,8 +10,8 @@ namespace tumble {
 Pose pose_at(const SweptMotion& motion, double t) {
   Pose pose;
   pose.position = motion.start.position + t * motion.translation;
-  pose.orientation = t == 0 ? motion.start.orientation
-                            : rotated(motion.start.orientation, t * motion.rotation);
+  pose.orientation =
+      t == 0 ? motion.start.orientation : rotated(motion.start.orientation, t * motion.rotation);
   return pose;
 }
 

@@ -28,10 +28,10 @@ struct SweptMotion {
 Pose pose_at(const SweptMotion& motion, double t);
 
 enum class ImpactStatus : std::uint8_t {
-  kMiss,            // no contact within the step
-  kHit,             // first within the target at `t`
-  kTouchingAtStart, // already within the target at t = 0: the contact solver's case
-  kIterationLimit,  // stopped at the bound; `t` is still safe (before any contact)
+  kMiss,             // no contact within the step
+  kHit,              // first within the target at `t`
+  kTouchingAtStart,  // already within the target at t = 0: the contact solver's case
+  kIterationLimit,   // stopped at the bound; `t` is still safe (before any contact)
 };
 
 struct ImpactResult {

@@ -369,10 +369,16 @@ void World::prepare_contacts(double /*dt*/) {
       case SolverKind::kSoft:
         kind = IslandSolver::kSoft;
         break;
-      case SolverKind::kAuto:
-        kind = points <= static_cast<std::uint32_t>(solver.exact_max_points) ? IslandSolver::kExact
-                                                                             : IslandSolver::kSoft;
+      case SolverKind::kAuto: {
+        // One body against statics gains nothing from solving its contacts together with
+        // others' (there are none), and the soft step resolves it at a fraction of a Lemke
+        // solve's cost (8-direction pyramids make 10 unknowns per point). A body touching
+        // nothing takes the plain step of dt.
+        const bool alone = s.islands.body_begin[i + 1] - s.islands.body_begin[i] == 1;
+        const bool small = points <= static_cast<std::uint32_t>(solver.exact_max_points);
+        kind = points == 0 || (!alone && small) ? IslandSolver::kExact : IslandSolver::kSoft;
         break;
+      }
     }
     s.reports[i].solver = kind;
   }

@@ -39,9 +39,9 @@ void World::sweep_fast_bodies(double /*dt*/) {
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) if (threads > 1 && count > 8)
   for (std::int64_t k = 0; k < count; ++k) {
     const BodyPair& pair = pairs_[s.swept_pairs[k]];
-    s.impacts[k] = time_of_impact(bodies_[pair.a].body.shape, motion_of(pair.a),
-                                  bodies_[pair.b].body.shape, motion_of(pair.b), target,
-                                  0.25 * target, solver.continuous_iterations);
+    s.impacts[k] =
+        time_of_impact(bodies_[pair.a].body.shape, motion_of(pair.a), bodies_[pair.b].body.shape,
+                       motion_of(pair.b), target, 0.25 * target, solver.continuous_iterations);
   }
 
   s.first_impact.assign(bodies_.size(), 1.0);

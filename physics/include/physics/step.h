@@ -11,7 +11,8 @@ enum class SolverKind : std::uint8_t {
   kExact,  // one linear complementarity problem per island, solved by Lemke's algorithm
   kPgs,    // projected Gauss-Seidel (sequential impulses), warm-started, one velocity solve
   kSoft,   // substeps with soft contacts: solve with bias, integrate, relax without bias
-  kAuto,   // exact for islands up to `exact_max_points` contact points, soft for larger ones
+  kAuto,   // exact for islands of several bodies with up to `exact_max_points` contact points;
+           // soft for larger ones and for a single body touching only statics
 };
 std::string_view solver_name(SolverKind kind);
 std::optional<SolverKind> solver_from_name(std::string_view name);

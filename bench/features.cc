@@ -1,0 +1,197 @@
+// Pay only for what is used: each row pair runs a scene that does not use a feature, once with
+// the feature available (the default) and once with it switched off or absent — the nearest we
+// can come to a build without it. The first must not be slower than the second.
+// Usage: bench_features [--steps N] (default 300 steps per run).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "physics/world.h"
+#include "scenes/scene.h"
+#include "scenes/standard.h"
+
+using namespace tumble;
+
+namespace {
+
+struct Measured {
+  double median_ms = 0, narrow_ms = 0, solve_ms = 0;
+  StepStats last;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+Measured measure(World& world, double dt, long steps) {
+  std::vector<double> total, narrow, solve;
+  for (long s = 0; s < steps; ++s) {
+    world.step(dt);
+    const StageTimes& t = world.last_step().time;
+    total.push_back(1e3 * t.total);
+    narrow.push_back(1e3 * t.narrow_phase);
+    solve.push_back(1e3 * t.solve);
+  }
+  return {median(total), median(narrow), median(solve), world.last_step()};
+}
+
+World make(const SceneDef& scene) { return make_world(scene).value(); }
+
+BodyDef box_at(const Vec3& position, BodyType type = BodyType::kDynamic, double friction = 0.5) {
+  BodyDef def;
+  def.shape = BoxDef{Vec3::Constant(0.5)};
+  def.mass = type == BodyType::kDynamic ? 1 : 0;
+  def.type = type;
+  def.position = position;
+  def.friction = friction;
+  return def;
+}
+
+BodyDef floor_plane(double friction = 0.5) {
+  BodyDef def;
+  def.shape = HalfSpaceDef{};
+  def.type = BodyType::kStatic;
+  def.friction = friction;
+  return def;
+}
+
+void header(const char* feature) { std::printf("\n%s\n", feature); }
+
+void row(const char* label, const Measured& m, const std::string& note) {
+  std::printf("  %-44s %9.3f %9.3f %9.3f  %s\n", label, m.median_ms, m.narrow_ms, m.solve_ms,
+              note.c_str());
+}
+
+// 32 x 32 boxes resting flat on the floor, 1.5 m apart: 1024 islands of four contacts.
+SceneDef resting_grid(double friction, SolverKind kind) {
+  SceneDef scene;
+  scene.name = "resting-grid";
+  scene.world.solver.kind = kind;
+  scene.world.solver.sleeping = false;
+  scene.bodies.push_back(floor_plane(friction));
+  for (int i = 0; i < 32; ++i)
+    for (int j = 0; j < 32; ++j)
+      scene.bodies.push_back(box_at(Vec3(1.5 * i, 1.5 * j, 0.5), BodyType::kDynamic, friction));
+  return scene;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  long steps = 300;
+  if (argc == 3 && std::string(argv[1]) == "--steps") steps = std::atol(argv[2]);
+  const double dt = 1.0 / 60;
+  std::printf(
+      "Pay only for what is used: %ld steps per run, one thread unless stated; medians over "
+      "steps, ms.\n  %-44s %9s %9s %9s\n",
+      steps, "scene / variant", "step", "narrow", "solve");
+
+  {  // warm up: page in the code and the allocator before the first measured run
+    SceneDef scene = pile_scene(1000);
+    scene.world.threads = 1;
+    World world = make(scene);
+    measure(world, dt, 120);
+  }
+
+  header("Continuous collision, scene with no fast body (pile-1000, awake)");
+  for (bool on : {true, false}) {
+    SceneDef scene = pile_scene(1000);
+    scene.world.threads = 1;
+    scene.world.solver.sleeping = false;
+    scene.world.solver.continuous = on;
+    World world = make(scene);
+    const Measured m = measure(world, dt, steps);
+    row(on ? "continuous on (default)" : "continuous off", m,
+        "swept bodies in the last step: " + std::to_string(m.last.swept_bodies));
+  }
+
+  header("Friction, mu = 0 (1024 boxes resting on the floor, awake)");
+  for (SolverKind kind : {SolverKind::kAuto, SolverKind::kSoft}) {
+    for (double mu : {0.5, 0.0}) {
+      SceneDef scene = resting_grid(mu, kind);
+      scene.world.threads = 1;
+      World world = make(scene);
+      const Measured m = measure(world, dt, steps);
+      const std::string label = std::string(solver_name(kind)) + ", mu = " + (mu > 0 ? "0.5" : "0");
+      row(label.c_str(), m,
+          "Lemke pivots " + std::to_string(m.last.lemke_pivots) + ", velocity iterations " +
+              std::to_string(m.last.velocity_iterations));
+    }
+  }
+
+  header("Only spheres: no GJK or EPA (pile lattice of 1000, awake)");
+  for (bool spheres : {true, false}) {
+    SceneDef scene = pile_scene(1000);
+    scene.world.threads = 1;
+    scene.world.solver.sleeping = false;
+    if (spheres)
+      for (BodyDef& def : scene.bodies)
+        if (std::holds_alternative<BoxDef>(def.shape)) def.shape = SphereDef{0.5};
+    World world = make(scene);
+    const Measured m = measure(world, dt, steps);
+    char note[96];
+    std::snprintf(note, sizeof note, "%u manifolds, narrow %.3f us per pair", m.last.manifolds,
+                  1e3 * m.narrow_ms / std::max(1u, m.last.pairs));
+    row(spheres ? "spheres" : "boxes (SAT)", m, note);
+  }
+
+  header("One thread: no thread team (tower-3, awake)");
+  for (int threads : {1, 2}) {
+    SceneDef scene = tower_scene(3);
+    scene.world.threads = threads;
+    scene.world.solver.sleeping = false;
+    World world = make(scene);
+    const Measured m = measure(world, dt, steps);
+    row(threads == 1 ? "threads = 1" : "threads = 2", m, "");
+  }
+
+  header("Sleeping islands (pile-1000 after 10 s) against the same sleepers made static");
+  {
+    SceneDef scene = pile_scene(1000);
+    scene.world.threads = 1;
+    World world = make(scene);
+    for (int s = 0; s < 600; ++s)
+      world.step(dt);
+    const Measured asleep = measure(world, dt, steps);
+    row("asleep", asleep, std::to_string(asleep.last.sleeping_bodies) + " sleeping bodies");
+    SceneDef frozen = scene;
+    frozen.bodies.clear();
+    frozen.bodies.push_back(floor_plane());
+    for (std::uint32_t i = 0; i < world.slot_count(); ++i) {
+      const Body* body = world.body(world.id_at(i));
+      if (body == nullptr || body->is_static()) continue;
+      // Awake bodies stay dynamic, with their velocities: only the sleepers change.
+      BodyDef def = box_at(body->position, body->asleep ? BodyType::kStatic : BodyType::kDynamic);
+      def.orientation = body->orientation;
+      def.linear_velocity = body->linear_velocity;
+      def.angular_velocity = body->angular_velocity;
+      frozen.bodies.push_back(def);
+    }
+    World still = make(frozen);
+    row("sleepers made static", measure(still, dt, steps), "");
+  }
+
+  header("Static-static pairs: 1000 overlapping static boxes and one falling box");
+  for (double spacing : {0.5, 2.0}) {
+    SceneDef scene;
+    scene.name = "statics";
+    scene.world.threads = 1;
+    scene.bodies.push_back(floor_plane());
+    for (int i = 0; i < 10; ++i)
+      for (int j = 0; j < 10; ++j)
+        for (int k = 0; k < 10; ++k)
+          scene.bodies.push_back(box_at(Vec3(spacing * i, spacing * j, 0.5 + spacing * k),
+                                        BodyType::kStatic));
+    scene.bodies.push_back(box_at(Vec3(-5, -5, 30)));
+    World world = make(scene);
+    const Measured m = measure(world, dt, steps);
+    row(spacing < 1 ? "overlapping (0.5 m apart)" : "apart (2 m)", m,
+        std::to_string(m.last.pairs) + " pairs");
+  }
+  return 0;
+}
