@@ -40,7 +40,9 @@ Measured measure(World& world, double dt, long steps) {
   return {median(total), median(narrow), median(solve), world.last_step()};
 }
 
-World make(const SceneDef& scene) { return make_world(scene).value(); }
+World make(const SceneDef& scene) {
+  return make_world(scene).value();
+}
 
 BodyDef box_at(const Vec3& position, BodyType type = BodyType::kDynamic, double friction = 0.5) {
   BodyDef def;
@@ -60,7 +62,9 @@ BodyDef floor_plane(double friction = 0.5) {
   return def;
 }
 
-void header(const char* feature) { std::printf("\n%s\n", feature); }
+void header(const char* feature) {
+  std::printf("\n%s\n", feature);
+}
 
 void row(const char* label, const Measured& m, const std::string& note) {
   std::printf("  %-44s %9.3f %9.3f %9.3f  %s\n", label, m.median_ms, m.narrow_ms, m.solve_ms,
@@ -185,8 +189,8 @@ int main(int argc, char** argv) {
     for (int i = 0; i < 10; ++i)
       for (int j = 0; j < 10; ++j)
         for (int k = 0; k < 10; ++k)
-          scene.bodies.push_back(box_at(Vec3(spacing * i, spacing * j, 0.5 + spacing * k),
-                                        BodyType::kStatic));
+          scene.bodies.push_back(
+              box_at(Vec3(spacing * i, spacing * j, 0.5 + spacing * k), BodyType::kStatic));
     scene.bodies.push_back(box_at(Vec3(-5, -5, 30)));
     World world = make(scene);
     const Measured m = measure(world, dt, steps);

@@ -76,5 +76,4 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
-
 }  // namespace tumble::bench

@@ -70,9 +70,10 @@ int main(int argc, char** argv) {
     // the pile (PEERS.md), and MuJoCo 2.2 has no threads: one thread each.
     print(bullet, 1, size, reference, 0);
     print(run_ode(scene, steps), 1, size, reference, 0);
-    std::printf("  %-20s %7d %9s  cannot hold the pile's contacts in its preallocated arena "
-                "(PEERS.md)\n",
-                "MuJoCo 2.2.2", 1, "-");
+    std::printf(
+        "  %-20s %7d %9s  cannot hold the pile's contacts in its preallocated arena "
+        "(PEERS.md)\n",
+        "MuJoCo 2.2.2", 1, "-");
 #endif
     const RunResult one = run_ours(scene, SolverKind::kAuto, steps, 1, sleeping);
     const double one_ms = median(one.step_ms);
