@@ -27,6 +27,26 @@ TEST(Sleeping, SettledStackSleepsAndCostsNothing) {
   EXPECT_EQ(stats.islands, 0u);
 }
 
+// A pile of 250 falls, tumbles and settles; once every box is slower than the sleep speeds
+// (0.05 m/s and rad/s) the whole pile is asleep within a second (the delay is 0.5 s).
+TEST(Sleeping, SettledPileFallsAsleepSoonAfterSettling) {
+  World world = build(pile_scene(250));
+  const SolverSettings& solver = world.settings().solver;
+  double last_moving = 0, all_asleep_at = -1;
+  run(world, 1.0 / 60, 1200, [&](long s) {
+    if (all_asleep_at >= 0) return;
+    for (const Body* b : dynamic_bodies(world))
+      if (b->linear_velocity.norm() >= solver.sleep_linear_speed ||
+          b->angular_velocity.norm() >= solver.sleep_angular_speed)
+        last_moving = s / 60.0;
+    if (all_asleep(world)) all_asleep_at = s / 60.0;
+  });
+  ASSERT_GT(all_asleep_at, 0) << "still awake after 20 s";
+  EXPECT_LE(all_asleep_at - last_moving, 1.0);
+  EXPECT_EQ(world.last_step().sleeping_bodies, 250u);
+  EXPECT_EQ(world.last_step().contact_points, 0u);
+}
+
 TEST(Sleeping, RemovingTheBottomBoxWakesTheStackAndItFalls) {
   World world = build(tower_scene(3));
   run(world, 1.0 / 60, 120);
