@@ -40,6 +40,17 @@ void expect_valid(const Colouring& colouring, std::span<const IslandLink> links,
     EXPECT_EQ(seen[m], 1) << "manifold " << m;
 }
 
+// Colours every link as one island.
+Colouring colour_all(std::span<const IslandLink> links, std::span<const std::uint8_t> dynamic,
+                     ColouringScratch* scratch) {
+  std::vector<std::uint32_t> island(links.size());
+  for (std::uint32_t m = 0; m < island.size(); ++m)
+    island[m] = m;
+  Colouring colouring;
+  colour_manifolds(island, links, dynamic, scratch, &colouring);
+  return colouring;
+}
+
 TEST(Colouring, RandomContactGraphsGiveIndependentColours) {
   std::mt19937 random(7);
   for (int trial = 0; trial < 50; ++trial) {
@@ -54,12 +65,8 @@ TEST(Colouring, RandomContactGraphsGiveIndependentColours) {
       if (a == b || (!dynamic[a] && !dynamic[b])) continue;
       links.push_back({a, b});
     }
-    std::vector<std::uint32_t> island(links.size());
-    for (std::uint32_t m = 0; m < island.size(); ++m)
-      island[m] = m;
-    Colouring colouring;
     ColouringScratch scratch;
-    colour_manifolds(island, links, dynamic, &scratch, &colouring);
+    const Colouring colouring = colour_all(links, dynamic, &scratch);
     expect_valid(colouring, links, dynamic, links.size());
     // The scratch masks are left clear for the next island.
     for (std::uint64_t used : scratch.used)
@@ -75,12 +82,8 @@ TEST(Colouring, ABodyWithMoreContactsThanColoursOverflows) {
   std::vector<IslandLink> links;
   for (std::uint32_t i = 1; i <= spokes; ++i)
     links.push_back({0, i});
-  std::vector<std::uint32_t> island(links.size());
-  for (std::uint32_t m = 0; m < island.size(); ++m)
-    island[m] = m;
-  Colouring colouring;
   ColouringScratch scratch;
-  colour_manifolds(island, links, dynamic, &scratch, &colouring);
+  const Colouring colouring = colour_all(links, dynamic, &scratch);
   expect_valid(colouring, links, dynamic, links.size());
   ASSERT_EQ(colouring.colour_count(), 1u);
   EXPECT_TRUE(colouring.serial[0]);
@@ -93,12 +96,8 @@ TEST(Colouring, StaticBodiesDoNotConflict) {
   std::vector<IslandLink> links;
   for (std::uint32_t i = 1; i <= 100; ++i)
     links.push_back({0, i});
-  std::vector<std::uint32_t> island(links.size());
-  for (std::uint32_t m = 0; m < island.size(); ++m)
-    island[m] = m;
-  Colouring colouring;
   ColouringScratch scratch;
-  colour_manifolds(island, links, dynamic, &scratch, &colouring);
+  const Colouring colouring = colour_all(links, dynamic, &scratch);
   ASSERT_EQ(colouring.colour_count(), 1u);
   EXPECT_FALSE(colouring.serial[0]);
   expect_valid(colouring, links, dynamic, links.size());
