@@ -49,9 +49,9 @@ struct SolverSettings {
   // Continuous collision: a body that would move more than `continuous_fraction` of its inner
   // radius in a step (for a box, its smallest half extent) keeps speculative contacts only that
   // far and is swept through the rest of its motion after the solve; the first time it comes
-  // within half the speculative distance of another body, it stops there for this step (its
-  // velocity is kept, so the next step's contact decides what happens). Scenes without fast
-  // bodies run no sweep at all.
+  // within half the speculative distance of another body, it stops there for this step, with
+  // the velocities it had at that time; the next step's contact decides what happens. Scenes
+  // without fast bodies run no sweep at all.
   bool continuous = true;
   double continuous_fraction = 0.75;
   int continuous_iterations = 32;     // conservative-advancement steps per swept pair
