@@ -66,5 +66,15 @@ TEST(Determinism, PyramidSplitByColoursSameBitsForAnyThreadCountAndRun) {
   expect_same_bits(pyramid, 120);
 }
 
+// Boxes, a ball and a capsule, some of them swept by continuous collision on the way down.
+TEST(Determinism, DefaultSceneWithSweptBodiesSameBitsForAnyThreadCountAndRun) {
+  const SceneDef scene = parse_scene(default_scene_json()).value();
+  World world = build(scene);
+  std::uint32_t swept = 0;
+  run(world, scene.dt, 300, [&](long) { swept += world.last_step().swept_bodies; });
+  EXPECT_GT(swept, 0u);
+  expect_same_bits(scene, 300);
+}
+
 }  // namespace
 }  // namespace tumble::testing
