@@ -32,8 +32,9 @@ void World::sweep_fast_bodies(double /*dt*/) {
     }
     return motion;
   };
-  // Half the speculative distance: the next step's narrow phase still sees the contact.
-  const double target = std::max(0.5 * solver.speculative_distance, solver.slop);
+  // Half the speculative distance: the next step's narrow phase still sees the contact. Never 0,
+  // which advancement would approach without reaching (both settings may be 0).
+  const double target = std::max({0.5 * solver.speculative_distance, solver.slop, 1e-6});
   const std::int64_t count = static_cast<std::int64_t>(s.swept_pairs.size());
   const int threads = settings_.threads > 0 ? settings_.threads : omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) if (threads > 1 && count > 8)
