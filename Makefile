@@ -8,7 +8,7 @@ CMAKE_FLAGS ?=
 all: build
 
 deps:
-	@scripts/install-deps core
+	@scripts/install-deps core service
 
 configure: deps
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
@@ -24,7 +24,7 @@ demo: build
 
 bench: CMAKE_FLAGS += -DTUMBLE_BENCH_PEERS=ON
 bench:
-	@scripts/install-deps core bench
+	@scripts/install-deps core service bench
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DTUMBLE_BENCH_PEERS=ON >/dev/null
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 	@scripts/run-bench $(BUILD_DIR)
