@@ -24,7 +24,8 @@ tumble::v1::Frame thousand_body_frame(bool velocities) {
     // Values with every bit of the mantissa in use, as positions of tumbling bodies are.
     for (double v : {1.0 / 3 + i, -2.0 / 7 * i, 0.1 * i + 0.5})
       frame.add_positions(v);
-    for (double v : {0.5477225575051661, 0.5477225575051661, 0.4472135954999579, 0.4472135954999579})
+    for (double v :
+         {0.5477225575051661, 0.5477225575051661, 0.4472135954999579, 0.4472135954999579})
       frame.add_orientations(v);
     if (velocities) {
       for (double v : {0.1 * i, -0.2, 9.81 / 7})

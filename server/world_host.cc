@@ -1,0 +1,214 @@
+#include "world_host.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tumble::server {
+
+WorldHost::WorldHost(World world, double dt, double real_time_factor)
+    : world_(std::move(world)), dt_(dt), real_time_factor_(real_time_factor) {
+  status_.bodies = world_.body_count();
+  status_.dt = dt_;
+  status_.real_time_factor = real_time_factor_;
+  thread_ = std::thread([this] { run(); });
+}
+
+WorldHost::~WorldHost() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+  for (Command& command : commands_)
+    command.done.set_value(Status::error("server: shutting down"));
+  for (const auto& mailbox : subscribers_)
+    mailbox->close();
+}
+
+Status WorldHost::apply(std::function<Status(World&)> change) {
+  std::future<Status> done;
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) return Status::error("server: shutting down");
+    commands_.push_back({std::move(change), {}});
+    done = commands_.back().done.get_future();
+  }
+  wake_.notify_all();
+  return done.get();
+}
+
+void WorldHost::play() {
+  {
+    std::lock_guard lock(mutex_);
+    running_ = true;
+  }
+  wake_.notify_all();
+}
+
+void WorldHost::pause() {
+  std::lock_guard lock(mutex_);
+  running_ = false;
+  steps_left_ = 0;
+}
+
+void WorldHost::step(std::uint64_t steps) {
+  {
+    std::lock_guard lock(mutex_);
+    running_ = false;
+    steps_left_ += steps;
+  }
+  wake_.notify_all();
+}
+
+Status WorldHost::set_dt(double dt) {
+  if (!(dt > 0) || !std::isfinite(dt)) return Status::error("dt: must be finite and > 0");
+  std::lock_guard lock(mutex_);
+  dt_ = dt;
+  return Status::ok();
+}
+
+Status WorldHost::set_real_time_factor(double factor) {
+  if (!(factor >= 0) || !std::isfinite(factor))
+    return Status::error("real_time_factor: must be finite and >= 0");
+  {
+    std::lock_guard lock(mutex_);
+    real_time_factor_ = factor;
+  }
+  wake_.notify_all();
+  return Status::ok();
+}
+
+bool WorldHost::wait_idle(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  return idle_.wait_for(lock, timeout, [&] { return !running_ && steps_left_ == 0; });
+}
+
+std::shared_ptr<FrameMailbox> WorldHost::subscribe() {
+  auto mailbox = std::make_shared<FrameMailbox>();
+  std::lock_guard lock(mutex_);
+  subscribers_.push_back(mailbox);
+  return mailbox;
+}
+
+void WorldHost::unsubscribe(const std::shared_ptr<FrameMailbox>& mailbox) {
+  mailbox->close();
+  std::lock_guard lock(mutex_);
+  std::erase(subscribers_, mailbox);
+}
+
+HostStatus WorldHost::status() const {
+  std::lock_guard lock(mutex_);
+  HostStatus status = status_;
+  status.running = running_ || steps_left_ > 0;
+  status.dt = dt_;
+  status.real_time_factor = real_time_factor_;
+  status.subscribers = subscribers_.size();
+  return status;
+}
+
+// Runs on the stepping thread with the lock held.
+void WorldHost::apply_pending() {
+  while (!commands_.empty()) {
+    Command command = std::move(commands_.front());
+    commands_.pop_front();
+    const Status result = command.change(world_);
+    if (result) ++catalogue_;
+    status_.bodies = world_.body_count();
+    command.done.set_value(result);
+  }
+}
+
+void WorldHost::run() {
+  using Clock = std::chrono::steady_clock;
+  std::unique_lock lock(mutex_);
+  // Pacing: simulated time since `epoch` over the real-time factor is when the next step is due.
+  Clock::time_point epoch = Clock::now();
+  double paced_time = 0;
+  bool was_stepping = false;
+  while (true) {
+    apply_pending();
+    if (stopping_) return;
+    const bool stepping = running_ || steps_left_ > 0;
+    if (!stepping) {
+      was_stepping = false;
+      idle_.notify_all();
+      wake_.wait(lock, [&] { return stopping_ || !commands_.empty() || running_ || steps_left_; });
+      continue;
+    }
+    if (!was_stepping) {  // (re)start the pacing clock
+      epoch = Clock::now();
+      paced_time = 0;
+      was_stepping = true;
+    }
+    if (running_ && real_time_factor_ > 0) {
+      const auto due = epoch + std::chrono::duration_cast<Clock::duration>(
+                                   std::chrono::duration<double>(paced_time / real_time_factor_));
+      if (Clock::now() < due) {
+        // Commands and control still get through while waiting.
+        wake_.wait_until(lock, due, [&] { return stopping_ || !commands_.empty() || !running_; });
+        continue;
+      }
+    }
+    const double dt = dt_;
+    if (steps_left_ > 0) --steps_left_;
+    lock.unlock();  // the world is this thread's alone; callers may queue meanwhile
+    const Status stepped = world_.step(dt);
+    std::shared_ptr<const FrameData> frame = stepped ? make_frame() : nullptr;
+    lock.lock();
+    paced_time += dt;
+    status_.step = world_.step_count();
+    status_.time = world_.time();
+    status_.last_step = world_.last_step();
+    if (frame != nullptr)
+      for (const auto& mailbox : subscribers_)
+        mailbox->put(frame);
+  }
+}
+
+std::shared_ptr<const FrameData> WorldHost::make_frame() const {
+  auto frame = std::make_shared<FrameData>();
+  frame->step = world_.step_count();
+  frame->time = world_.time();
+  frame->stats = world_.last_step();
+  frame->catalogue = catalogue_;
+  const std::size_t n = world_.body_count();
+  frame->ids.reserve(n);
+  frame->positions.reserve(3 * n);
+  frame->orientations.reserve(4 * n);
+  frame->linear_velocities.reserve(3 * n);
+  frame->angular_velocities.reserve(3 * n);
+  for (std::uint32_t slot = 0; slot < world_.slot_count(); ++slot) {
+    const BodyId id = world_.id_at(slot);
+    const Body* body = world_.body(id);
+    if (body == nullptr) continue;
+    frame->ids.push_back(wire_id(id));
+    frame->positions.insert(frame->positions.end(), body->position.data(),
+                            body->position.data() + 3);
+    const Quat& q = body->orientation;
+    frame->orientations.insert(frame->orientations.end(), {q.w(), q.x(), q.y(), q.z()});
+    frame->linear_velocities.insert(frame->linear_velocities.end(), body->linear_velocity.data(),
+                                    body->linear_velocity.data() + 3);
+    frame->angular_velocities.insert(frame->angular_velocities.end(),
+                                     body->angular_velocity.data(),
+                                     body->angular_velocity.data() + 3);
+  }
+  const auto impulses = world_.contact_impulses();
+  std::size_t row = 0;
+  for (const Contact& contact : world_.contacts()) {
+    for (int i = 0; i < contact.manifold.count; ++i, ++row) {
+      const ContactPoint& point = contact.manifold.points[i];
+      frame->contact_a.push_back(wire_id(contact.a));
+      frame->contact_b.push_back(wire_id(contact.b));
+      frame->contact_points.insert(frame->contact_points.end(), point.point_b.data(),
+                                   point.point_b.data() + 3);
+      frame->contact_normals.insert(frame->contact_normals.end(), contact.manifold.normal.data(),
+                                    contact.manifold.normal.data() + 3);
+      frame->contact_depths.push_back(point.depth);
+      frame->contact_impulses.push_back(row < impulses.size() ? impulses[row] : 0.0);
+    }
+  }
+  return frame;
+}
+
+}  // namespace tumble::server

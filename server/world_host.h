@@ -1,0 +1,110 @@
+// The world as the server runs it: one thread owns the World and steps it; every change comes in
+// as a command that this thread applies between two steps, so a change is never seen half done;
+// after each step one immutable frame is built and offered to every subscriber's mailbox.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "mailbox.h"
+#include "physics/world.h"
+
+namespace tumble::server {
+
+// Ids on the wire: the slot index in the low 32 bits, its generation above.
+inline std::uint64_t wire_id(BodyId id) {
+  return static_cast<std::uint64_t>(id.generation) << 32 | id.index;
+}
+inline BodyId body_id(std::uint64_t wire) {
+  return {static_cast<std::uint32_t>(wire & 0xFFFFFFFFu), static_cast<std::uint32_t>(wire >> 32)};
+}
+
+// One step of the world, shared read-only by every subscriber.
+struct FrameData {
+  std::uint64_t step = 0;
+  double time = 0;                  // s, simulated
+  std::vector<std::uint64_t> ids;   // live bodies, slot order
+  std::vector<double> positions;    // x y z per body, m
+  std::vector<double> orientations; // w x y z per body
+  std::vector<double> linear_velocities, angular_velocities;  // x y z per body
+  // One entry per contact point.
+  std::vector<std::uint64_t> contact_a, contact_b;
+  std::vector<double> contact_points, contact_normals, contact_depths, contact_impulses;
+  StepStats stats;
+  // Changes whenever bodies are added or removed: a subscriber that saw another value asks for
+  // the body descriptions again.
+  std::uint64_t catalogue = 0;
+};
+
+using FrameMailbox = Mailbox<FrameData>;
+
+struct HostStatus {
+  std::uint64_t step = 0;
+  double time = 0;
+  std::size_t bodies = 0;
+  bool running = false;
+  double dt = 0, real_time_factor = 0;
+  StepStats last_step;
+  std::size_t subscribers = 0;
+};
+
+class WorldHost {
+ public:
+  // `dt`: s per step; `real_time_factor`: 1 paces simulated time to wall time, 0 runs flat out.
+  WorldHost(World world, double dt, double real_time_factor);
+  ~WorldHost();  // stops the thread; pending commands are answered with an error
+  WorldHost(const WorldHost&) = delete;
+  WorldHost& operator=(const WorldHost&) = delete;
+
+  // Runs `change` on the world on the stepping thread, between two steps, and returns its
+  // status. A change that fails must leave the world as it found it (the World's own batch
+  // operations do). Blocks until applied.
+  Status apply(std::function<Status(World&)> change);
+
+  void play();
+  void pause();
+  // Runs `steps` more steps, then pauses.
+  void step(std::uint64_t steps);
+  Status set_dt(double dt);
+  Status set_real_time_factor(double factor);
+  // Waits until the world is paused with no steps left to run, or the timeout passes.
+  bool wait_idle(std::chrono::milliseconds timeout);
+
+  std::shared_ptr<FrameMailbox> subscribe();
+  void unsubscribe(const std::shared_ptr<FrameMailbox>& mailbox);
+
+  HostStatus status() const;
+
+ private:
+  struct Command {
+    std::function<Status(World&)> change;
+    std::promise<Status> done;
+  };
+  void run();
+  void apply_pending();
+  std::shared_ptr<const FrameData> make_frame() const;
+
+  World world_;  // touched by the stepping thread only (commands run there)
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;  // commands, play, step, stop
+  std::condition_variable idle_;
+  std::deque<Command> commands_;
+  bool running_ = false, stopping_ = false;
+  std::uint64_t steps_left_ = 0;
+  double dt_, real_time_factor_;
+  std::uint64_t catalogue_ = 0;
+  HostStatus status_;
+  std::vector<std::shared_ptr<FrameMailbox>> subscribers_;
+  std::thread thread_;
+};
+
+}  // namespace tumble::server

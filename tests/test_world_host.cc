@@ -1,0 +1,131 @@
+// The server's core without gRPC: the newest-frame mailbox, commands applied between steps, and
+// a stalled subscriber that cannot hold the world back or make memory grow.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "scene_runner.h"
+#include "world_host.h"
+
+namespace tumble::server {
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(Mailbox, KeepsTheNewestFrameAndCountsTheDropped) {
+  Mailbox<int> box;
+  EXPECT_FALSE(box.take(1ms).has_value());
+  for (int i = 1; i <= 3; ++i)
+    box.put(std::make_shared<const int>(i));
+  auto delivery = box.take(1ms);
+  ASSERT_TRUE(delivery.has_value());
+  EXPECT_EQ(*delivery->frame, 3);
+  EXPECT_EQ(delivery->dropped, 2u);
+  box.put(std::make_shared<const int>(4));
+  delivery = box.take(1ms);
+  ASSERT_TRUE(delivery.has_value());
+  EXPECT_EQ(delivery->dropped, 0u);
+}
+
+TEST(Mailbox, CloseWakesAWaitingReader) {
+  Mailbox<int> box;
+  std::thread closer([&] {
+    std::this_thread::sleep_for(20ms);
+    box.close();
+  });
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(box.take(10s).has_value());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  closer.join();
+  box.put(std::make_shared<const int>(1));  // discarded once closed
+  EXPECT_FALSE(box.take(1ms).has_value());
+}
+
+World pile_world(int boxes) {
+  return make_world(pile_scene(boxes)).value();
+}
+
+TEST(WorldHost, StepsExactlyAsAskedAndPublishesEveryStep) {
+  WorldHost host(pile_world(27), 1.0 / 60, 0);
+  auto mailbox = host.subscribe();
+  host.step(10);
+  ASSERT_TRUE(host.wait_idle(30s));
+  EXPECT_EQ(host.status().step, 10u);
+  auto delivery = mailbox->take(1s);
+  ASSERT_TRUE(delivery.has_value());
+  EXPECT_EQ(delivery->frame->step, 10u);
+  EXPECT_EQ(delivery->dropped, 9u);  // nobody read steps 1 to 9
+  EXPECT_EQ(delivery->frame->ids.size(), 28u);
+  EXPECT_EQ(delivery->frame->positions.size(), 3 * 28u);
+  EXPECT_EQ(delivery->frame->orientations.size(), 4 * 28u);
+}
+
+// A batch spawned while the world runs appears whole in one frame: no frame shows part of it.
+TEST(WorldHost, ABatchAppearsWholeBetweenTwoSteps) {
+  WorldHost host(pile_world(8), 1.0 / 60, 0);
+  auto mailbox = host.subscribe();
+  host.play();
+  std::vector<BodyDef> batch(50);
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    batch[i].shape = SphereDef{0.1};
+    batch[i].position = Vec3(0.3 * i, 20, 5);
+  }
+  std::size_t before = 0, after = 0;
+  std::thread reader([&] {
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (after < 20 && std::chrono::steady_clock::now() < deadline) {
+      auto delivery = mailbox->take(50ms);
+      if (!delivery) continue;
+      const std::size_t bodies = delivery->frame->ids.size();
+      EXPECT_TRUE(bodies == 9 || bodies == 59) << bodies;
+      (bodies == 9 ? before : after)++;
+    }
+  });
+  std::this_thread::sleep_for(50ms);
+  EXPECT_TRUE(host.apply([&](World& world) { return world.create_bodies(batch).status(); }));
+  reader.join();
+  host.pause();
+  EXPECT_GT(before, 0u);
+  EXPECT_EQ(after, 20u);
+  // A refused batch (one bad body) changes nothing.
+  batch[7].shape = SphereDef{-1};
+  const std::size_t count = host.status().bodies;
+  const Status refused =
+      host.apply([&](World& world) { return world.create_bodies(batch).status(); });
+  EXPECT_FALSE(refused);
+  EXPECT_NE(refused.message().find("bodies[7]"), std::string::npos) << refused.message();
+  EXPECT_EQ(host.status().bodies, count);
+}
+
+// A subscriber that never reads: the world still runs every step, and its mailbox holds one
+// frame however long it is ignored.
+TEST(WorldHost, AStalledSubscriberNeitherBlocksNorGrows) {
+  WorldHost host(pile_world(64), 1.0 / 60, 0);
+  auto stalled = host.subscribe();
+  host.step(300);
+  ASSERT_TRUE(host.wait_idle(60s));
+  EXPECT_EQ(host.status().step, 300u);
+  auto delivery = stalled->take(1s);
+  ASSERT_TRUE(delivery.has_value());
+  EXPECT_EQ(delivery->frame->step, 300u);
+  EXPECT_EQ(delivery->dropped, 299u);
+  EXPECT_FALSE(stalled->take(1ms).has_value());  // one frame held, never a queue
+}
+
+TEST(WorldHost, RealTimePacing) {
+  WorldHost host(pile_world(8), 1.0 / 60, 1.0);
+  const auto start = std::chrono::steady_clock::now();
+  host.play();
+  std::this_thread::sleep_for(300ms);
+  host.pause();
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // At real time a step is due every 1/60 s of wall time, never sooner: however loaded the
+  // machine, no more steps than the wall time allows (an unpaced world of 8 boxes runs hundreds).
+  EXPECT_LE(host.status().step, elapsed * 60 + 1);
+  EXPECT_GE(host.status().step, 1u);
+  EXPECT_FALSE(host.set_real_time_factor(-1));
+  EXPECT_FALSE(host.set_dt(0));
+}
+
+}  // namespace
+}  // namespace tumble::server
