@@ -189,8 +189,7 @@ std::shared_ptr<const FrameData> WorldHost::make_frame() const {
     frame->orientations.insert(frame->orientations.end(), {q.w(), q.x(), q.y(), q.z()});
     frame->linear_velocities.insert(frame->linear_velocities.end(), body->linear_velocity.data(),
                                     body->linear_velocity.data() + 3);
-    frame->angular_velocities.insert(frame->angular_velocities.end(),
-                                     body->angular_velocity.data(),
+    frame->angular_velocities.insert(frame->angular_velocities.end(), body->angular_velocity.data(),
                                      body->angular_velocity.data() + 3);
   }
   const auto impulses = world_.contact_impulses();

@@ -31,10 +31,10 @@ inline BodyId body_id(std::uint64_t wire) {
 // One step of the world, shared read-only by every subscriber.
 struct FrameData {
   std::uint64_t step = 0;
-  double time = 0;                  // s, simulated
-  std::vector<std::uint64_t> ids;   // live bodies, slot order
-  std::vector<double> positions;    // x y z per body, m
-  std::vector<double> orientations; // w x y z per body
+  double time = 0;                                            // s, simulated
+  std::vector<std::uint64_t> ids;                             // live bodies, slot order
+  std::vector<double> positions;                              // x y z per body, m
+  std::vector<double> orientations;                           // w x y z per body
   std::vector<double> linear_velocities, angular_velocities;  // x y z per body
   // One entry per contact point.
   std::vector<std::uint64_t> contact_a, contact_b;

@@ -118,7 +118,8 @@ TEST(WorldHost, RealTimePacing) {
   host.play();
   std::this_thread::sleep_for(300ms);
   host.pause();
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // At real time a step is due every 1/60 s of wall time, never sooner: however loaded the
   // machine, no more steps than the wall time allows (an unpaced world of 8 boxes runs hundreds).
   EXPECT_LE(host.status().step, elapsed * 60 + 1);

@@ -1,0 +1,208 @@
+#include "convert.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace tumble::server {
+namespace {
+
+Status finite(const v1::Vec3& v, const std::string& field) {
+  if (!std::isfinite(v.x())) return Status::error(field + ".x: must be finite");
+  if (!std::isfinite(v.y())) return Status::error(field + ".y: must be finite");
+  if (!std::isfinite(v.z())) return Status::error(field + ".z: must be finite");
+  return Status::ok();
+}
+
+Status positive(double value, const std::string& field) {
+  if (!std::isfinite(value) || !(value > 0)) return Status::error(field + ": must be finite and > 0");
+  return Status::ok();
+}
+
+Vec3 vec(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+void set(const Vec3& v, v1::Vec3* out) {
+  out->set_x(v.x());
+  out->set_y(v.y());
+  out->set_z(v.z());
+}
+
+Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
+  switch (shape.kind_case()) {
+    case v1::Shape::kBox: {
+      const v1::Vec3& size = shape.box().size();
+      for (auto [value, axis] : {std::pair{size.x(), "x"}, {size.y(), "y"}, {size.z(), "z"}})
+        if (Status s = positive(value, std::string("shape.box.size.") + axis); !s) return s;
+      return ShapeDef{BoxDef{0.5 * vec(size)}};
+    }
+    case v1::Shape::kSphere:
+      if (Status s = positive(shape.sphere().radius(), "shape.sphere.radius"); !s) return s;
+      return ShapeDef{SphereDef{shape.sphere().radius()}};
+    case v1::Shape::kCapsule:
+      if (Status s = positive(shape.capsule().radius(), "shape.capsule.radius"); !s) return s;
+      if (Status s = positive(shape.capsule().half_height(), "shape.capsule.half_height"); !s)
+        return s;
+      return ShapeDef{CapsuleDef{shape.capsule().radius(), shape.capsule().half_height()}};
+    case v1::Shape::kHull: {
+      const auto& points = shape.hull().points();
+      if (points.size() % 3 != 0)
+        return Status::error("shape.hull.points: must hold x, y, z triples");
+      HullDef hull;
+      for (int i = 0; i < points.size(); i += 3) {
+        if (!std::isfinite(points[i]) || !std::isfinite(points[i + 1]) ||
+            !std::isfinite(points[i + 2]))
+          return Status::error("shape.hull.points[" + std::to_string(i / 3) +
+                               "]: must be finite");
+        hull.points.emplace_back(points[i], points[i + 1], points[i + 2]);
+      }
+      return ShapeDef{std::move(hull)};
+    }
+    case v1::Shape::kPlane:
+      return ShapeDef{HalfSpaceDef{}};
+    case v1::Shape::KIND_NOT_SET:
+      break;
+  }
+  return Status::error("shape: required (box, sphere, capsule, hull or plane)");
+}
+
+}  // namespace
+
+Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
+  BodyDef def;
+  Result<ShapeDef> shape = shape_from_proto(spec.shape());
+  if (!shape) return shape.status();
+  def.shape = std::move(shape).value();
+  switch (spec.type()) {
+    case v1::BODY_TYPE_DYNAMIC:
+      def.type = BodyType::kDynamic;
+      break;
+    case v1::BODY_TYPE_STATIC:
+      def.type = BodyType::kStatic;
+      break;
+    default:
+      return Status::error("type: unknown body type " + std::to_string(spec.type()));
+  }
+  if (std::holds_alternative<HalfSpaceDef>(def.shape) && def.type != BodyType::kStatic)
+    return Status::error("type: a plane must be static");
+  if (Status s = finite(spec.position(), "position"); !s) return s;
+  if (Status s = finite(spec.linear_velocity(), "linear_velocity"); !s) return s;
+  if (Status s = finite(spec.angular_velocity(), "angular_velocity"); !s) return s;
+  def.position = vec(spec.position());
+  def.linear_velocity = vec(spec.linear_velocity());
+  def.angular_velocity = vec(spec.angular_velocity());
+  if (spec.has_orientation()) {
+    const v1::Quat& q = spec.orientation();
+    const double norm = std::sqrt(q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z());
+    if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
+      return Status::error("orientation: must be a unit quaternion (|q| = " +
+                           std::to_string(norm) + ")");
+    def.orientation = Quat(q.w() / norm, q.x() / norm, q.y() / norm, q.z() / norm);
+  }
+  if (spec.has_mass()) {
+    if (Status s = positive(spec.mass(), "mass"); !s) return s;
+    def.mass = spec.mass();
+  }
+  if (spec.has_density()) {
+    if (Status s = positive(spec.density(), "density"); !s) return s;
+    def.density = spec.density();
+  }
+  if (spec.has_friction()) {
+    if (!std::isfinite(spec.friction()) || spec.friction() < 0)
+      return Status::error("friction: must be finite and >= 0");
+    def.friction = spec.friction();
+  }
+  if (spec.has_restitution()) {
+    if (!(spec.restitution() >= 0 && spec.restitution() <= 1))
+      return Status::error("restitution: must be in [0, 1]");
+    def.restitution = spec.restitution();
+  }
+  if (def.type == BodyType::kStatic) def.mass = 0;
+  if (Status s = validate(def); !s) return s;  // what only the engine can tell (a flat hull)
+  return def;
+}
+
+void describe(BodyId id, const Body& body, v1::BodyDescription* out) {
+  out->set_id(wire_id(id));
+  out->set_type(body.is_static() ? v1::BODY_TYPE_STATIC : v1::BODY_TYPE_DYNAMIC);
+  out->set_mass(body.is_static() ? 0 : body.mass);
+  v1::Shape* shape = out->mutable_shape();
+  const Shape& s = body.shape;
+  switch (s.type()) {
+    case ShapeType::kBox:
+      set(2 * s.half_extents(), shape->mutable_box()->mutable_size());
+      break;
+    case ShapeType::kSphere:
+      shape->mutable_sphere()->set_radius(s.radius());
+      break;
+    case ShapeType::kCapsule:
+      shape->mutable_capsule()->set_radius(s.radius());
+      shape->mutable_capsule()->set_half_height(s.half_height());
+      break;
+    case ShapeType::kHull:
+      for (const Vec3& v : s.polyhedron()->vertices)
+        for (int k = 0; k < 3; ++k)
+          shape->mutable_hull()->add_points(v[k]);
+      break;
+    case ShapeType::kHalfSpace:
+      shape->mutable_plane();
+      break;
+  }
+}
+
+void stats_to_proto(const StepStats& s, v1::StepStats* out) {
+  out->set_step(s.step);
+  out->set_pairs(s.pairs);
+  out->set_manifolds(s.manifolds);
+  out->set_contact_points(s.contact_points);
+  out->set_islands(s.islands);
+  out->set_sleeping_bodies(s.sleeping_bodies);
+  out->set_velocity_iterations(s.velocity_iterations);
+  out->set_lemke_pivots(s.lemke_pivots);
+  out->set_residual(s.residual);
+  out->set_max_penetration(s.max_penetration);
+  out->set_swept_bodies(s.swept_bodies);
+  out->set_broad_phase_seconds(s.time.broad_phase);
+  out->set_narrow_phase_seconds(s.time.narrow_phase);
+  out->set_prepare_seconds(s.time.prepare);
+  out->set_solve_seconds(s.time.solve);
+  out->set_correct_positions_seconds(s.time.correct_positions);
+  out->set_continuous_seconds(s.time.continuous);
+  out->set_total_seconds(s.time.total);
+}
+
+void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out) {
+  out->set_step(frame.step);
+  out->set_time(frame.time);
+  const bool all = options.ids.empty();
+  for (std::size_t i = 0; i < frame.ids.size(); ++i) {
+    if (!all && !std::binary_search(options.ids.begin(), options.ids.end(), frame.ids[i]))
+      continue;
+    out->add_ids(frame.ids[i]);
+    for (int k = 0; k < 3; ++k)
+      out->add_positions(frame.positions[3 * i + k]);
+    for (int k = 0; k < 4; ++k)
+      out->add_orientations(frame.orientations[4 * i + k]);
+    if (options.velocities) {
+      for (int k = 0; k < 3; ++k) {
+        out->add_linear_velocities(frame.linear_velocities[3 * i + k]);
+        out->add_angular_velocities(frame.angular_velocities[3 * i + k]);
+      }
+    }
+  }
+  if (options.contacts) {
+    v1::Contacts* contacts = out->mutable_contacts();
+    for (std::size_t c = 0; c < frame.contact_a.size(); ++c) {
+      contacts->add_body_a(frame.contact_a[c]);
+      contacts->add_body_b(frame.contact_b[c]);
+      for (int k = 0; k < 3; ++k) {
+        contacts->add_points(frame.contact_points[3 * c + k]);
+        contacts->add_normals(frame.contact_normals[3 * c + k]);
+      }
+      contacts->add_depths(frame.contact_depths[c]);
+      contacts->add_impulses(frame.contact_impulses[c]);
+    }
+  }
+  if (options.stats) stats_to_proto(frame.stats, out->mutable_stats());
+}
+
+}  // namespace tumble::server
