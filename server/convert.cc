@@ -15,11 +15,14 @@ Status finite(const v1::Vec3& v, const std::string& field) {
 }
 
 Status positive(double value, const std::string& field) {
-  if (!std::isfinite(value) || !(value > 0)) return Status::error(field + ": must be finite and > 0");
+  if (!std::isfinite(value) || !(value > 0))
+    return Status::error(field + ": must be finite and > 0");
   return Status::ok();
 }
 
-Vec3 vec(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Vec3 vec(const v1::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 void set(const Vec3& v, v1::Vec3* out) {
   out->set_x(v.x());
@@ -51,8 +54,7 @@ Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
       for (int i = 0; i < points.size(); i += 3) {
         if (!std::isfinite(points[i]) || !std::isfinite(points[i + 1]) ||
             !std::isfinite(points[i + 2]))
-          return Status::error("shape.hull.points[" + std::to_string(i / 3) +
-                               "]: must be finite");
+          return Status::error("shape.hull.points[" + std::to_string(i / 3) + "]: must be finite");
         hull.points.emplace_back(points[i], points[i + 1], points[i + 2]);
       }
       return ShapeDef{std::move(hull)};
@@ -94,8 +96,8 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
     const v1::Quat& q = spec.orientation();
     const double norm = std::sqrt(q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z());
     if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
-      return Status::error("orientation: must be a unit quaternion (|q| = " +
-                           std::to_string(norm) + ")");
+      return Status::error("orientation: must be a unit quaternion (|q| = " + std::to_string(norm) +
+                           ")");
     def.orientation = Quat(q.w() / norm, q.x() / norm, q.y() / norm, q.z() / norm);
   }
   if (spec.has_mass()) {
@@ -175,8 +177,7 @@ void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Fra
   out->set_time(frame.time);
   const bool all = options.ids.empty();
   for (std::size_t i = 0; i < frame.ids.size(); ++i) {
-    if (!all && !std::binary_search(options.ids.begin(), options.ids.end(), frame.ids[i]))
-      continue;
+    if (!all && !std::binary_search(options.ids.begin(), options.ids.end(), frame.ids[i])) continue;
     out->add_ids(frame.ids[i]);
     for (int k = 0; k < 3; ++k)
       out->add_positions(frame.positions[3 * i + k]);

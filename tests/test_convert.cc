@@ -52,8 +52,7 @@ TEST(Convert, EveryBadFieldIsNamed) {
       {[](v1::BodySpec& s) { s.mutable_shape()->mutable_hull()->add_points(1); },
        "shape.hull.points:"},
       {[&](v1::BodySpec& s) { s.mutable_position()->set_y(nan); }, "position.y:"},
-      {[](v1::BodySpec& s) { s.mutable_linear_velocity()->set_z(INFINITY); },
-       "linear_velocity.z:"},
+      {[](v1::BodySpec& s) { s.mutable_linear_velocity()->set_z(INFINITY); }, "linear_velocity.z:"},
       {[](v1::BodySpec& s) { s.mutable_orientation(); }, "orientation:"},  // the zero quaternion
       {[](v1::BodySpec& s) { s.mutable_orientation()->set_w(2); }, "orientation:"},
       {[](v1::BodySpec& s) { s.set_mass(-1); }, "mass:"},

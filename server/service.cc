@@ -1,0 +1,242 @@
+#include "service.h"
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+#include "convert.h"
+
+namespace tumble::server {
+namespace {
+
+grpc::Status invalid(const std::string& message) {
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message);
+}
+
+void settings_to_proto(const HostStatus& status, const World* world, v1::RunSettings* out) {
+  out->set_dt(status.dt);
+  out->set_real_time_factor(status.real_time_factor);
+  (void)world;
+}
+
+}  // namespace
+
+WorldService::WorldService(WorldHost& host, ServiceLimits limits) : host_(host), limits_(limits) {}
+
+grpc::Status WorldService::SpawnBodies(grpc::ServerContext*, const v1::SpawnBodiesRequest* request,
+                                       v1::SpawnBodiesResponse* response) {
+  std::vector<BodyDef> defs;
+  defs.reserve(request->bodies_size());
+  for (int i = 0; i < request->bodies_size(); ++i) {
+    Result<BodyDef> def = body_from_proto(request->bodies(i));
+    if (!def) return invalid("bodies[" + std::to_string(i) + "]." + def.error());
+    defs.push_back(std::move(def).value());
+  }
+  bool too_many = false;
+  std::vector<BodyId> ids;
+  const Status applied = host_.apply([&](World& world) {
+    if (world.body_count() + defs.size() > limits_.max_bodies) {
+      too_many = true;
+      return Status::error("bodies: " + std::to_string(defs.size()) + " more would exceed the " +
+                           std::to_string(limits_.max_bodies) + " bodies allowed");
+    }
+    Result<std::vector<BodyId>> made = world.create_bodies(defs);
+    if (!made) return made.status();
+    ids = std::move(made).value();
+    return Status::ok();
+  });
+  if (!applied)
+    return grpc::Status(
+        too_many ? grpc::StatusCode::RESOURCE_EXHAUSTED : grpc::StatusCode::INVALID_ARGUMENT,
+        applied.message());
+  for (BodyId id : ids)
+    response->add_ids(wire_id(id));
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::RemoveBodies(grpc::ServerContext*,
+                                        const v1::RemoveBodiesRequest* request,
+                                        v1::RemoveBodiesResponse*) {
+  std::set<std::uint64_t> seen;
+  for (int i = 0; i < request->ids_size(); ++i)
+    if (!seen.insert(request->ids(i)).second)
+      return invalid("ids[" + std::to_string(i) + "]: listed twice");
+  bool missing = false;
+  const Status applied = host_.apply([&](World& world) {
+    // Every id is checked before anything is removed: all or nothing.
+    for (int i = 0; i < request->ids_size(); ++i) {
+      if (!world.contains(body_id(request->ids(i)))) {
+        missing = true;
+        return Status::error("ids[" + std::to_string(i) + "]: no body " +
+                             std::to_string(request->ids(i)));
+      }
+    }
+    for (std::uint64_t id : request->ids())
+      world.remove_body(body_id(id));
+    return Status::ok();
+  });
+  if (!applied)
+    return grpc::Status(
+        missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INVALID_ARGUMENT,
+        applied.message());
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::GetBodies(grpc::ServerContext*, const v1::GetBodiesRequest* request,
+                                     v1::GetBodiesResponse* response) {
+  bool missing = false;
+  const Status read = host_.apply([&](World& world) {
+    std::vector<BodyId> ids;
+    if (request->ids_size() == 0) {
+      for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
+        if (world.id_at(slot).is_valid()) ids.push_back(world.id_at(slot));
+    } else {
+      for (int i = 0; i < request->ids_size(); ++i) {
+        const BodyId id = body_id(request->ids(i));
+        if (!world.contains(id)) {
+          missing = true;
+          return Status::error("ids[" + std::to_string(i) + "]: no body " +
+                               std::to_string(request->ids(i)));
+        }
+        ids.push_back(id);
+      }
+    }
+    response->set_step(world.step_count());
+    for (BodyId id : ids) {
+      const Body& body = *world.body(id);
+      describe(id, body, response->add_descriptions());
+      v1::BodyState* state = response->add_states();
+      state->set_id(wire_id(id));
+      auto set = [](const Vec3& v, v1::Vec3* out) {
+        out->set_x(v.x());
+        out->set_y(v.y());
+        out->set_z(v.z());
+      };
+      set(body.position, state->mutable_position());
+      state->mutable_orientation()->set_w(body.orientation.w());
+      state->mutable_orientation()->set_x(body.orientation.x());
+      state->mutable_orientation()->set_y(body.orientation.y());
+      state->mutable_orientation()->set_z(body.orientation.z());
+      set(body.linear_velocity, state->mutable_linear_velocity());
+      set(body.angular_velocity, state->mutable_angular_velocity());
+      state->set_asleep(body.asleep);
+    }
+    return Status::ok();
+  });
+  if (!read)
+    return grpc::Status(missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INTERNAL,
+                        read.message());
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::Control(grpc::ServerContext*, const v1::ControlRequest* request,
+                                   v1::ControlResponse* response) {
+  const v1::RunSettings& settings = request->settings();
+  // Checked before anything changes, so a refused request changes nothing.
+  if (settings.has_dt() && !(settings.dt() > 0 && std::isfinite(settings.dt())))
+    return invalid("settings.dt: must be finite and > 0");
+  if (settings.has_real_time_factor() &&
+      !(settings.real_time_factor() >= 0 && std::isfinite(settings.real_time_factor())))
+    return invalid("settings.real_time_factor: must be finite and >= 0");
+  if (settings.has_substeps() || settings.solver() != v1::SOLVER_KIND_UNSPECIFIED ||
+      settings.has_gravity())
+    return grpc::Status(grpc::StatusCode::UNIMPLEMENTED,
+                        "settings: only dt and real_time_factor can be changed yet");
+  if (request->action_case() == v1::ControlRequest::kReset)
+    return grpc::Status(grpc::StatusCode::UNIMPLEMENTED, "reset: not yet");
+  if (settings.has_dt()) host_.set_dt(settings.dt());
+  if (settings.has_real_time_factor()) host_.set_real_time_factor(settings.real_time_factor());
+  switch (request->action_case()) {
+    case v1::ControlRequest::kPlay:
+      if (request->play()) host_.play();
+      break;
+    case v1::ControlRequest::kPause:
+      if (request->pause()) host_.pause();
+      break;
+    case v1::ControlRequest::kStep:
+      host_.step(request->step());
+      break;
+    default:
+      break;
+  }
+  const HostStatus status = host_.status();
+  response->set_running(status.running);
+  response->set_step(status.step);
+  settings_to_proto(status, nullptr, response->mutable_settings());
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::GetInfo(grpc::ServerContext*, const v1::GetInfoRequest*,
+                                   v1::GetInfoResponse* response) {
+  const HostStatus status = host_.status();
+  response->set_version(TUMBLE_VERSION);
+  response->set_step(status.step);
+  response->set_time(status.time);
+  response->set_body_count(static_cast<std::uint32_t>(status.bodies));
+  response->set_running(status.running);
+  settings_to_proto(status, nullptr, response->mutable_settings());
+  stats_to_proto(status.last_step, response->mutable_last_step());
+  response->set_subscribers(static_cast<std::uint32_t>(status.subscribers));
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
+                                        const v1::StreamFramesRequest* request,
+                                        grpc::ServerWriter<v1::Frame>* writer) {
+  if (!(request->max_rate() >= 0) || !std::isfinite(request->max_rate()))
+    return invalid("max_rate: must be finite and >= 0");
+  FrameOptions options;
+  options.velocities = request->velocities();
+  options.contacts = request->contacts();
+  options.stats = request->stats();
+  options.ids.assign(request->ids().begin(), request->ids().end());
+  std::sort(options.ids.begin(), options.ids.end());
+  const auto min_interval = std::chrono::duration<double>(
+      request->max_rate() > 0 ? 1 / request->max_rate() : 0.0);
+
+  std::shared_ptr<FrameMailbox> mailbox = host_.subscribe();
+  std::vector<std::uint64_t> known;  // ids this subscriber has descriptions of, sorted
+  std::uint64_t dropped = 0;
+  auto last_sent = std::chrono::steady_clock::time_point{};
+  grpc::Status result = grpc::Status::OK;
+  while (!context->IsCancelled() && !shutting_down_) {
+    auto delivery = mailbox->take(std::chrono::milliseconds(100));
+    if (!delivery) continue;
+    dropped += delivery->dropped;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_sent < min_interval) {
+      ++dropped;  // over this subscriber's rate
+      continue;
+    }
+    const FrameData& data = *delivery->frame;
+    v1::Frame frame;
+    frame_to_proto(data, options, &frame);
+    frame.set_dropped(dropped);
+    // Bodies new to this subscriber get their descriptions; vanished ones are listed.
+    std::vector<std::uint64_t> current(frame.ids().begin(), frame.ids().end());
+    std::sort(current.begin(), current.end());
+    std::vector<std::uint64_t> added, removed;
+    std::set_difference(current.begin(), current.end(), known.begin(), known.end(),
+                        std::back_inserter(added));
+    std::set_difference(known.begin(), known.end(), current.begin(), current.end(),
+                        std::back_inserter(removed));
+    if (!added.empty()) {
+      host_.apply([&](World& world) {
+        for (std::uint64_t wire : added)
+          if (const Body* body = world.body(body_id(wire)))
+            describe(body_id(wire), *body, frame.add_added());
+        return Status::ok();
+      });
+    }
+    for (std::uint64_t wire : removed)
+      frame.add_removed(wire);
+    known = std::move(current);
+    if (!writer->Write(frame)) break;  // the client went away
+    dropped = 0;
+    last_sent = now;
+  }
+  host_.unsubscribe(mailbox);
+  return result;
+}
+
+}  // namespace tumble::server

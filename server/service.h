@@ -1,0 +1,46 @@
+// The gRPC World service over a WorldHost. Every RPC that changes the world runs as one host
+// command, so it is applied between two steps, all or nothing; refusals carry the status code
+// and a message naming the field.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <atomic>
+#include <string>
+
+#include "tumble/v1/world.grpc.pb.h"
+#include "world_host.h"
+
+namespace tumble::server {
+
+struct ServiceLimits {
+  std::size_t max_bodies = 100000;  // spawning past this is RESOURCE_EXHAUSTED
+};
+
+class WorldService final : public v1::World::Service {
+ public:
+  WorldService(WorldHost& host, ServiceLimits limits);
+
+  grpc::Status SpawnBodies(grpc::ServerContext*, const v1::SpawnBodiesRequest*,
+                           v1::SpawnBodiesResponse*) override;
+  grpc::Status RemoveBodies(grpc::ServerContext*, const v1::RemoveBodiesRequest*,
+                            v1::RemoveBodiesResponse*) override;
+  grpc::Status GetBodies(grpc::ServerContext*, const v1::GetBodiesRequest*,
+                         v1::GetBodiesResponse*) override;
+  grpc::Status Control(grpc::ServerContext*, const v1::ControlRequest*,
+                       v1::ControlResponse*) override;
+  grpc::Status GetInfo(grpc::ServerContext*, const v1::GetInfoRequest*,
+                       v1::GetInfoResponse*) override;
+  grpc::Status StreamFrames(grpc::ServerContext*, const v1::StreamFramesRequest*,
+                            grpc::ServerWriter<v1::Frame>*) override;
+
+  // Ends every stream (they return CANCELLED-free OK after their last frame).
+  void shut_down() { shutting_down_ = true; }
+
+ private:
+  WorldHost& host_;
+  ServiceLimits limits_;
+  std::atomic<bool> shutting_down_{false};
+};
+
+}  // namespace tumble::server

@@ -1,0 +1,158 @@
+// The gRPC service through an in-process channel: spawning, removing, reading, control and the
+// frame stream; bad input is refused with the right code and a message naming the field, and
+// leaves the world as it was.
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "scene_runner.h"
+#include "service.h"
+
+namespace tumble::server {
+namespace {
+
+using namespace std::chrono_literals;
+
+class ServiceTest : public ::testing::Test {
+ protected:
+  ServiceTest()
+      : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0), service_(host_, {.max_bodies = 100}) {
+    grpc::ServerBuilder builder;
+    builder.RegisterService(&service_);
+    server_ = builder.BuildAndStart();
+    stub_ = v1::World::NewStub(server_->InProcessChannel(grpc::ChannelArguments()));
+  }
+  ~ServiceTest() override {
+    service_.shut_down();
+    server_->Shutdown();
+  }
+
+  std::uint32_t body_count() {
+    grpc::ClientContext context;
+    v1::GetInfoResponse info;
+    EXPECT_TRUE(stub_->GetInfo(&context, {}, &info).ok());
+    return info.body_count();
+  }
+
+  static v1::BodySpec ball(double z) {
+    v1::BodySpec spec;
+    spec.mutable_shape()->mutable_sphere()->set_radius(0.25);
+    spec.mutable_position()->set_z(z);
+    return spec;
+  }
+
+  WorldHost host_;
+  WorldService service_;
+  std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<v1::World::Stub> stub_;
+};
+
+TEST_F(ServiceTest, SpawnReadAndRemove) {
+  v1::SpawnBodiesRequest request;
+  for (int i = 0; i < 3; ++i)
+    *request.add_bodies() = ball(10 + i);
+  v1::SpawnBodiesResponse spawned;
+  grpc::ClientContext spawn_context;
+  ASSERT_TRUE(stub_->SpawnBodies(&spawn_context, request, &spawned).ok());
+  ASSERT_EQ(spawned.ids_size(), 3);
+  EXPECT_EQ(body_count(), 12u);
+
+  v1::GetBodiesRequest get;
+  get.add_ids(spawned.ids(1));
+  v1::GetBodiesResponse bodies;
+  grpc::ClientContext get_context;
+  ASSERT_TRUE(stub_->GetBodies(&get_context, get, &bodies).ok());
+  ASSERT_EQ(bodies.states_size(), 1);
+  EXPECT_EQ(bodies.states(0).position().z(), 11);
+  EXPECT_EQ(bodies.descriptions(0).shape().sphere().radius(), 0.25);
+
+  v1::RemoveBodiesRequest remove;
+  remove.add_ids(spawned.ids(0));
+  remove.add_ids(spawned.ids(2));
+  grpc::ClientContext remove_context;
+  v1::RemoveBodiesResponse removed;
+  ASSERT_TRUE(stub_->RemoveBodies(&remove_context, remove, &removed).ok());
+  EXPECT_EQ(body_count(), 10u);
+}
+
+TEST_F(ServiceTest, BadInputIsRefusedByFieldAndChangesNothing) {
+  const std::uint32_t before = body_count();
+  {  // one bad body refuses the batch
+    v1::SpawnBodiesRequest request;
+    *request.add_bodies() = ball(3);
+    *request.add_bodies() = ball(4);
+    request.mutable_bodies(1)->mutable_orientation()->set_w(0);  // the zero quaternion
+    request.mutable_bodies(1)->mutable_orientation()->set_x(0);
+    grpc::ClientContext context;
+    v1::SpawnBodiesResponse response;
+    const grpc::Status status = stub_->SpawnBodies(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(status.error_message().rfind("bodies[1].orientation:", 0), 0u)
+        << status.error_message();
+  }
+  {  // over the body limit
+    v1::SpawnBodiesRequest request;
+    for (int i = 0; i < 100; ++i)
+      *request.add_bodies() = ball(3 + i);
+    grpc::ClientContext context;
+    v1::SpawnBodiesResponse response;
+    EXPECT_EQ(stub_->SpawnBodies(&context, request, &response).error_code(),
+              grpc::StatusCode::RESOURCE_EXHAUSTED);
+  }
+  {  // one unknown id refuses the whole removal
+    v1::RemoveBodiesRequest request;
+    request.add_ids(wire_id(host_.status().bodies > 0 ? BodyId{1, 0} : BodyId{}));
+    request.add_ids(wire_id(BodyId{999, 0}));
+    grpc::ClientContext context;
+    v1::RemoveBodiesResponse response;
+    const grpc::Status status = stub_->RemoveBodies(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_EQ(status.error_message().rfind("ids[1]:", 0), 0u) << status.error_message();
+  }
+  {  // control settings are checked before anything changes
+    v1::ControlRequest request;
+    request.mutable_settings()->set_dt(-1);
+    request.set_step(5);
+    grpc::ClientContext context;
+    v1::ControlResponse response;
+    EXPECT_EQ(stub_->Control(&context, request, &response).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(host_.status().step, 0u);
+  }
+  EXPECT_EQ(body_count(), before);
+}
+
+TEST_F(ServiceTest, StreamDescribesBodiesThenSendsPoses) {
+  v1::StreamFramesRequest request;
+  request.set_stats(true);
+  grpc::ClientContext context;
+  auto reader = stub_->StreamFrames(&context, request);
+  // The stream subscribes when the server runs the call: step only once it has.
+  for (int i = 0; i < 500 && host_.status().subscribers == 0; ++i)
+    std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(host_.status().subscribers, 1u);
+  {
+    v1::ControlRequest control;
+    control.set_step(20);
+    grpc::ClientContext control_context;
+    v1::ControlResponse response;
+    ASSERT_TRUE(stub_->Control(&control_context, control, &response).ok());
+  }
+  v1::Frame first;
+  ASSERT_TRUE(reader->Read(&first));
+  EXPECT_EQ(first.ids_size(), 9);
+  EXPECT_EQ(first.added_size(), 9);  // every body described in the first frame
+  EXPECT_EQ(first.positions_size(), 27);
+  EXPECT_TRUE(first.has_stats());
+  // Later frames carry poses only; the step count reaches 20.
+  v1::Frame frame = first;
+  while (frame.step() < 20 && reader->Read(&frame))
+    EXPECT_EQ(frame.added_size(), 0);
+  EXPECT_EQ(frame.step(), 20u);
+  context.TryCancel();
+  reader->Finish();
+}
+
+}  // namespace
+}  // namespace tumble::server
