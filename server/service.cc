@@ -76,9 +76,8 @@ grpc::Status WorldService::RemoveBodies(grpc::ServerContext*,
     return Status::ok();
   });
   if (!applied)
-    return grpc::Status(
-        missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INVALID_ARGUMENT,
-        applied.message());
+    return grpc::Status(missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INVALID_ARGUMENT,
+                        applied.message());
   return grpc::Status::OK;
 }
 
@@ -191,8 +190,8 @@ grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
   options.stats = request->stats();
   options.ids.assign(request->ids().begin(), request->ids().end());
   std::sort(options.ids.begin(), options.ids.end());
-  const auto min_interval = std::chrono::duration<double>(
-      request->max_rate() > 0 ? 1 / request->max_rate() : 0.0);
+  const auto min_interval =
+      std::chrono::duration<double>(request->max_rate() > 0 ? 1 / request->max_rate() : 0.0);
 
   std::shared_ptr<FrameMailbox> mailbox = host_.subscribe();
   std::vector<std::uint64_t> known;  // ids this subscriber has descriptions of, sorted

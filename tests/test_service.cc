@@ -17,7 +17,8 @@ using namespace std::chrono_literals;
 class ServiceTest : public ::testing::Test {
  protected:
   ServiceTest()
-      : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0), service_(host_, {.max_bodies = 100}) {
+      : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0),
+        service_(host_, {.max_bodies = 100}) {
     grpc::ServerBuilder builder;
     builder.RegisterService(&service_);
     server_ = builder.BuildAndStart();
