@@ -77,8 +77,8 @@ int main(int argc, char** argv) {
   }
   // With port 0 the system picks one: print the one in use, for scripts and tests to read.
   const std::string bound = listen.substr(0, listen.rfind(':')) + ":" + std::to_string(port);
-  std::printf("tumble-server: scene %s, %zu bodies, listening on %s\n",
-              scene.value().name.c_str(), host.status().bodies, bound.c_str());
+  std::printf("tumble-server: scene %s, %zu bodies, listening on %s\n", scene.value().name.c_str(),
+              host.status().bodies, bound.c_str());
   std::fflush(stdout);
   if (!paused) host.play();
 

@@ -13,10 +13,23 @@ grpc::Status invalid(const std::string& message) {
   return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message);
 }
 
-void settings_to_proto(const HostStatus& status, const World* world, v1::RunSettings* out) {
+// The bodies named by `wire_ids`, or the first unknown one's position in the list.
+Status find_bodies(const World& world,
+                   const google::protobuf::RepeatedField<std::uint64_t>& wire_ids,
+                   std::vector<BodyId>* ids) {
+  for (int i = 0; i < wire_ids.size(); ++i) {
+    const BodyId id = body_id(wire_ids[i]);
+    if (!world.contains(id))
+      return Status::error("ids[" + std::to_string(i) + "]: no body " +
+                           std::to_string(wire_ids[i]));
+    ids->push_back(id);
+  }
+  return Status::ok();
+}
+
+void settings_to_proto(const HostStatus& status, v1::RunSettings* out) {
   out->set_dt(status.dt);
   out->set_real_time_factor(status.real_time_factor);
-  (void)world;
 }
 
 }  // namespace
@@ -64,15 +77,13 @@ grpc::Status WorldService::RemoveBodies(grpc::ServerContext*,
   bool missing = false;
   const Status applied = host_.apply([&](World& world) {
     // Every id is checked before anything is removed: all or nothing.
-    for (int i = 0; i < request->ids_size(); ++i) {
-      if (!world.contains(body_id(request->ids(i)))) {
-        missing = true;
-        return Status::error("ids[" + std::to_string(i) + "]: no body " +
-                             std::to_string(request->ids(i)));
-      }
+    std::vector<BodyId> ids;
+    if (Status found = find_bodies(world, request->ids(), &ids); !found) {
+      missing = true;
+      return found;
     }
-    for (std::uint64_t id : request->ids())
-      world.remove_body(body_id(id));
+    for (BodyId id : ids)
+      world.remove_body(id);
     return Status::ok();
   });
   if (!applied)
@@ -89,16 +100,9 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext*, const v1::GetBodiesRe
     if (request->ids_size() == 0) {
       for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
         if (world.id_at(slot).is_valid()) ids.push_back(world.id_at(slot));
-    } else {
-      for (int i = 0; i < request->ids_size(); ++i) {
-        const BodyId id = body_id(request->ids(i));
-        if (!world.contains(id)) {
-          missing = true;
-          return Status::error("ids[" + std::to_string(i) + "]: no body " +
-                               std::to_string(request->ids(i)));
-        }
-        ids.push_back(id);
-      }
+    } else if (Status found = find_bodies(world, request->ids(), &ids); !found) {
+      missing = true;
+      return found;
     }
     response->set_step(world.step_count());
     for (BodyId id : ids) {
@@ -161,7 +165,7 @@ grpc::Status WorldService::Control(grpc::ServerContext*, const v1::ControlReques
   const HostStatus status = host_.status();
   response->set_running(status.running);
   response->set_step(status.step);
-  settings_to_proto(status, nullptr, response->mutable_settings());
+  settings_to_proto(status, response->mutable_settings());
   return grpc::Status::OK;
 }
 
@@ -173,7 +177,7 @@ grpc::Status WorldService::GetInfo(grpc::ServerContext*, const v1::GetInfoReques
   response->set_time(status.time);
   response->set_body_count(static_cast<std::uint32_t>(status.bodies));
   response->set_running(status.running);
-  settings_to_proto(status, nullptr, response->mutable_settings());
+  settings_to_proto(status, response->mutable_settings());
   stats_to_proto(status.last_step, response->mutable_last_step());
   response->set_subscribers(static_cast<std::uint32_t>(status.subscribers));
   return grpc::Status::OK;

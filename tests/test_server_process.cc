@@ -58,7 +58,8 @@ TEST(ServerProcess, ServesOverLoopbackAndStopsOnSigterm) {
   address.erase(address.find_last_not_of("\n") + 1);
 
   auto channel = grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
-  ASSERT_TRUE(channel->WaitForConnected(std::chrono::system_clock::now() + std::chrono::seconds(10)));
+  ASSERT_TRUE(
+      channel->WaitForConnected(std::chrono::system_clock::now() + std::chrono::seconds(10)));
   auto stub = tumble::v1::World::NewStub(channel);
   {
     grpc::ClientContext context;
