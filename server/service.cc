@@ -5,6 +5,8 @@
 #include <set>
 
 #include "convert.h"
+#include "scenes/scene.h"
+#include "scenes/standard.h"
 
 namespace tumble::server {
 namespace {
@@ -129,6 +131,43 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext*, const v1::GetBodiesRe
   if (!read)
     return grpc::Status(missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INTERNAL,
                         read.message());
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::LoadScene(grpc::ServerContext*, const v1::LoadSceneRequest* request,
+                                     v1::LoadSceneResponse* response) {
+  Result<SceneDef> scene = Status::error("source: required (scene_json or builtin)");
+  if (request->has_scene_json())
+    scene = parse_scene(request->scene_json());
+  else if (request->has_builtin())
+    scene = standard_scene(request->builtin());
+  if (!scene) {
+    const char* field = request->has_scene_json() ? "scene_json: "
+                        : request->has_builtin()  ? "builtin: "
+                                                  : "";
+    return invalid(field + scene.error());
+  }
+  if (scene.value().bodies.size() > limits_.max_bodies)
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        "scene: " + std::to_string(scene.value().bodies.size()) +
+                            " bodies, more than the " + std::to_string(limits_.max_bodies) +
+                            " allowed");
+  // Built before the world is touched: a scene that cannot be made changes nothing.
+  Result<World> made = make_world(scene.value());
+  if (!made) return invalid("scene: " + made.error());
+  const Status replaced = host_.apply([&](World& world) {
+    const int threads = world.settings().threads;  // the server's choice, not the scene's
+    world = std::move(made).value();
+    WorldSettings settings = world.settings();
+    settings.threads = threads;
+    if (Status s = world.set_settings(settings); !s) return s;
+    for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
+      if (world.id_at(slot).is_valid()) response->add_ids(wire_id(world.id_at(slot)));
+    return Status::ok();
+  });
+  if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
+  host_.set_dt(scene.value().dt);
+  response->set_name(scene.value().name);
   return grpc::Status::OK;
 }
 

@@ -27,6 +27,8 @@ class WorldService final : public v1::World::Service {
                             v1::RemoveBodiesResponse*) override;
   grpc::Status GetBodies(grpc::ServerContext*, const v1::GetBodiesRequest*,
                          v1::GetBodiesResponse*) override;
+  grpc::Status LoadScene(grpc::ServerContext*, const v1::LoadSceneRequest*,
+                         v1::LoadSceneResponse*) override;
   grpc::Status Control(grpc::ServerContext*, const v1::ControlRequest*,
                        v1::ControlResponse*) override;
   grpc::Status GetInfo(grpc::ServerContext*, const v1::GetInfoRequest*,

@@ -115,6 +115,8 @@ void WorldHost::apply_pending() {
     const Status result = command.change(world_);
     if (result) ++catalogue_;
     status_.bodies = world_.body_count();
+    status_.step = world_.step_count();  // a command may have replaced the world
+    status_.time = world_.time();
     command.done.set_value(result);
   }
 }

@@ -124,6 +124,30 @@ TEST_F(ServiceTest, BadInputIsRefusedByFieldAndChangesNothing) {
   EXPECT_EQ(body_count(), before);
 }
 
+TEST_F(ServiceTest, LoadSceneReplacesTheWorldOrNothing) {
+  {
+    v1::LoadSceneRequest request;
+    request.set_scene_json(R"({"name": "bad", "bodies": [{"shape": "box", "size": [1, -1, 1]}]})");
+    grpc::ClientContext context;
+    v1::LoadSceneResponse response;
+    const grpc::Status status = stub_->LoadScene(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(status.error_message().find("bodies[0].size[1]"), std::string::npos)
+        << status.error_message();
+    EXPECT_EQ(body_count(), 9u);
+  }
+  {
+    v1::LoadSceneRequest request;
+    request.set_builtin("pyramid:5");
+    grpc::ClientContext context;
+    v1::LoadSceneResponse response;
+    ASSERT_TRUE(stub_->LoadScene(&context, request, &response).ok());
+    EXPECT_EQ(response.name(), "pyramid-5");
+    EXPECT_EQ(response.ids_size(), 16);  // ground and 15 boxes
+    EXPECT_EQ(body_count(), 16u);
+  }
+}
+
 TEST_F(ServiceTest, StreamDescribesBodiesThenSendsPoses) {
   v1::StreamFramesRequest request;
   request.set_stats(true);
