@@ -133,8 +133,17 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
 Status World::remove_body(BodyId id) {
   if (!contains(id)) return Status::error("body: no body with this id");
   Slot& slot = bodies_[id.index];
-  // Whatever rested on it must fall: wake every sleeping island near it.
-  const Aabb near = transform_aabb(slot.body.shape.local_bounds(), slot.body.pose())
+  wake_around(slot.body);  // whatever rested on it must fall
+  slot.alive = false;
+  ++slot.generation;
+  slot.body = Body();
+  free_slots_.push_back(id.index);
+  --live_count_;
+  return Status::ok();
+}
+
+void World::wake_around(const Body& body) {
+  const Aabb near = transform_aabb(body.shape.local_bounds(), body.pose())
                         .expanded(settings_.solver.speculative_distance + 0.05);
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     const Body& other = bodies_[i].body;
@@ -142,11 +151,63 @@ Status World::remove_body(BodyId id) {
         transform_aabb(other.shape.local_bounds(), other.pose()).overlaps(near))
       wake_island(other.sleep_island);
   }
-  slot.alive = false;
-  ++slot.generation;
-  slot.body = Body();
-  free_slots_.push_back(id.index);
-  --live_count_;
+}
+
+Status World::check_motion(BodyId id, const BodyMotion& motion) const {
+  if (!contains(id)) return Status::error("body: no body with this id");
+  if (motion.position && !is_finite(*motion.position))
+    return Status::error("position: must be finite");
+  if (motion.orientation) {
+    const double norm = motion.orientation->norm();
+    if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
+      return Status::error("orientation: must be a unit quaternion");
+  }
+  const bool is_static = bodies_[id.index].body.is_static();
+  for (const auto& [velocity, name] : {std::pair{&motion.linear_velocity, "linear_velocity"},
+                                       {&motion.angular_velocity, "angular_velocity"}}) {
+    if (!*velocity) continue;
+    if (!is_finite(**velocity)) return Status::error(std::string(name) + ": must be finite");
+    if (is_static && !(*velocity)->isZero(0))
+      return Status::error(std::string(name) + ": a static body does not move");
+  }
+  return Status::ok();
+}
+
+Status World::set_motion(BodyId id, const BodyMotion& motion) {
+  if (Status s = check_motion(id, motion); !s) return s;
+  Body& body = bodies_[id.index].body;
+  if (body.is_static()) wake_around(body);  // what rested on it where it was
+  if (motion.position) body.position = *motion.position;
+  if (motion.orientation) body.orientation = motion.orientation->normalized();
+  if (!body.is_static()) {
+    if (motion.linear_velocity) body.linear_velocity = *motion.linear_velocity;
+    if (motion.angular_velocity) body.angular_velocity = *motion.angular_velocity;
+  }
+  body.update_world_inertia();
+  if (body.is_static())
+    wake_around(body);  // and what it now touches
+  else if (body.asleep)
+    wake_island(body.sleep_island);
+  body.sleep_timer = 0;
+  return Status::ok();
+}
+
+Status World::check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) const {
+  if (!contains(id)) return Status::error("body: no body with this id");
+  if (bodies_[id.index].body.is_static()) return Status::error("body: a static body does not move");
+  if (!is_finite(impulse)) return Status::error("impulse: must be finite");
+  if (point != nullptr && !is_finite(*point)) return Status::error("point: must be finite");
+  return Status::ok();
+}
+
+Status World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point) {
+  if (Status s = check_impulse(id, impulse, point); !s) return s;
+  Body& body = bodies_[id.index].body;
+  if (body.asleep) wake_island(body.sleep_island);
+  body.sleep_timer = 0;
+  body.linear_velocity += body.inverse_mass * impulse;
+  if (point != nullptr)
+    body.angular_velocity += body.inverse_inertia_world * (*point - body.position).cross(impulse);
   return Status::ok();
 }
 

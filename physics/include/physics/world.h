@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -42,6 +43,14 @@ struct Contact {
   ContactManifold manifold;
 };
 
+// A change of a body's pose or velocities; absent fields stay as they are.
+struct BodyMotion {
+  std::optional<Vec3> position;  // m, centre of mass
+  std::optional<Quat> orientation;
+  std::optional<Vec3> linear_velocity;   // m/s
+  std::optional<Vec3> angular_velocity;  // rad/s, world
+};
+
 struct StepScratch;
 
 class World {
@@ -59,6 +68,16 @@ class World {
   Status remove_body(BodyId id);
   // Wakes a sleeping body and the island it fell asleep with.
   Status wake(BodyId id);
+  // Moves a body or changes its velocities (the fields given; a static body takes a pose only).
+  // Refused, changing nothing, for an unknown id, a non-finite value or a quaternion not within
+  // 1e-3 of unit length; check_motion says so without changing anything. The body wakes, and
+  // so do sleepers around a static body that moved.
+  Status check_motion(BodyId id, const BodyMotion& motion) const;
+  Status set_motion(BodyId id, const BodyMotion& motion);
+  // An impulse (N s, world) at a point (m, world; the centre of mass when null) of a dynamic
+  // body, applied now to its velocities; the body wakes.
+  Status check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) const;
+  Status apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point);
 
   bool contains(BodyId id) const;
   // The body, or null when `id` is stale or was never made.
@@ -99,6 +118,8 @@ class World {
     bool alive = false;
   };
   std::uint32_t wake_island(std::uint32_t island);
+  // Wakes every sleeping island whose bounds come near `body` (it moved or is going away).
+  void wake_around(const Body& body);
   // After the narrow phase: sleepers touched by moving bodies wake with their islands; returns
   // how many woke.
   std::uint32_t wake_touched();
