@@ -134,6 +134,84 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext*, const v1::GetBodiesRe
   return grpc::Status::OK;
 }
 
+namespace {
+
+Vec3 vec(const v1::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+// Checks every entry with `check`, then applies every entry with `apply`, in one host command:
+// all or nothing. An unknown id is NOT_FOUND, any other refusal INVALID_ARGUMENT; the message
+// starts with the entry ("updates[2].orientation: ...").
+template <class Entries, class Check, class Apply>
+grpc::Status apply_batch(WorldHost& host, const char* name, const Entries& entries, Check check,
+                         Apply apply) {
+  bool missing = false;
+  const Status applied = host.apply([&](World& world) {
+    for (int i = 0; i < entries.size(); ++i) {
+      if (!world.contains(body_id(entries[i].id()))) {
+        missing = true;
+        return Status::error(std::string(name) + "[" + std::to_string(i) + "].id: no body " +
+                             std::to_string(entries[i].id()));
+      }
+      if (Status s = check(world, entries[i]); !s)
+        return s.within(std::string(name) + "[" + std::to_string(i) + "].");
+    }
+    for (const auto& entry : entries)
+      apply(world, entry);
+    return Status::ok();
+  });
+  if (!applied)
+    return grpc::Status(missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INVALID_ARGUMENT,
+                        applied.message());
+  return grpc::Status::OK;
+}
+
+BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
+  BodyMotion motion;
+  if (update.has_position()) motion.position = vec(update.position());
+  if (update.has_orientation()) {
+    const v1::Quat& q = update.orientation();
+    motion.orientation = Quat(q.w(), q.x(), q.y(), q.z());
+  }
+  if (update.has_linear_velocity()) motion.linear_velocity = vec(update.linear_velocity());
+  if (update.has_angular_velocity()) motion.angular_velocity = vec(update.angular_velocity());
+  return motion;
+}
+
+}  // namespace
+
+grpc::Status WorldService::SetBodyState(grpc::ServerContext*,
+                                        const v1::SetBodyStateRequest* request,
+                                        v1::SetBodyStateResponse*) {
+  return apply_batch(
+      host_, "updates", request->updates(),
+      [](const World& world, const v1::BodyStateUpdate& u) {
+        return world.check_motion(body_id(u.id()), motion_from_proto(u));
+      },
+      [](World& world, const v1::BodyStateUpdate& u) {
+        world.set_motion(body_id(u.id()), motion_from_proto(u));
+      });
+}
+
+grpc::Status WorldService::ApplyImpulse(grpc::ServerContext*,
+                                        const v1::ApplyImpulseRequest* request,
+                                        v1::ApplyImpulseResponse*) {
+  auto point_of = [](const v1::Impulse& i) {
+    return i.has_point() ? std::optional<Vec3>(vec(i.point())) : std::nullopt;
+  };
+  return apply_batch(
+      host_, "impulses", request->impulses(),
+      [&](const World& world, const v1::Impulse& i) {
+        const std::optional<Vec3> point = point_of(i);
+        return world.check_impulse(body_id(i.id()), vec(i.impulse()), point ? &*point : nullptr);
+      },
+      [&](World& world, const v1::Impulse& i) {
+        const std::optional<Vec3> point = point_of(i);
+        world.apply_impulse(body_id(i.id()), vec(i.impulse()), point ? &*point : nullptr);
+      });
+}
+
 grpc::Status WorldService::LoadScene(grpc::ServerContext*, const v1::LoadSceneRequest* request,
                                      v1::LoadSceneResponse* response) {
   Result<SceneDef> scene = Status::error("source: required (scene_json or builtin)");

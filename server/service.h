@@ -27,6 +27,10 @@ class WorldService final : public v1::World::Service {
                             v1::RemoveBodiesResponse*) override;
   grpc::Status GetBodies(grpc::ServerContext*, const v1::GetBodiesRequest*,
                          v1::GetBodiesResponse*) override;
+  grpc::Status SetBodyState(grpc::ServerContext*, const v1::SetBodyStateRequest*,
+                            v1::SetBodyStateResponse*) override;
+  grpc::Status ApplyImpulse(grpc::ServerContext*, const v1::ApplyImpulseRequest*,
+                            v1::ApplyImpulseResponse*) override;
   grpc::Status LoadScene(grpc::ServerContext*, const v1::LoadSceneRequest*,
                          v1::LoadSceneResponse*) override;
   grpc::Status Control(grpc::ServerContext*, const v1::ControlRequest*,

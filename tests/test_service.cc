@@ -124,6 +124,56 @@ TEST_F(ServiceTest, BadInputIsRefusedByFieldAndChangesNothing) {
   EXPECT_EQ(body_count(), before);
 }
 
+TEST_F(ServiceTest, SetStateAndImpulsesApplyWholeBatchesOnly) {
+  auto state_of = [&](std::uint64_t id) {
+    v1::GetBodiesRequest get;
+    get.add_ids(id);
+    v1::GetBodiesResponse bodies;
+    grpc::ClientContext context;
+    EXPECT_TRUE(stub_->GetBodies(&context, get, &bodies).ok());
+    return bodies.states(0);
+  };
+  const std::uint64_t a = wire_id(BodyId{1, 0}), b = wire_id(BodyId{2, 0});
+  {
+    v1::SetBodyStateRequest request;
+    auto* first = request.add_updates();
+    first->set_id(a);
+    first->mutable_position()->set_z(42);
+    auto* second = request.add_updates();
+    second->set_id(b);
+    second->mutable_orientation()->set_w(3);  // not a unit quaternion: the batch is refused
+    grpc::ClientContext context;
+    v1::SetBodyStateResponse response;
+    const grpc::Status status = stub_->SetBodyState(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(status.error_message().rfind("updates[1].orientation:", 0), 0u)
+        << status.error_message();
+    EXPECT_NE(state_of(a).position().z(), 42);  // the first update was not applied either
+    second->mutable_orientation()->set_w(1);
+    grpc::ClientContext again;
+    ASSERT_TRUE(stub_->SetBodyState(&again, request, &response).ok());
+    EXPECT_EQ(state_of(a).position().z(), 42);
+  }
+  {
+    v1::ApplyImpulseRequest request;
+    auto* push = request.add_impulses();
+    push->set_id(b);
+    push->mutable_impulse()->set_x(3);  // 3 N s on a 1 kg box
+    grpc::ClientContext context;
+    v1::ApplyImpulseResponse response;
+    ASSERT_TRUE(stub_->ApplyImpulse(&context, request, &response).ok());
+    EXPECT_EQ(state_of(b).linear_velocity().x(), 3);
+    push->set_id(wire_id(BodyId{0, 0}));  // the ground
+    grpc::ClientContext ground;
+    EXPECT_EQ(stub_->ApplyImpulse(&ground, request, &response).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+    push->set_id(wire_id(BodyId{77, 3}));
+    grpc::ClientContext unknown;
+    EXPECT_EQ(stub_->ApplyImpulse(&unknown, request, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+  }
+}
+
 TEST_F(ServiceTest, LoadSceneReplacesTheWorldOrNothing) {
   {
     v1::LoadSceneRequest request;
