@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
   }
 
   server::WorldHost host(std::move(world).value(), scene.value().dt, real_time_factor);
-  server::WorldService service(host, {.max_bodies = max_bodies});
+  server::WorldService service(host, {.max_bodies = max_bodies}, scene.value());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;

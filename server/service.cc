@@ -36,7 +36,32 @@ void settings_to_proto(const HostStatus& status, v1::RunSettings* out) {
 
 }  // namespace
 
-WorldService::WorldService(WorldHost& host, ServiceLimits limits) : host_(host), limits_(limits) {}
+WorldService::WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene)
+    : host_(host), limits_(limits), scene_(std::move(scene)) {}
+
+grpc::Status WorldService::replace_world(const SceneDef& scene, std::vector<std::uint64_t>* ids) {
+  if (scene.bodies.size() > limits_.max_bodies)
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        "scene: " + std::to_string(scene.bodies.size()) +
+                            " bodies, more than the " + std::to_string(limits_.max_bodies) +
+                            " allowed");
+  // Built before the world is touched: a scene that cannot be made changes nothing.
+  Result<World> made = make_world(scene);
+  if (!made) return invalid("scene: " + made.error());
+  const Status replaced = host_.apply([&](World& world) {
+    const int threads = world.settings().threads;  // the server's choice, not the scene's
+    world = std::move(made).value();
+    WorldSettings settings = world.settings();
+    settings.threads = threads;
+    if (Status s = world.set_settings(settings); !s) return s;
+    for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
+      if (world.id_at(slot).is_valid()) ids->push_back(wire_id(world.id_at(slot)));
+    return Status::ok();
+  });
+  if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
+  host_.set_dt(scene.dt);
+  return grpc::Status::OK;
+}
 
 grpc::Status WorldService::SpawnBodies(grpc::ServerContext*, const v1::SpawnBodiesRequest* request,
                                        v1::SpawnBodiesResponse* response) {
@@ -225,26 +250,14 @@ grpc::Status WorldService::LoadScene(grpc::ServerContext*, const v1::LoadSceneRe
                                                   : "";
     return invalid(field + scene.error());
   }
-  if (scene.value().bodies.size() > limits_.max_bodies)
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        "scene: " + std::to_string(scene.value().bodies.size()) +
-                            " bodies, more than the " + std::to_string(limits_.max_bodies) +
-                            " allowed");
-  // Built before the world is touched: a scene that cannot be made changes nothing.
-  Result<World> made = make_world(scene.value());
-  if (!made) return invalid("scene: " + made.error());
-  const Status replaced = host_.apply([&](World& world) {
-    const int threads = world.settings().threads;  // the server's choice, not the scene's
-    world = std::move(made).value();
-    WorldSettings settings = world.settings();
-    settings.threads = threads;
-    if (Status s = world.set_settings(settings); !s) return s;
-    for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
-      if (world.id_at(slot).is_valid()) response->add_ids(wire_id(world.id_at(slot)));
-    return Status::ok();
-  });
-  if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
-  host_.set_dt(scene.value().dt);
+  std::vector<std::uint64_t> ids;
+  if (grpc::Status replaced = replace_world(scene.value(), &ids); !replaced.ok()) return replaced;
+  {
+    std::lock_guard lock(scene_mutex_);
+    scene_ = scene.value();
+  }
+  for (std::uint64_t id : ids)
+    response->add_ids(id);
   response->set_name(scene.value().name);
   return grpc::Status::OK;
 }
@@ -258,12 +271,59 @@ grpc::Status WorldService::Control(grpc::ServerContext*, const v1::ControlReques
   if (settings.has_real_time_factor() &&
       !(settings.real_time_factor() >= 0 && std::isfinite(settings.real_time_factor())))
     return invalid("settings.real_time_factor: must be finite and >= 0");
-  if (settings.has_substeps() || settings.solver() != v1::SOLVER_KIND_UNSPECIFIED ||
-      settings.has_gravity())
-    return grpc::Status(grpc::StatusCode::UNIMPLEMENTED,
-                        "settings: only dt and real_time_factor can be changed yet");
-  if (request->action_case() == v1::ControlRequest::kReset)
-    return grpc::Status(grpc::StatusCode::UNIMPLEMENTED, "reset: not yet");
+  if (settings.has_gravity()) {
+    const v1::Vec3& g = settings.gravity();
+    if (!std::isfinite(g.x()) || !std::isfinite(g.y()) || !std::isfinite(g.z()))
+      return invalid("settings.gravity: must be finite");
+  }
+  std::optional<SolverKind> solver;
+  switch (settings.solver()) {
+    case v1::SOLVER_KIND_UNSPECIFIED:
+      break;
+    case v1::SOLVER_KIND_EXACT:
+      solver = SolverKind::kExact;
+      break;
+    case v1::SOLVER_KIND_PGS:
+      solver = SolverKind::kPgs;
+      break;
+    case v1::SOLVER_KIND_SOFT:
+      solver = SolverKind::kSoft;
+      break;
+    case v1::SOLVER_KIND_AUTO:
+      solver = SolverKind::kAuto;
+      break;
+    default:
+      return invalid("settings.solver: unknown solver " + std::to_string(settings.solver()));
+  }
+  auto changed_settings = [&](WorldSettings next) {
+    if (settings.has_gravity())
+      next.gravity = Vec3(settings.gravity().x(), settings.gravity().y(), settings.gravity().z());
+    if (settings.has_substeps()) next.solver.substeps = settings.substeps();
+    if (solver) next.solver.kind = *solver;
+    return next;
+  };
+  // Checked against the world as it is before the reset below can change anything.
+  const Status acceptable =
+      host_.apply([&](World& world) { return validate(changed_settings(world.settings())); });
+  if (!acceptable) return invalid("settings." + acceptable.message());
+  if (request->action_case() == v1::ControlRequest::kReset && request->reset()) {
+    SceneDef scene;
+    {
+      std::lock_guard lock(scene_mutex_);
+      scene = scene_;
+    }
+    std::vector<std::uint64_t> ids;
+    host_.pause();
+    if (grpc::Status reset = replace_world(scene, &ids); !reset.ok()) return reset;
+  }
+  // The world's own settings change in one command, all or nothing (World::set_settings).
+  WorldSettings now;
+  const Status changed = host_.apply([&](World& world) {
+    if (Status s = world.set_settings(changed_settings(world.settings())); !s) return s;
+    now = world.settings();
+    return Status::ok();
+  });
+  if (!changed) return invalid("settings." + changed.message());
   if (settings.has_dt()) host_.set_dt(settings.dt());
   if (settings.has_real_time_factor()) host_.set_real_time_factor(settings.real_time_factor());
   switch (request->action_case()) {
@@ -282,7 +342,13 @@ grpc::Status WorldService::Control(grpc::ServerContext*, const v1::ControlReques
   const HostStatus status = host_.status();
   response->set_running(status.running);
   response->set_step(status.step);
-  settings_to_proto(status, response->mutable_settings());
+  v1::RunSettings* out = response->mutable_settings();
+  settings_to_proto(status, out);
+  out->set_substeps(now.solver.substeps);
+  out->set_solver(static_cast<v1::SolverKind>(static_cast<int>(now.solver.kind) + 1));
+  out->mutable_gravity()->set_x(now.gravity.x());
+  out->mutable_gravity()->set_y(now.gravity.y());
+  out->mutable_gravity()->set_z(now.gravity.z());
   return grpc::Status::OK;
 }
 

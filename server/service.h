@@ -8,6 +8,9 @@
 #include <atomic>
 #include <string>
 
+#include <mutex>
+
+#include "scenes/scene.h"
 #include "tumble/v1/world.grpc.pb.h"
 #include "world_host.h"
 
@@ -19,7 +22,8 @@ struct ServiceLimits {
 
 class WorldService final : public v1::World::Service {
  public:
-  WorldService(WorldHost& host, ServiceLimits limits);
+  // `scene`: what the host's world was made from, and what Control's reset goes back to.
+  WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene);
 
   grpc::Status SpawnBodies(grpc::ServerContext*, const v1::SpawnBodiesRequest*,
                            v1::SpawnBodiesResponse*) override;
@@ -46,6 +50,10 @@ class WorldService final : public v1::World::Service {
  private:
   WorldHost& host_;
   ServiceLimits limits_;
+  // Builds `scene`'s world and swaps it in between two steps; its body ids into `ids`.
+  grpc::Status replace_world(const SceneDef& scene, std::vector<std::uint64_t>* ids);
+  std::mutex scene_mutex_;
+  SceneDef scene_;  // the last scene loaded
   std::atomic<bool> shutting_down_{false};
 };
 

@@ -18,7 +18,7 @@ class ServiceTest : public ::testing::Test {
  protected:
   ServiceTest()
       : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0),
-        service_(host_, {.max_bodies = 100}) {
+        service_(host_, {.max_bodies = 100}, pile_scene(8)) {
     grpc::ServerBuilder builder;
     builder.RegisterService(&service_);
     server_ = builder.BuildAndStart();
@@ -171,6 +171,46 @@ TEST_F(ServiceTest, SetStateAndImpulsesApplyWholeBatchesOnly) {
     grpc::ClientContext unknown;
     EXPECT_EQ(stub_->ApplyImpulse(&unknown, request, &response).error_code(),
               grpc::StatusCode::NOT_FOUND);
+  }
+}
+
+TEST_F(ServiceTest, ControlChangesSettingsAllOrNothingAndResets) {
+  {
+    v1::ControlRequest request;
+    request.mutable_settings()->set_solver(v1::SOLVER_KIND_SOFT);
+    request.mutable_settings()->mutable_gravity()->set_z(-1);
+    request.mutable_settings()->set_substeps(0);  // refused: nothing changes
+    grpc::ClientContext context;
+    v1::ControlResponse response;
+    const grpc::Status status = stub_->Control(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(status.error_message().find("substeps"), std::string::npos) << status.error_message();
+    request.mutable_settings()->set_substeps(8);
+    grpc::ClientContext again;
+    ASSERT_TRUE(stub_->Control(&again, request, &response).ok());
+    EXPECT_EQ(response.settings().solver(), v1::SOLVER_KIND_SOFT);
+    EXPECT_EQ(response.settings().gravity().z(), -1);
+    EXPECT_EQ(response.settings().substeps(), 8);
+  }
+  {  // run, spawn, then reset: the scene as loaded, at step 0
+    v1::ControlRequest step;
+    step.set_step(5);
+    grpc::ClientContext step_context;
+    v1::ControlResponse response;
+    ASSERT_TRUE(stub_->Control(&step_context, step, &response).ok());
+    ASSERT_TRUE(host_.wait_idle(std::chrono::seconds(30)));
+    v1::SpawnBodiesRequest spawn;
+    *spawn.add_bodies() = ball(9);
+    grpc::ClientContext spawn_context;
+    v1::SpawnBodiesResponse spawned;
+    ASSERT_TRUE(stub_->SpawnBodies(&spawn_context, spawn, &spawned).ok());
+    EXPECT_EQ(body_count(), 10u);
+    v1::ControlRequest reset;
+    reset.set_reset(true);
+    grpc::ClientContext reset_context;
+    ASSERT_TRUE(stub_->Control(&reset_context, reset, &response).ok());
+    EXPECT_EQ(body_count(), 9u);
+    EXPECT_EQ(response.step(), 0u);
   }
 }
 
