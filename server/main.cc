@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   double real_time_factor = 1;
   std::size_t max_bodies = 100000;
   bool paused = false;
+  std::string token;
   app.add_option("--listen", listen, "address to listen on (loopback by default)")
       ->envname("TUMBLE_LISTEN");
   app.add_option("--scene", scene_file, "a scene file (JSON, docs/SCENES.md)")
@@ -38,6 +39,9 @@ int main(int argc, char** argv) {
   app.add_option("--max-bodies", max_bodies, "refuse spawns beyond this many bodies")
       ->envname("TUMBLE_MAX_BODIES");
   app.add_flag("--paused", paused, "start paused (Control play starts it)");
+  app.add_option("--token", token,
+                 "require 'authorization: Bearer TOKEN' on every call (prefer the variable)")
+      ->envname("TUMBLE_TOKEN");
   CLI11_PARSE(app, argc, argv);
 
   // SIGINT and SIGTERM are blocked in every thread (threads inherit the mask) and taken by the
@@ -63,7 +67,7 @@ int main(int argc, char** argv) {
   }
 
   server::WorldHost host(std::move(world).value(), scene.value().dt, real_time_factor);
-  server::WorldService service(host, {.max_bodies = max_bodies}, scene.value());
+  server::WorldService service(host, {.max_bodies = max_bodies, .token = token}, scene.value());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;

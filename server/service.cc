@@ -39,6 +39,24 @@ void settings_to_proto(const HostStatus& status, v1::RunSettings* out) {
 WorldService::WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene)
     : host_(host), limits_(limits), scene_(std::move(scene)) {}
 
+grpc::Status WorldService::authorize(const grpc::ServerContext* context) const {
+  if (limits_.token.empty()) return grpc::Status::OK;
+  const std::string expected = "Bearer " + limits_.token;
+  const auto& metadata = context->client_metadata();
+  const auto found = metadata.find("authorization");
+  bool same = found != metadata.end() && found->second.size() == expected.size();
+  if (same) {
+    // Compared in full whatever the first difference, so timing tells nothing of the token.
+    unsigned char difference = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i)
+      difference |= static_cast<unsigned char>(found->second.data()[i] ^ expected[i]);
+    same = difference == 0;
+  }
+  return same ? grpc::Status::OK
+              : grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                             "authorization: missing or wrong bearer token");
+}
+
 grpc::Status WorldService::replace_world(const SceneDef& scene, std::vector<std::uint64_t>* ids) {
   if (scene.bodies.size() > limits_.max_bodies)
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
@@ -63,8 +81,10 @@ grpc::Status WorldService::replace_world(const SceneDef& scene, std::vector<std:
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::SpawnBodies(grpc::ServerContext*, const v1::SpawnBodiesRequest* request,
+grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
+                                       const v1::SpawnBodiesRequest* request,
                                        v1::SpawnBodiesResponse* response) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   std::vector<BodyDef> defs;
   defs.reserve(request->bodies_size());
   for (int i = 0; i < request->bodies_size(); ++i) {
@@ -94,9 +114,10 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext*, const v1::SpawnBodi
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::RemoveBodies(grpc::ServerContext*,
+grpc::Status WorldService::RemoveBodies(grpc::ServerContext* context,
                                         const v1::RemoveBodiesRequest* request,
                                         v1::RemoveBodiesResponse*) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   std::set<std::uint64_t> seen;
   for (int i = 0; i < request->ids_size(); ++i)
     if (!seen.insert(request->ids(i)).second)
@@ -119,8 +140,10 @@ grpc::Status WorldService::RemoveBodies(grpc::ServerContext*,
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::GetBodies(grpc::ServerContext*, const v1::GetBodiesRequest* request,
+grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
+                                     const v1::GetBodiesRequest* request,
                                      v1::GetBodiesResponse* response) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   bool missing = false;
   const Status read = host_.apply([&](World& world) {
     std::vector<BodyId> ids;
@@ -206,9 +229,10 @@ BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
 
 }  // namespace
 
-grpc::Status WorldService::SetBodyState(grpc::ServerContext*,
+grpc::Status WorldService::SetBodyState(grpc::ServerContext* context,
                                         const v1::SetBodyStateRequest* request,
                                         v1::SetBodyStateResponse*) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   return apply_batch(
       host_, "updates", request->updates(),
       [](const World& world, const v1::BodyStateUpdate& u) {
@@ -219,9 +243,10 @@ grpc::Status WorldService::SetBodyState(grpc::ServerContext*,
       });
 }
 
-grpc::Status WorldService::ApplyImpulse(grpc::ServerContext*,
+grpc::Status WorldService::ApplyImpulse(grpc::ServerContext* context,
                                         const v1::ApplyImpulseRequest* request,
                                         v1::ApplyImpulseResponse*) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   auto point_of = [](const v1::Impulse& i) {
     return i.has_point() ? std::optional<Vec3>(vec(i.point())) : std::nullopt;
   };
@@ -237,8 +262,10 @@ grpc::Status WorldService::ApplyImpulse(grpc::ServerContext*,
       });
 }
 
-grpc::Status WorldService::LoadScene(grpc::ServerContext*, const v1::LoadSceneRequest* request,
+grpc::Status WorldService::LoadScene(grpc::ServerContext* context,
+                                     const v1::LoadSceneRequest* request,
                                      v1::LoadSceneResponse* response) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   Result<SceneDef> scene = Status::error("source: required (scene_json or builtin)");
   if (request->has_scene_json())
     scene = parse_scene(request->scene_json());
@@ -262,8 +289,9 @@ grpc::Status WorldService::LoadScene(grpc::ServerContext*, const v1::LoadSceneRe
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::Control(grpc::ServerContext*, const v1::ControlRequest* request,
+grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::ControlRequest* request,
                                    v1::ControlResponse* response) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   const v1::RunSettings& settings = request->settings();
   // Checked before anything changes, so a refused request changes nothing.
   if (settings.has_dt() && !(settings.dt() > 0 && std::isfinite(settings.dt())))
@@ -352,8 +380,9 @@ grpc::Status WorldService::Control(grpc::ServerContext*, const v1::ControlReques
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::GetInfo(grpc::ServerContext*, const v1::GetInfoRequest*,
+grpc::Status WorldService::GetInfo(grpc::ServerContext* context, const v1::GetInfoRequest*,
                                    v1::GetInfoResponse* response) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   const HostStatus status = host_.status();
   response->set_version(TUMBLE_VERSION);
   response->set_step(status.step);
@@ -369,6 +398,7 @@ grpc::Status WorldService::GetInfo(grpc::ServerContext*, const v1::GetInfoReques
 grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
                                         const v1::StreamFramesRequest* request,
                                         grpc::ServerWriter<v1::Frame>* writer) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   if (!(request->max_rate() >= 0) || !std::isfinite(request->max_rate()))
     return invalid("max_rate: must be finite and >= 0");
   FrameOptions options;

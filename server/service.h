@@ -18,6 +18,9 @@ namespace tumble::server {
 
 struct ServiceLimits {
   std::size_t max_bodies = 100000;  // spawning past this is RESOURCE_EXHAUSTED
+  // When set, every call must carry the metadata "authorization: Bearer <token>" or is
+  // UNAUTHENTICATED.
+  std::string token;
 };
 
 class WorldService final : public v1::World::Service {
@@ -48,6 +51,7 @@ class WorldService final : public v1::World::Service {
   void shut_down() { shutting_down_ = true; }
 
  private:
+  grpc::Status authorize(const grpc::ServerContext* context) const;
   WorldHost& host_;
   ServiceLimits limits_;
   // Builds `scene`'s world and swaps it in between two steps; its body ids into `ids`.

@@ -18,7 +18,7 @@ class ServiceTest : public ::testing::Test {
  protected:
   ServiceTest()
       : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0),
-        service_(host_, {.max_bodies = 100}, pile_scene(8)) {
+        service_(host_, {.max_bodies = 100, .token = ""}, pile_scene(8)) {
     grpc::ServerBuilder builder;
     builder.RegisterService(&service_);
     server_ = builder.BuildAndStart();
@@ -267,6 +267,38 @@ TEST_F(ServiceTest, StreamDescribesBodiesThenSendsPoses) {
   EXPECT_EQ(frame.step(), 20u);
   context.TryCancel();
   reader->Finish();
+}
+
+TEST(ServiceAuth, EveryCallNeedsTheBearerToken) {
+  WorldHost host(make_world(pile_scene(8)).value(), 1.0 / 60, 0);
+  WorldService service(host, {.max_bodies = 100, .token = "s3cret"}, pile_scene(8));
+  grpc::ServerBuilder builder;
+  builder.RegisterService(&service);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  auto stub = v1::World::NewStub(server->InProcessChannel(grpc::ChannelArguments()));
+  for (const char* header : {"", "Bearer wrong", "Bearer s3cre", "s3cret"}) {
+    grpc::ClientContext context;
+    if (*header != 0) context.AddMetadata("authorization", header);
+    v1::GetInfoResponse info;
+    EXPECT_EQ(stub->GetInfo(&context, {}, &info).error_code(), grpc::StatusCode::UNAUTHENTICATED)
+        << header;
+  }
+  {
+    grpc::ClientContext context;
+    v1::RemoveBodiesRequest remove;
+    remove.add_ids(wire_id(BodyId{1, 0}));
+    v1::RemoveBodiesResponse removed;
+    EXPECT_EQ(stub->RemoveBodies(&context, remove, &removed).error_code(),
+              grpc::StatusCode::UNAUTHENTICATED);
+    EXPECT_EQ(host.status().bodies, 9u);  // refused before anything changed
+  }
+  grpc::ClientContext context;
+  context.AddMetadata("authorization", "Bearer s3cret");
+  v1::GetInfoResponse info;
+  EXPECT_TRUE(stub->GetInfo(&context, {}, &info).ok());
+  EXPECT_EQ(info.body_count(), 9u);
+  service.shut_down();
+  server->Shutdown();
 }
 
 }  // namespace
