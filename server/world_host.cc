@@ -10,6 +10,7 @@ WorldHost::WorldHost(World world, double dt, double real_time_factor)
   status_.bodies = world_.body_count();
   status_.dt = dt_;
   status_.real_time_factor = real_time_factor_;
+  last_frame_ = make_frame();  // the state before the first step
   thread_ = std::thread([this] { run(); });
 }
 
@@ -87,6 +88,7 @@ bool WorldHost::wait_idle(std::chrono::milliseconds timeout) {
 std::shared_ptr<FrameMailbox> WorldHost::subscribe() {
   auto mailbox = std::make_shared<FrameMailbox>();
   std::lock_guard lock(mutex_);
+  if (last_frame_ != nullptr) mailbox->put(last_frame_);
   subscribers_.push_back(mailbox);
   return mailbox;
 }
@@ -107,18 +109,31 @@ HostStatus WorldHost::status() const {
   return status;
 }
 
-// Runs on the stepping thread with the lock held.
+// With the lock held.
+void WorldHost::publish(std::shared_ptr<const FrameData> frame) {
+  last_frame_ = frame;
+  for (const auto& mailbox : subscribers_)
+    mailbox->put(frame);
+}
+
+// Runs on the stepping thread with the lock held. When a command changed the world, subscribers
+// see the change at once in a frame of the same step (a paused world too).
 void WorldHost::apply_pending() {
+  bool changed = false;
   while (!commands_.empty()) {
     Command command = std::move(commands_.front());
     commands_.pop_front();
     const Status result = command.change(world_);
-    if (result) ++catalogue_;
+    if (result) {
+      ++catalogue_;
+      changed = true;
+    }
     status_.bodies = world_.body_count();
     status_.step = world_.step_count();  // a command may have replaced the world
     status_.time = world_.time();
     command.done.set_value(result);
   }
+  if (changed) publish(make_frame());
 }
 
 void WorldHost::run() {
@@ -162,9 +177,7 @@ void WorldHost::run() {
     status_.step = world_.step_count();
     status_.time = world_.time();
     status_.last_step = world_.last_step();
-    if (frame != nullptr)
-      for (const auto& mailbox : subscribers_)
-        mailbox->put(frame);
+    if (frame != nullptr) publish(std::move(frame));
   }
 }
 

@@ -104,6 +104,9 @@ class WorldHost {
   std::uint64_t catalogue_ = 0;
   HostStatus status_;
   std::vector<std::shared_ptr<FrameMailbox>> subscribers_;
+  // The newest frame: a new subscriber starts from it, even while the world is paused.
+  std::shared_ptr<const FrameData> last_frame_;
+  void publish(std::shared_ptr<const FrameData> frame);
   std::thread thread_;
 };
 

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include "tumble/v1/world.grpc.pb.h"
@@ -77,6 +78,29 @@ TEST(ServerProcess, ServesOverLoopbackAndStopsOnSigterm) {
     EXPECT_EQ(frame.added_size(), 51);
     context.TryCancel();
     reader->Finish();
+  }
+  {  // the command-line client: spawn a box, then one frame as a JSON line that holds it
+    const std::string cli = std::string(TUMBLE_CLI_BINARY) + " --server " + address + " ";
+    FILE* spawn = popen((cli + "spawn box --size 1,1,1 --mass 2 --pos 0,0,5").c_str(), "r");
+    ASSERT_NE(spawn, nullptr);
+    char id[64] = {};
+    ASSERT_NE(fgets(id, sizeof id, spawn), nullptr);
+    EXPECT_EQ(pclose(spawn), 0);
+    FILE* stream = popen((cli + "stream --format jsonl --frames 1").c_str(), "r");
+    ASSERT_NE(stream, nullptr);
+    std::string json;
+    char buffer[4096];
+    while (fgets(buffer, sizeof buffer, stream) != nullptr)
+      json += buffer;
+    EXPECT_EQ(pclose(stream), 0);
+    EXPECT_EQ(json.rfind("{", 0), 0u);
+    const std::string spawned = std::string("\"id\":") + std::string(id, strcspn(id, "\n"));
+    EXPECT_NE(json.find(spawned), std::string::npos) << spawned;
+    FILE* bad = popen((cli + "spawn sphere --radius -1 2>&1").c_str(), "r");
+    ASSERT_NE(bad, nullptr);
+    ASSERT_NE(fgets(buffer, sizeof buffer, bad), nullptr);
+    EXPECT_NE(std::string(buffer).find("shape.sphere.radius"), std::string::npos) << buffer;
+    EXPECT_NE(pclose(bad), 0);
   }
   ASSERT_EQ(kill(server.pid, SIGTERM), 0);
   int status = 0;

@@ -54,7 +54,7 @@ TEST(WorldHost, StepsExactlyAsAskedAndPublishesEveryStep) {
   auto delivery = mailbox->take(1s);
   ASSERT_TRUE(delivery.has_value());
   EXPECT_EQ(delivery->frame->step, 10u);
-  EXPECT_EQ(delivery->dropped, 9u);  // nobody read steps 1 to 9
+  EXPECT_EQ(delivery->dropped, 10u);  // nobody read the starting frame or steps 1 to 9
   EXPECT_EQ(delivery->frame->ids.size(), 28u);
   EXPECT_EQ(delivery->frame->positions.size(), 3 * 28u);
   EXPECT_EQ(delivery->frame->orientations.size(), 4 * 28u);
@@ -108,8 +108,26 @@ TEST(WorldHost, AStalledSubscriberNeitherBlocksNorGrows) {
   auto delivery = stalled->take(1s);
   ASSERT_TRUE(delivery.has_value());
   EXPECT_EQ(delivery->frame->step, 300u);
-  EXPECT_EQ(delivery->dropped, 299u);
+  EXPECT_EQ(delivery->dropped, 300u);            // the starting frame and steps 1 to 299
   EXPECT_FALSE(stalled->take(1ms).has_value());  // one frame held, never a queue
+}
+
+// A subscriber to a paused world gets its state at once, and again after each change.
+TEST(WorldHost, APausedWorldStillShowsItsStateAndChanges) {
+  WorldHost host(pile_world(8), 1.0 / 60, 0);
+  auto mailbox = host.subscribe();
+  auto first = mailbox->take(1s);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->frame->step, 0u);
+  EXPECT_EQ(first->frame->ids.size(), 9u);
+  BodyDef ball;
+  ball.shape = SphereDef{0.2};
+  ball.position = Vec3(0, 0, 30);
+  ASSERT_TRUE(host.apply([&](World& world) { return world.create_body(ball).status(); }));
+  auto changed = mailbox->take(1s);
+  ASSERT_TRUE(changed.has_value());
+  EXPECT_EQ(changed->frame->step, 0u);
+  EXPECT_EQ(changed->frame->ids.size(), 10u);
 }
 
 TEST(WorldHost, RealTimePacing) {
