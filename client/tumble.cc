@@ -26,8 +26,8 @@ void set_vec(const std::vector<double>& v, v1::Vec3* out) {
 }
 
 void print_json_frame(const v1::Frame& frame) {
-  nlohmann::json line = {{"step", frame.step()}, {"time", frame.time()},
-                         {"dropped", frame.dropped()}};
+  nlohmann::json line = {
+      {"step", frame.step()}, {"time", frame.time()}, {"dropped", frame.dropped()}};
   nlohmann::json bodies = nlohmann::json::array();
   for (int i = 0; i < frame.ids_size(); ++i) {
     nlohmann::json body = {
@@ -165,10 +165,10 @@ int main(int argc, char** argv) {
     if (*step) request.set_step(steps);
     Result<v1::ControlResponse> done = client.control(request);
     if (!done) return fail("control", done.status());
-    std::printf("%s\n", nlohmann::json{{"running", done.value().running()},
-                                       {"step", done.value().step()}}
-                            .dump()
-                            .c_str());
+    std::printf("%s\n",
+                nlohmann::json{{"running", done.value().running()}, {"step", done.value().step()}}
+                    .dump()
+                    .c_str());
   } else if (*stream) {
     v1::StreamFramesRequest request;
     request.set_max_rate(rate);

@@ -414,7 +414,6 @@ grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
   std::vector<std::uint64_t> known;  // ids this subscriber has descriptions of, sorted
   std::uint64_t dropped = 0;
   auto last_sent = std::chrono::steady_clock::time_point{};
-  grpc::Status result = grpc::Status::OK;
   while (!context->IsCancelled() && !shutting_down_) {
     auto delivery = mailbox->take(std::chrono::milliseconds(100));
     if (!delivery) continue;
@@ -452,7 +451,7 @@ grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
     last_sent = now;
   }
   host_.unsubscribe(mailbox);
-  return result;
+  return grpc::Status::OK;
 }
 
 }  // namespace tumble::server

@@ -124,10 +124,7 @@ void WorldHost::apply_pending() {
     Command command = std::move(commands_.front());
     commands_.pop_front();
     const Status result = command.change(world_);
-    if (result) {
-      ++catalogue_;
-      changed = true;
-    }
+    changed |= result.is_ok();
     status_.bodies = world_.body_count();
     status_.step = world_.step_count();  // a command may have replaced the world
     status_.time = world_.time();
@@ -186,7 +183,6 @@ std::shared_ptr<const FrameData> WorldHost::make_frame() const {
   frame->step = world_.step_count();
   frame->time = world_.time();
   frame->stats = world_.last_step();
-  frame->catalogue = catalogue_;
   const std::size_t n = world_.body_count();
   frame->ids.reserve(n);
   frame->positions.reserve(3 * n);

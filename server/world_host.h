@@ -3,7 +3,6 @@
 // after each step one immutable frame is built and offered to every subscriber's mailbox.
 #pragma once
 
-#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -40,9 +39,6 @@ struct FrameData {
   std::vector<std::uint64_t> contact_a, contact_b;
   std::vector<double> contact_points, contact_normals, contact_depths, contact_impulses;
   StepStats stats;
-  // Changes whenever bodies are added or removed: a subscriber that saw another value asks for
-  // the body descriptions again.
-  std::uint64_t catalogue = 0;
 };
 
 using FrameMailbox = Mailbox<FrameData>;
@@ -101,7 +97,6 @@ class WorldHost {
   bool running_ = false, stopping_ = false;
   std::uint64_t steps_left_ = 0;
   double dt_, real_time_factor_;
-  std::uint64_t catalogue_ = 0;
   HostStatus status_;
   std::vector<std::shared_ptr<FrameMailbox>> subscribers_;
   // The newest frame: a new subscriber starts from it, even while the world is paused.

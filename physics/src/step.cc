@@ -138,10 +138,11 @@ double team_max(double local, std::vector<double>& values) {
 
 // Calls fn(row ids of a manifold) for colours [first, last), forwards or backwards. Manifolds
 // of one colour share no moving body, so the team splits them; the overflow colour runs on one
-// thread. Returns the largest value fn returned, on every thread.
+// thread. Returns the largest value fn returned, on every thread (0 without `reduce`, which
+// spares the two barriers of the reduction).
 template <class Fn>
 double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                     Fn&& fn) {
+                     Fn&& fn, bool reduce = true) {
   const Colouring& colouring = s.colouring;
   double local = 0;
   for (std::uint32_t k = first; k < last; ++k) {
@@ -159,7 +160,7 @@ double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
         local = std::max(local, fn(manifold_rows(s, colouring.manifolds[i])));
     }
   }
-  return team_max(local, s.team_values);
+  return reduce ? team_max(local, s.team_values) : 0.0;
 }
 
 std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
@@ -209,7 +210,7 @@ void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint3
         contact_softness(std::min(solver.contact_hertz, 0.25 / h), solver.contact_damping_ratio, h);
     for (int sub = 0; sub < solver.substeps; ++sub) {
       hits += team_integrate_velocities(c, h);
-      sweep_colours(s, first, last, false, warm);
+      sweep_colours(s, first, last, false, warm, false);
       for (int i = 0; i < solver.soft_iterations; ++i)
         if (sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
       team_integrate_positions(c, h);
@@ -218,7 +219,7 @@ void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint3
     }
   } else {
     hits += team_integrate_velocities(c, dt);
-    sweep_colours(s, first, last, false, warm);
+    sweep_colours(s, first, last, false, warm, false);
     for (int i = 0; i < solver.iterations; ++i)
       if (sweep(nullptr, dt, i % 2 == 1) <= solver.velocity_tolerance) break;
   }
@@ -227,10 +228,13 @@ void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint3
         return normal_residual(s.rows, ids, s.bodies, h);
       });
   if (report->solver != IslandSolver::kSoft) team_integrate_positions(c, dt);
-  sweep_colours(s, first, last, false, [&](std::span<const std::uint32_t> ids) {
-    apply_restitution(s.rows, ids, s.blocks, s.bodies, solver);
-    return 0.0;
-  });
+  sweep_colours(
+      s, first, last, false,
+      [&](std::span<const std::uint32_t> ids) {
+        apply_restitution(s.rows, ids, s.blocks, s.bodies, solver);
+        return 0.0;
+      },
+      false);
 #pragma omp atomic
   report->gyroscopic_limit_hits += hits;
   if (lead) {
@@ -469,11 +473,13 @@ void World::correct_positions() {
     for (std::uint32_t i : s.team_islands) {
       if (!needs_correction(i)) continue;
       for (int k = 0; k < solver.position_iterations; ++k)
-        sweep_colours(s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
-                      [&](std::span<const std::uint32_t> ids) {
-                        tumble::correct_positions(s.rows, ids, s.bodies, s.poses, solver);
-                        return 0.0;
-                      });
+        sweep_colours(
+            s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
+            [&](std::span<const std::uint32_t> ids) {
+              tumble::correct_positions(s.rows, ids, s.bodies, s.poses, solver);
+              return 0.0;
+            },
+            false);
     }
 #pragma omp for schedule(dynamic, 1)
     for (std::int64_t k = 0; k < singles; ++k) {
