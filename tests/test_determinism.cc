@@ -9,29 +9,6 @@
 namespace tumble::testing {
 namespace {
 
-// FNV-1a over the bits of every dynamic body's pose and velocities.
-std::uint64_t state_hash(const World& world) {
-  std::uint64_t hash = 1469598103934665603ull;
-  auto mix = [&](double value) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &value, sizeof bits);
-    for (int i = 0; i < 8; ++i) {
-      hash ^= (bits >> (8 * i)) & 0xFF;
-      hash *= 1099511628211ull;
-    }
-  };
-  for (const Body* b : dynamic_bodies(world)) {
-    for (int k = 0; k < 3; ++k) {
-      mix(b->position[k]);
-      mix(b->linear_velocity[k]);
-      mix(b->angular_velocity[k]);
-    }
-    for (int k = 0; k < 4; ++k)
-      mix(b->orientation.coeffs()[k]);
-  }
-  return hash;
-}
-
 struct Run {
   std::uint64_t hash = 0;
   std::uint32_t coloured_islands = 0;  // in the last step

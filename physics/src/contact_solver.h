@@ -16,6 +16,7 @@
 #include "physics/collision.h"
 #include "physics/math.h"
 #include "physics/step.h"
+#include "physics/world_state.h"
 
 namespace tumble {
 
@@ -61,13 +62,7 @@ struct NormalBlock {
 };
 
 // Impulses of the last step, looked up by body pair and feature to warm-start the next one.
-struct CachedImpulse {
-  BodyId a, b;
-  std::uint64_t feature = 0;
-  Vec3 local_a = Vec3::Zero();  // the point in A's axes, for matching when features change
-  double normal = 0;
-  Vec3 friction = Vec3::Zero();  // world
-};
+using CachedImpulse = WarmStartImpulse;
 
 // Writes the manifold.count rows of one manifold to `rows` and its block to `block`, which is
 // blocks[block_index]. `cache` is sorted by (a, b); a row starts from the impulse of the cached

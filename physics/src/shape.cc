@@ -252,4 +252,79 @@ Shape Shape::recentred(const Vec3& offset) const {
   return shape;
 }
 
+ShapeState Shape::state() const {
+  ShapeState state{type_, radius_, half_height_, half_extents_, nullptr};
+  if (type_ == ShapeType::kHull) state.polyhedron = polyhedron_;
+  return state;
+}
+
+namespace {
+
+Status check_polyhedron(const ConvexPolyhedron& p) {
+  const std::size_t vertex_count = p.vertices.size(), face_count = p.faces.size();
+  if (vertex_count < 4 || face_count < 4 || p.edges.size() < 6)
+    return Status::error("polyhedron: needs at least 4 vertices, 4 faces and 6 edges");
+  for (std::size_t i = 0; i < vertex_count; ++i)
+    if (!is_finite(p.vertices[i]))
+      return Status::error("polyhedron.vertices[" + std::to_string(i) + "]: must be finite");
+  for (std::size_t i = 0; i < face_count; ++i) {
+    const ConvexPolyhedron::Face& face = p.faces[i];
+    const std::string field = "polyhedron.faces[" + std::to_string(i) + "]";
+    if (!is_finite(face.normal) || std::abs(face.normal.norm() - 1) > 1e-9 ||
+        !std::isfinite(face.offset))
+      return Status::error(field + ": needs a finite unit normal and offset");
+    if (face.count < 3 || face.first > p.face_vertices.size() ||
+        face.count > p.face_vertices.size() - face.first)
+      return Status::error(field + ": vertex loop out of range");
+  }
+  for (std::size_t i = 0; i < p.face_vertices.size(); ++i)
+    if (p.face_vertices[i] >= vertex_count)
+      return Status::error("polyhedron.face_vertices[" + std::to_string(i) + "]: out of range");
+  for (std::size_t i = 0; i < p.edges.size(); ++i) {
+    const ConvexPolyhedron::Edge& edge = p.edges[i];
+    if (edge.tail >= vertex_count || edge.head >= vertex_count || edge.left >= face_count ||
+        edge.right >= face_count)
+      return Status::error("polyhedron.edges[" + std::to_string(i) + "]: out of range");
+  }
+  if (!is_finite(p.centroid)) return Status::error("polyhedron.centroid: must be finite");
+  if (!(p.volume > 0) || !std::isfinite(p.volume))
+    return Status::error("polyhedron.volume: must be finite and > 0");
+  return Status::ok();
+}
+
+}  // namespace
+
+Result<Shape> Shape::from_state(const ShapeState& state) {
+  ShapeDef def;
+  switch (state.type) {
+    case ShapeType::kSphere:
+      def = SphereDef{state.radius};
+      break;
+    case ShapeType::kCapsule:
+      def = CapsuleDef{state.radius, state.half_height};
+      break;
+    case ShapeType::kBox:
+      def = BoxDef{state.half_extents};
+      break;
+    case ShapeType::kHalfSpace:
+      def = HalfSpaceDef{};
+      break;
+    case ShapeType::kHull: {
+      if (state.polyhedron == nullptr) return Status::error("polyhedron: required for a hull");
+      if (Status s = check_polyhedron(*state.polyhedron); !s) return s;
+      for (int k = 0; k < 3; ++k)
+        if (Status s = check_length(state.half_extents[k], "half_extents"); !s) return s;
+      Shape shape;
+      shape.type_ = ShapeType::kHull;
+      shape.polyhedron_ = state.polyhedron;
+      shape.half_extents_ = state.half_extents;
+      shape.update_radii();
+      return shape;
+    }
+    default:
+      return Status::error("type: unknown shape type");
+  }
+  return create(def);
+}
+
 }  // namespace tumble

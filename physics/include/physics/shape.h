@@ -47,6 +47,15 @@ struct MassProperties {
   Mat3 inertia = Mat3::Zero();         // kg m^2, about the centre of mass, shape-frame axes
 };
 
+// Everything a Shape is made of, for saving a world and restoring it bit for bit (the radii
+// derived from it are recomputed).
+struct ShapeState {
+  ShapeType type = ShapeType::kSphere;
+  double radius = 0, half_height = 0;
+  Vec3 half_extents = Vec3::Zero();
+  std::shared_ptr<const ConvexPolyhedron> polyhedron;  // hulls only (a box rebuilds its own)
+};
+
 class Shape {
  public:
   // Validates the definition; the message names the bad field ("half_extents[1]: must be > 0").
@@ -76,6 +85,11 @@ class Shape {
   Vec3 support(const Vec3& direction) const;
   // The same shape moved so that `offset` (shape frame) becomes the origin.
   Shape recentred(const Vec3& offset) const;
+
+  ShapeState state() const;
+  // Rebuilds a shape from a state that may come from outside (a saved file, the network): every
+  // number and index is checked, and the message names what is wrong.
+  static Result<Shape> from_state(const ShapeState& state);
 
  private:
   ShapeType type_ = ShapeType::kSphere;

@@ -12,6 +12,7 @@
 #include "physics/math.h"
 #include "physics/status.h"
 #include "physics/step.h"
+#include "physics/world_state.h"
 
 namespace tumble {
 
@@ -78,6 +79,12 @@ class World {
   // body, applied now to its velocities; the body wakes.
   Status check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) const;
   Status apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point);
+
+  // The whole state (settings apart: settings()), and a world made from one. from_state checks
+  // everything (the state may come from a file or the network) and names what is wrong; a world
+  // restored from save_state() steps on exactly as this one would, bit for bit.
+  WorldStateData save_state() const;
+  static Result<World> from_state(const WorldSettings& settings, WorldStateData state);
 
   bool contains(BodyId id) const;
   // The body, or null when `id` is stale or was never made.

@@ -1,0 +1,106 @@
+// Saving a world's state and restoring it.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "physics/world.h"
+#include "step_scratch.h"
+
+namespace tumble {
+namespace {
+
+Status check_body(const Body& body, std::uint32_t slot_count) {
+  if (!is_finite(body.position) || !is_finite(body.linear_velocity) ||
+      !is_finite(body.angular_velocity))
+    return Status::error("position and velocities: must be finite");
+  const double norm = body.orientation.norm();
+  if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-6)
+    return Status::error("orientation: must be a unit quaternion");
+  if (!body.inertia_body.allFinite() || !body.inverse_inertia_body.allFinite() ||
+      !body.inverse_inertia_world.allFinite())
+    return Status::error("inertia: must be finite");
+  if (body.is_static()) {
+    if (body.inverse_mass != 0 || !body.inverse_inertia_body.isZero(0))
+      return Status::error("inverse_mass: must be 0 for a static body");
+  } else {
+    if (!(body.mass > 0) || !std::isfinite(body.mass) || !(body.inverse_mass > 0) ||
+        !std::isfinite(body.inverse_mass))
+      return Status::error("mass: must be finite and > 0 for a dynamic body");
+    if (body.shape.type() == ShapeType::kHalfSpace)
+      return Status::error("shape: a half-space must be static");
+  }
+  if (!(body.friction >= 0) || !std::isfinite(body.friction))
+    return Status::error("friction: must be finite and >= 0");
+  if (!(body.restitution >= 0 && body.restitution <= 1))
+    return Status::error("restitution: must be in [0, 1]");
+  if (!(body.sleep_timer >= 0) || !std::isfinite(body.sleep_timer))
+    return Status::error("sleep_timer: must be finite and >= 0");
+  if (body.sleep_island >= slot_count) return Status::error("sleep_island: out of range");
+  return Status::ok();
+}
+
+}  // namespace
+
+WorldStateData World::save_state() const {
+  WorldStateData state;
+  state.slots.reserve(bodies_.size());
+  for (const Slot& slot : bodies_)
+    state.slots.push_back({slot.generation, slot.alive, slot.alive ? slot.body : Body{}});
+  state.free_slots = free_slots_;
+  state.time = time_;
+  state.step = stats_.step;
+  state.warm_start = scratch_->cache;
+  return state;
+}
+
+Result<World> World::from_state(const WorldSettings& settings, WorldStateData state) {
+  if (Status s = validate(settings); !s) return s.within("settings.");
+  if (!(state.time >= 0) || !std::isfinite(state.time))
+    return Status::error("time: must be finite and >= 0");
+  const auto slot_count = static_cast<std::uint32_t>(state.slots.size());
+  if (state.slots.size() >= UINT32_MAX) return Status::error("slots: too many");
+  std::size_t live = 0;
+  for (std::uint32_t i = 0; i < slot_count; ++i) {
+    const BodySlotState& slot = state.slots[i];
+    if (!slot.alive) continue;
+    ++live;
+    if (Status s = check_body(slot.body, slot_count); !s)
+      return s.within("slots[" + std::to_string(i) + "].");
+  }
+  // Exactly the dead slots are free, each once: creation reuses them in this order.
+  std::vector<std::uint8_t> listed(slot_count, 0);
+  for (std::size_t k = 0; k < state.free_slots.size(); ++k) {
+    const std::uint32_t i = state.free_slots[k];
+    if (i >= slot_count || state.slots[i].alive || listed[i])
+      return Status::error("free_slots[" + std::to_string(k) + "]: not a dead slot, or repeated");
+    listed[i] = 1;
+  }
+  if (state.free_slots.size() != slot_count - live)
+    return Status::error("free_slots: must list every dead slot");
+  for (std::size_t k = 0; k < state.warm_start.size(); ++k) {
+    const WarmStartImpulse& w = state.warm_start[k];
+    const std::string field = "warm_start[" + std::to_string(k) + "]";
+    if (w.a.index >= slot_count || w.b.index >= slot_count)
+      return Status::error(field + ": body out of range");
+    if (!is_finite(w.local_a) || !std::isfinite(w.normal) || !is_finite(w.friction))
+      return Status::error(field + ": must be finite");
+    if (k > 0) {
+      const WarmStartImpulse& p = state.warm_start[k - 1];
+      if (p.a.index != w.a.index ? p.a.index > w.a.index : p.b.index > w.b.index)
+        return Status::error(field + ": not sorted by body pair");
+    }
+  }
+
+  World world(settings);
+  world.bodies_.reserve(slot_count);
+  for (BodySlotState& slot : state.slots)
+    world.bodies_.push_back({std::move(slot.body), slot.generation, slot.alive});
+  world.free_slots_ = std::move(state.free_slots);
+  world.live_count_ = live;
+  world.time_ = state.time;
+  world.stats_.step = state.step;
+  world.scratch_->cache = std::move(state.warm_start);
+  return world;
+}
+
+}  // namespace tumble
