@@ -123,12 +123,17 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   return def;
 }
 
-void describe(BodyId id, const Body& body, v1::BodyDescription* out) {
-  out->set_id(wire_id(id));
-  out->set_type(body.is_static() ? v1::BODY_TYPE_STATIC : v1::BODY_TYPE_DYNAMIC);
-  out->set_mass(body.is_static() ? 0 : body.mass);
+BodyLook look_of(const Body& body, std::uint32_t colour) {
+  return {body.shape, body.type, body.is_static() ? 0 : body.mass, colour};
+}
+
+void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) {
+  out->set_id(id);
+  out->set_type(look.type == BodyType::kStatic ? v1::BODY_TYPE_STATIC : v1::BODY_TYPE_DYNAMIC);
+  out->set_mass(look.mass);
+  out->set_color(look.colour);
   v1::Shape* shape = out->mutable_shape();
-  const Shape& s = body.shape;
+  const Shape& s = look.shape;
   switch (s.type()) {
     case ShapeType::kBox:
       set(2 * s.half_extents(), shape->mutable_box()->mutable_size());

@@ -10,8 +10,9 @@ namespace tumble::server {
 
 Result<BodyDef> body_from_proto(const v1::BodySpec& spec);
 
-// What a viewer needs to draw `body`.
-void describe(BodyId id, const Body& body, v1::BodyDescription* out);
+BodyLook look_of(const Body& body, std::uint32_t colour);
+// What a viewer needs to draw the body with wire id `id`.
+void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
 
 struct FrameOptions {
   bool velocities = false, contacts = false, stats = false;

@@ -7,6 +7,7 @@
 #include "convert.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
+#include "snapshot.h"
 
 namespace tumble::server {
 namespace {
@@ -66,18 +67,17 @@ grpc::Status WorldService::replace_world(const SceneDef& scene, std::vector<std:
   // Built before the world is touched: a scene that cannot be made changes nothing.
   Result<World> made = make_world(scene);
   if (!made) return invalid("scene: " + made.error());
-  const Status replaced = host_.apply([&](World& world) {
-    const int threads = world.settings().threads;  // the server's choice, not the scene's
-    world = std::move(made).value();
+  const Status replaced = host_.apply([&](HostedWorld& hosted) {
+    World& world = made.value();
     WorldSettings settings = world.settings();
-    settings.threads = threads;
+    settings.threads = hosted.world.settings().threads;  // the server's choice, not the scene's
     if (Status s = world.set_settings(settings); !s) return s;
     for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
       if (world.id_at(slot).is_valid()) ids->push_back(wire_id(world.id_at(slot)));
+    hosted.replace(std::move(world), scene.dt, {});
     return Status::ok();
   });
   if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
-  host_.set_dt(scene.dt);
   return grpc::Status::OK;
 }
 
@@ -94,7 +94,8 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
   }
   bool too_many = false;
   std::vector<BodyId> ids;
-  const Status applied = host_.apply([&](World& world) {
+  const Status applied = host_.apply([&](HostedWorld& hosted) {
+    World& world = hosted.world;
     if (world.body_count() + defs.size() > limits_.max_bodies) {
       too_many = true;
       return Status::error("bodies: " + std::to_string(defs.size()) + " more would exceed the " +
@@ -103,6 +104,8 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
     Result<std::vector<BodyId>> made = world.create_bodies(defs);
     if (!made) return made.status();
     ids = std::move(made).value();
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      hosted.set_colour(ids[i], request->bodies(static_cast<int>(i)).color());
     return Status::ok();
   });
   if (!applied)
@@ -123,7 +126,8 @@ grpc::Status WorldService::RemoveBodies(grpc::ServerContext* context,
     if (!seen.insert(request->ids(i)).second)
       return invalid("ids[" + std::to_string(i) + "]: listed twice");
   bool missing = false;
-  const Status applied = host_.apply([&](World& world) {
+  const Status applied = host_.apply([&](HostedWorld& hosted) {
+    World& world = hosted.world;
     // Every id is checked before anything is removed: all or nothing.
     std::vector<BodyId> ids;
     if (Status found = find_bodies(world, request->ids(), &ids); !found) {
@@ -144,20 +148,21 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
                                      const v1::GetBodiesRequest* request,
                                      v1::GetBodiesResponse* response) {
   if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
-  bool missing = false;
-  const Status read = host_.apply([&](World& world) {
+  Status read = Status::ok();
+  host_.inspect([&](const HostedWorld& hosted) {
+    const World& world = hosted.world;
     std::vector<BodyId> ids;
     if (request->ids_size() == 0) {
       for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
         if (world.id_at(slot).is_valid()) ids.push_back(world.id_at(slot));
     } else if (Status found = find_bodies(world, request->ids(), &ids); !found) {
-      missing = true;
-      return found;
+      read = found;
+      return;
     }
     response->set_step(world.step_count());
     for (BodyId id : ids) {
       const Body& body = *world.body(id);
-      describe(id, body, response->add_descriptions());
+      describe(wire_id(id), look_of(body, hosted.colours[id.index]), response->add_descriptions());
       v1::BodyState* state = response->add_states();
       state->set_id(wire_id(id));
       auto set = [](const Vec3& v, v1::Vec3* out) {
@@ -174,11 +179,8 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
       set(body.angular_velocity, state->mutable_angular_velocity());
       state->set_asleep(body.asleep);
     }
-    return Status::ok();
   });
-  if (!read)
-    return grpc::Status(missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INTERNAL,
-                        read.message());
+  if (!read) return grpc::Status(grpc::StatusCode::NOT_FOUND, read.message());
   return grpc::Status::OK;
 }
 
@@ -195,7 +197,8 @@ template <class Entries, class Check, class Apply>
 grpc::Status apply_batch(WorldHost& host, const char* name, const Entries& entries, Check check,
                          Apply apply) {
   bool missing = false;
-  const Status applied = host.apply([&](World& world) {
+  const Status applied = host.apply([&](HostedWorld& hosted) {
+    World& world = hosted.world;
     for (int i = 0; i < entries.size(); ++i) {
       if (!world.contains(body_id(entries[i].id()))) {
         missing = true;
@@ -331,8 +334,10 @@ grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::Contr
     return next;
   };
   // Checked against the world as it is before the reset below can change anything.
-  const Status acceptable =
-      host_.apply([&](World& world) { return validate(changed_settings(world.settings())); });
+  Status acceptable = Status::ok();
+  host_.inspect([&](const HostedWorld& hosted) {
+    acceptable = validate(changed_settings(hosted.world.settings()));
+  });
   if (!acceptable) return invalid("settings." + acceptable.message());
   if (request->action_case() == v1::ControlRequest::kReset && request->reset()) {
     SceneDef scene;
@@ -346,7 +351,8 @@ grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::Contr
   }
   // The world's own settings change in one command, all or nothing (World::set_settings).
   WorldSettings now;
-  const Status changed = host_.apply([&](World& world) {
+  const Status changed = host_.apply([&](HostedWorld& hosted) {
+    World& world = hosted.world;
     if (Status s = world.set_settings(changed_settings(world.settings())); !s) return s;
     now = world.settings();
     return Status::ok();
@@ -395,6 +401,49 @@ grpc::Status WorldService::GetInfo(grpc::ServerContext* context, const v1::GetIn
   return grpc::Status::OK;
 }
 
+grpc::Status WorldService::Snapshot(grpc::ServerContext* context, const v1::SnapshotRequest*,
+                                    v1::SnapshotResponse* response) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+  SavedWorld saved;
+  host_.inspect([&](const HostedWorld& hosted) {
+    saved = {hosted.world.settings(), hosted.world.save_state(), hosted.dt, hosted.colours};
+  });
+  // Encoded off the stepping thread: the copy above is all the world waits for.
+  response->set_step(saved.state.step);
+  response->set_state(encode_snapshot(saved));
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::RestoreRequest* request,
+                                   v1::RestoreResponse* response) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+  Result<SavedWorld> saved = decode_snapshot(request->state());
+  if (!saved) return invalid("state." + saved.error());
+  SavedWorld& s = saved.value();
+  std::size_t live = 0;
+  for (const BodySlotState& slot : s.state.slots)
+    live += slot.alive ? 1 : 0;
+  if (live > limits_.max_bodies)
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        "state: " + std::to_string(live) + " bodies, more than the " +
+                            std::to_string(limits_.max_bodies) + " allowed");
+  const std::uint64_t step = s.state.step;
+  // Checked whole before the running world is touched.
+  Result<World> restored = World::from_state(s.settings, std::move(s.state));
+  if (!restored) return invalid("state." + restored.error());
+  const Status replaced = host_.apply([&](HostedWorld& hosted) {
+    World& world = restored.value();
+    WorldSettings settings = world.settings();
+    settings.threads = hosted.world.settings().threads;  // the server's choice
+    if (Status t = world.set_settings(settings); !t) return t;
+    hosted.replace(std::move(world), s.dt, std::move(s.colours));
+    return Status::ok();
+  });
+  if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
+  response->set_step(step);
+  return grpc::Status::OK;
+}
+
 grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
                                         const v1::StreamFramesRequest* request,
                                         grpc::ServerWriter<v1::Frame>* writer) {
@@ -412,7 +461,7 @@ grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
 
   std::shared_ptr<FrameMailbox> mailbox = host_.subscribe();
   std::vector<std::uint64_t> known;  // ids this subscriber has descriptions of, sorted
-  std::uint64_t dropped = 0;
+  std::uint64_t dropped = 0, epoch = 0;
   auto last_sent = std::chrono::steady_clock::time_point{};
   while (!context->IsCancelled() && !shutting_down_) {
     auto delivery = mailbox->take(std::chrono::milliseconds(100));
@@ -430,18 +479,20 @@ grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
     // Bodies new to this subscriber get their descriptions; vanished ones are listed.
     std::vector<std::uint64_t> current(frame.ids().begin(), frame.ids().end());
     std::sort(current.begin(), current.end());
+    if (data.epoch != epoch) {  // a new world: every body it had before is gone
+      for (std::uint64_t wire : known)
+        frame.add_removed(wire);
+      known.clear();
+      epoch = data.epoch;
+    }
     std::vector<std::uint64_t> added, removed;
     std::set_difference(current.begin(), current.end(), known.begin(), known.end(),
                         std::back_inserter(added));
     std::set_difference(known.begin(), known.end(), current.begin(), current.end(),
                         std::back_inserter(removed));
-    if (!added.empty()) {
-      host_.apply([&](World& world) {
-        for (std::uint64_t wire : added)
-          if (const Body* body = world.body(body_id(wire)))
-            describe(body_id(wire), *body, frame.add_added());
-        return Status::ok();
-      });
+    for (std::uint64_t wire : added) {
+      const auto look = data.catalogue->find(wire);
+      if (look != data.catalogue->end()) describe(wire, look->second, frame.add_added());
     }
     for (std::uint64_t wire : removed)
       frame.add_removed(wire);

@@ -44,6 +44,10 @@ class WorldService final : public v1::World::Service {
                        v1::ControlResponse*) override;
   grpc::Status GetInfo(grpc::ServerContext*, const v1::GetInfoRequest*,
                        v1::GetInfoResponse*) override;
+  grpc::Status Snapshot(grpc::ServerContext*, const v1::SnapshotRequest*,
+                        v1::SnapshotResponse*) override;
+  grpc::Status Restore(grpc::ServerContext*, const v1::RestoreRequest*,
+                       v1::RestoreResponse*) override;
   grpc::Status StreamFrames(grpc::ServerContext*, const v1::StreamFramesRequest*,
                             grpc::ServerWriter<v1::Frame>*) override;
 

@@ -6,9 +6,12 @@
 namespace tumble::server {
 
 WorldHost::WorldHost(World world, double dt, double real_time_factor)
-    : world_(std::move(world)), dt_(dt), real_time_factor_(real_time_factor) {
-  status_.bodies = world_.body_count();
-  status_.dt = dt_;
+    : real_time_factor_(real_time_factor) {
+  hosted_.world = std::move(world);
+  hosted_.dt = dt;
+  refresh_catalogue();
+  status_.bodies = hosted_.world.body_count();
+  status_.dt = dt;
   status_.real_time_factor = real_time_factor_;
   last_frame_ = make_frame();  // the state before the first step
   thread_ = std::thread([this] { run(); });
@@ -27,16 +30,29 @@ WorldHost::~WorldHost() {
     mailbox->close();
 }
 
-Status WorldHost::apply(std::function<Status(World&)> change) {
+Status WorldHost::submit(Command command) {
   std::future<Status> done;
   {
     std::lock_guard lock(mutex_);
     if (stopping_) return Status::error("server: shutting down");
-    commands_.push_back({std::move(change), {}});
+    commands_.push_back(std::move(command));
     done = commands_.back().done.get_future();
   }
   wake_.notify_all();
   return done.get();
+}
+
+Status WorldHost::apply(std::function<Status(HostedWorld&)> change) {
+  return submit({std::move(change), {}, false});
+}
+
+void WorldHost::inspect(std::function<void(const HostedWorld&)> read) {
+  submit({[&read](HostedWorld& hosted) {
+            read(hosted);
+            return Status::ok();
+          },
+          {},
+          true});
 }
 
 void WorldHost::play() {
@@ -65,7 +81,7 @@ void WorldHost::step(std::uint64_t steps) {
 Status WorldHost::set_dt(double dt) {
   if (!(dt > 0) || !std::isfinite(dt)) return Status::error("dt: must be finite and > 0");
   std::lock_guard lock(mutex_);
-  dt_ = dt;
+  hosted_.dt = dt;
   return Status::ok();
 }
 
@@ -103,7 +119,7 @@ HostStatus WorldHost::status() const {
   std::lock_guard lock(mutex_);
   HostStatus status = status_;
   status.running = running_ || steps_left_ > 0;
-  status.dt = dt_;
+  status.dt = hosted_.dt;
   status.real_time_factor = real_time_factor_;
   status.subscribers = subscribers_.size();
   return status;
@@ -123,14 +139,44 @@ void WorldHost::apply_pending() {
   while (!commands_.empty()) {
     Command command = std::move(commands_.front());
     commands_.pop_front();
-    const Status result = command.change(world_);
-    changed |= result.is_ok();
-    status_.bodies = world_.body_count();
-    status_.step = world_.step_count();  // a command may have replaced the world
-    status_.time = world_.time();
+    const Status result = command.change(hosted_);
+    if (result && !command.read_only) {
+      changed = true;
+      refresh_catalogue();
+    }
+    status_.bodies = hosted_.world.body_count();
+    status_.step = hosted_.world.step_count();  // a command may have replaced the world
+    status_.time = hosted_.world.time();
     command.done.set_value(result);
   }
   if (changed) publish(make_frame());
+}
+
+// A new catalogue only when the set of bodies changed: frames of a steady world share one.
+void WorldHost::refresh_catalogue() {
+  const World& world = hosted_.world;
+  hosted_.colours.resize(world.slot_count(), 0);
+  bool same = catalogue_epoch_ == hosted_.epoch && catalogue_->size() == world.body_count();
+  for (std::uint32_t slot = 0; same && slot < world.slot_count(); ++slot) {
+    const BodyId id = world.id_at(slot);
+    same = !id.is_valid() || catalogue_->contains(wire_id(id));
+  }
+  if (same) return;
+  auto fresh = std::make_shared<Catalogue>();
+  fresh->reserve(world.body_count());
+  for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
+    const BodyId id = world.id_at(slot);
+    const Body* body = world.body(id);
+    if (body == nullptr) {
+      hosted_.colours[slot] = 0;  // a later body in this slot starts with the viewer's choice
+      continue;
+    }
+    fresh->emplace(wire_id(id),
+                   BodyLook{body->shape, body->type, body->is_static() ? 0 : body->mass,
+                            hosted_.colours[slot]});
+  }
+  catalogue_ = std::move(fresh);
+  catalogue_epoch_ = hosted_.epoch;
 }
 
 void WorldHost::run() {
@@ -164,34 +210,37 @@ void WorldHost::run() {
         continue;
       }
     }
-    const double dt = dt_;
+    const double dt = hosted_.dt;
     if (steps_left_ > 0) --steps_left_;
     lock.unlock();  // the world is this thread's alone; callers may queue meanwhile
-    const Status stepped = world_.step(dt);
+    const Status stepped = hosted_.world.step(dt);
     std::shared_ptr<const FrameData> frame = stepped ? make_frame() : nullptr;
     lock.lock();
     paced_time += dt;
-    status_.step = world_.step_count();
-    status_.time = world_.time();
-    status_.last_step = world_.last_step();
+    status_.step = hosted_.world.step_count();
+    status_.time = hosted_.world.time();
+    status_.last_step = hosted_.world.last_step();
     if (frame != nullptr) publish(std::move(frame));
   }
 }
 
 std::shared_ptr<const FrameData> WorldHost::make_frame() const {
+  const World& world = hosted_.world;
   auto frame = std::make_shared<FrameData>();
-  frame->step = world_.step_count();
-  frame->time = world_.time();
-  frame->stats = world_.last_step();
-  const std::size_t n = world_.body_count();
+  frame->epoch = hosted_.epoch;
+  frame->catalogue = catalogue_;
+  frame->step = world.step_count();
+  frame->time = world.time();
+  frame->stats = world.last_step();
+  const std::size_t n = world.body_count();
   frame->ids.reserve(n);
   frame->positions.reserve(3 * n);
   frame->orientations.reserve(4 * n);
   frame->linear_velocities.reserve(3 * n);
   frame->angular_velocities.reserve(3 * n);
-  for (std::uint32_t slot = 0; slot < world_.slot_count(); ++slot) {
-    const BodyId id = world_.id_at(slot);
-    const Body* body = world_.body(id);
+  for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
+    const BodyId id = world.id_at(slot);
+    const Body* body = world.body(id);
     if (body == nullptr) continue;
     frame->ids.push_back(wire_id(id));
     frame->positions.insert(frame->positions.end(), body->position.data(),
@@ -203,9 +252,9 @@ std::shared_ptr<const FrameData> WorldHost::make_frame() const {
     frame->angular_velocities.insert(frame->angular_velocities.end(), body->angular_velocity.data(),
                                      body->angular_velocity.data() + 3);
   }
-  const auto impulses = world_.contact_impulses();
+  const auto impulses = world.contact_impulses();
   std::size_t row = 0;
-  for (const Contact& contact : world_.contacts()) {
+  for (const Contact& contact : world.contacts()) {
     for (int i = 0; i < contact.manifold.count; ++i, ++row) {
       const ContactPoint& point = contact.manifold.points[i];
       frame->contact_a.push_back(wire_id(contact.a));

@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "mailbox.h"
@@ -27,8 +28,42 @@ inline BodyId body_id(std::uint64_t wire) {
   return {static_cast<std::uint32_t>(wire & 0xFFFFFFFFu), static_cast<std::uint32_t>(wire >> 32)};
 }
 
+// What a viewer needs to draw a body, kept while the body lives.
+struct BodyLook {
+  Shape shape;  // in the body's frame (origin at the centre of mass)
+  BodyType type = BodyType::kDynamic;
+  double mass = 0;           // kg; 0 for static bodies
+  std::uint32_t colour = 0;  // 0xRRGGBBAA; 0 lets the viewer choose
+};
+// Every live body's look by wire id. Shared by frames until the set of bodies changes.
+using Catalogue = std::unordered_map<std::uint64_t, BodyLook>;
+
+// The world and what the server keeps beside it. Only the stepping thread touches it: commands
+// run there.
+struct HostedWorld {
+  World world;
+  double dt = 1.0 / 60;                // s per step
+  std::vector<std::uint32_t> colours;  // by slot, 0xRRGGBBAA
+  // Counts wholesale replacements (a scene loaded, a snapshot restored): ids start over, so a
+  // subscriber must forget the bodies it knew.
+  std::uint64_t epoch = 0;
+
+  void replace(World replacement, double new_dt, std::vector<std::uint32_t> new_colours) {
+    world = std::move(replacement);
+    dt = new_dt;
+    colours = std::move(new_colours);
+    ++epoch;
+  }
+  void set_colour(BodyId id, std::uint32_t colour) {
+    if (colours.size() <= id.index) colours.resize(id.index + 1, 0);
+    colours[id.index] = colour;
+  }
+};
+
 // One step of the world, shared read-only by every subscriber.
 struct FrameData {
+  std::uint64_t epoch = 0;  // HostedWorld::epoch
+  std::shared_ptr<const Catalogue> catalogue;
   std::uint64_t step = 0;
   double time = 0;                                            // s, simulated
   std::vector<std::uint64_t> ids;                             // live bodies, slot order
@@ -63,8 +98,10 @@ class WorldHost {
 
   // Runs `change` on the world on the stepping thread, between two steps, and returns its
   // status. A change that fails must leave the world as it found it (the World's own batch
-  // operations do). Blocks until applied.
-  Status apply(std::function<Status(World&)> change);
+  // operations do). Blocks until applied; subscribers then get a frame showing the change.
+  Status apply(std::function<Status(HostedWorld&)> change);
+  // Runs `read` between two steps, changing nothing (no frame is published for it).
+  void inspect(std::function<void(const HostedWorld&)> read);
 
   void play();
   void pause();
@@ -82,21 +119,27 @@ class WorldHost {
 
  private:
   struct Command {
-    std::function<Status(World&)> change;
+    std::function<Status(HostedWorld&)> change;
     std::promise<Status> done;
+    bool read_only = false;
   };
+  Status submit(Command command);
+  void refresh_catalogue();
   void run();
   void apply_pending();
   std::shared_ptr<const FrameData> make_frame() const;
 
-  World world_;  // touched by the stepping thread only (commands run there)
+  HostedWorld hosted_;  // the world by the stepping thread only (commands run there); dt under
+                        // the lock
+  std::shared_ptr<const Catalogue> catalogue_ = std::make_shared<Catalogue>();
+  std::uint64_t catalogue_epoch_ = 0;
   mutable std::mutex mutex_;
   std::condition_variable wake_;  // commands, play, step, stop
   std::condition_variable idle_;
   std::deque<Command> commands_;
   bool running_ = false, stopping_ = false;
   std::uint64_t steps_left_ = 0;
-  double dt_, real_time_factor_;
+  double real_time_factor_;
   HostStatus status_;
   std::vector<std::shared_ptr<FrameMailbox>> subscribers_;
   // The newest frame: a new subscriber starts from it, even while the world is paused.

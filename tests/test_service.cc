@@ -8,6 +8,7 @@
 
 #include "scene_runner.h"
 #include "service.h"
+#include "tumble/v1/snapshot.pb.h"
 
 namespace tumble::server {
 namespace {
@@ -265,6 +266,123 @@ TEST_F(ServiceTest, StreamDescribesBodiesThenSendsPoses) {
   while (frame.step() < 20 && reader->Read(&frame))
     EXPECT_EQ(frame.added_size(), 0);
   EXPECT_EQ(frame.step(), 20u);
+  context.TryCancel();
+  reader->Finish();
+}
+
+// Helpers for the snapshot tests: run n steps and wait; every body's state.
+class SnapshotTest : public ServiceTest {
+ protected:
+  void run_steps(std::uint64_t n) {
+    v1::ControlRequest step;
+    step.set_step(n);
+    grpc::ClientContext context;
+    v1::ControlResponse response;
+    ASSERT_TRUE(stub_->Control(&context, step, &response).ok());
+    ASSERT_TRUE(host_.wait_idle(std::chrono::seconds(60)));
+  }
+  v1::GetBodiesResponse bodies() {
+    grpc::ClientContext context;
+    v1::GetBodiesResponse response;
+    EXPECT_TRUE(stub_->GetBodies(&context, {}, &response).ok());
+    return response;
+  }
+  v1::SnapshotResponse snapshot() {
+    grpc::ClientContext context;
+    v1::SnapshotResponse response;
+    EXPECT_TRUE(stub_->Snapshot(&context, {}, &response).ok());
+    return response;
+  }
+  grpc::Status restore(const std::string& state) {
+    v1::RestoreRequest request;
+    request.set_state(state);
+    grpc::ClientContext context;
+    v1::RestoreResponse response;
+    return stub_->Restore(&context, request, &response);
+  }
+};
+
+TEST_F(SnapshotTest, RestoreContinuesTheRunBitForBit) {
+  v1::SpawnBodiesRequest spawn;
+  *spawn.add_bodies() = ball(6);
+  spawn.mutable_bodies(0)->set_color(0xff8000ffu);
+  grpc::ClientContext spawn_context;
+  v1::SpawnBodiesResponse spawned;
+  ASSERT_TRUE(stub_->SpawnBodies(&spawn_context, spawn, &spawned).ok());
+  run_steps(50);  // the pile is landing: contacts and warm starts in play
+  const v1::SnapshotResponse saved = snapshot();
+  EXPECT_EQ(saved.step(), 50u);
+  v1::snapshot::WorldSnapshot parsed;
+  ASSERT_TRUE(parsed.ParseFromString(saved.state()));
+  ASSERT_GT(parsed.warm_start().normal_size(), 0);
+  run_steps(60);
+  const v1::GetBodiesResponse straight = bodies();
+
+  ASSERT_TRUE(restore(saved.state()).ok());
+  EXPECT_EQ(bodies().step(), 50u);
+  run_steps(60);
+  const v1::GetBodiesResponse resumed = bodies();
+  ASSERT_EQ(resumed.step(), 110u);
+  ASSERT_EQ(resumed.states_size(), straight.states_size());
+  for (int i = 0; i < straight.states_size(); ++i) {
+    // Bit for bit: the serialized states are the same bytes.
+    EXPECT_EQ(resumed.states(i).SerializeAsString(), straight.states(i).SerializeAsString())
+        << "body " << i;
+    EXPECT_EQ(resumed.descriptions(i).color(), straight.descriptions(i).color());
+  }
+  bool coloured = false;
+  for (const auto& d : resumed.descriptions())
+    coloured |= d.id() == spawned.ids(0) && d.color() == 0xff8000ffu;
+  EXPECT_TRUE(coloured);
+}
+
+TEST_F(SnapshotTest, BadSnapshotsAreRefusedAndChangeNothing) {
+  run_steps(10);
+  const std::string good = snapshot().state();
+  const std::string before = bodies().SerializeAsString();
+  grpc::Status status = restore("not a snapshot at all");
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("state"), std::string::npos) << status.error_message();
+
+  // A well-formed snapshot with one bad number: the field is named.
+  v1::snapshot::WorldSnapshot bad;
+  ASSERT_TRUE(bad.ParseFromString(good));
+  bad.mutable_slots(3)->set_position(2, std::nan(""));
+  status = restore(bad.SerializeAsString());
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("state.slots[3].position"), std::string::npos)
+      << status.error_message();
+  bad.ParseFromString(good);
+  bad.set_version(v1::snapshot::VERSION_UNSPECIFIED);
+  status = restore(bad.SerializeAsString());
+  EXPECT_NE(status.error_message().find("version"), std::string::npos) << status.error_message();
+  bad.ParseFromString(good);
+  bad.mutable_slots(1)->mutable_shape()->clear_half_extents();
+  status = restore(bad.SerializeAsString());
+  EXPECT_NE(status.error_message().find("slots[1].shape.half_extents"), std::string::npos)
+      << status.error_message();
+  EXPECT_EQ(bodies().SerializeAsString(), before);
+}
+
+TEST_F(SnapshotTest, StreamForgetsTheOldWorldAfterARestore) {
+  const std::string saved = snapshot().state();
+  v1::SpawnBodiesRequest spawn;
+  *spawn.add_bodies() = ball(6);
+  grpc::ClientContext spawn_context;
+  v1::SpawnBodiesResponse spawned;
+  ASSERT_TRUE(stub_->SpawnBodies(&spawn_context, spawn, &spawned).ok());
+
+  grpc::ClientContext context;
+  auto reader = stub_->StreamFrames(&context, {});
+  v1::Frame frame;
+  ASSERT_TRUE(reader->Read(&frame));
+  EXPECT_EQ(frame.added_size(), 10);
+  ASSERT_TRUE(restore(saved).ok());
+  ASSERT_TRUE(reader->Read(&frame));
+  // Same ids again, but a new world: all ten are gone, nine are described afresh.
+  EXPECT_EQ(frame.removed_size(), 10);
+  EXPECT_EQ(frame.added_size(), 9);
+  EXPECT_EQ(frame.ids_size(), 9);
   context.TryCancel();
   reader->Finish();
 }

@@ -82,7 +82,8 @@ TEST(WorldHost, ABatchAppearsWholeBetweenTwoSteps) {
     }
   });
   std::this_thread::sleep_for(50ms);
-  EXPECT_TRUE(host.apply([&](World& world) { return world.create_bodies(batch).status(); }));
+  EXPECT_TRUE(
+      host.apply([&](HostedWorld& hosted) { return hosted.world.create_bodies(batch).status(); }));
   reader.join();
   host.pause();
   EXPECT_GT(before, 0u);
@@ -91,7 +92,7 @@ TEST(WorldHost, ABatchAppearsWholeBetweenTwoSteps) {
   batch[7].shape = SphereDef{-1};
   const std::size_t count = host.status().bodies;
   const Status refused =
-      host.apply([&](World& world) { return world.create_bodies(batch).status(); });
+      host.apply([&](HostedWorld& hosted) { return hosted.world.create_bodies(batch).status(); });
   EXPECT_FALSE(refused);
   EXPECT_NE(refused.message().find("bodies[7]"), std::string::npos) << refused.message();
   EXPECT_EQ(host.status().bodies, count);
@@ -123,7 +124,8 @@ TEST(WorldHost, APausedWorldStillShowsItsStateAndChanges) {
   BodyDef ball;
   ball.shape = SphereDef{0.2};
   ball.position = Vec3(0, 0, 30);
-  ASSERT_TRUE(host.apply([&](World& world) { return world.create_body(ball).status(); }));
+  ASSERT_TRUE(
+      host.apply([&](HostedWorld& hosted) { return hosted.world.create_body(ball).status(); }));
   auto changed = mailbox->take(1s);
   ASSERT_TRUE(changed.has_value());
   EXPECT_EQ(changed->frame->step, 0u);

@@ -1,0 +1,24 @@
+// Snapshot's bytes (proto/tumble/v1/snapshot.proto): a hosted world's whole state, encoded
+// exactly, and decoded with every field checked, since the bytes come from a client.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "physics/world.h"
+
+namespace tumble::server {
+
+struct SavedWorld {
+  WorldSettings settings;
+  WorldStateData state;
+  double dt = 0;                       // s per step
+  std::vector<std::uint32_t> colours;  // by slot
+};
+
+std::string encode_snapshot(const SavedWorld& saved);
+// Refusals name the field ("slots[3].shape.polyhedron.edges[2]: out of range").
+Result<SavedWorld> decode_snapshot(std::string_view bytes);
+
+}  // namespace tumble::server
