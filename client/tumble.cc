@@ -1,14 +1,19 @@
-// tumble: the command-line client. Spawns and removes bodies, steers the run, and streams
-// frames to stdout as JSON lines or CSV for other tools.
+// tumble: the command-line client. Spawns and removes bodies, steers the run, saves and restores
+// the world, and streams frames to stdout as JSON lines or CSV, or into a recording to replay.
 //   tumble --server 127.0.0.1:50051 spawn box --size 1,1,1 --mass 2 --pos 0,0,5
 //   tumble stream --format jsonl --frames 100
+// `tumble COMMAND --help` describes each command.
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "client.h"
+#include "frame_format.h"
+#include "recording.h"
 
 using namespace tumble;
 
@@ -25,67 +30,124 @@ void set_vec(const std::vector<double>& v, v1::Vec3* out) {
   out->set_z(v[2]);
 }
 
-void print_json_frame(const v1::Frame& frame) {
-  nlohmann::json line = {
-      {"step", frame.step()}, {"time", frame.time()}, {"dropped", frame.dropped()}};
-  nlohmann::json bodies = nlohmann::json::array();
-  for (int i = 0; i < frame.ids_size(); ++i) {
-    nlohmann::json body = {
-        {"id", frame.ids(i)},
-        {"p", {frame.positions(3 * i), frame.positions(3 * i + 1), frame.positions(3 * i + 2)}},
-        {"q",
-         {frame.orientations(4 * i), frame.orientations(4 * i + 1), frame.orientations(4 * i + 2),
-          frame.orientations(4 * i + 3)}}};
-    if (frame.linear_velocities_size() == 3 * frame.ids_size()) {
-      body["v"] = {frame.linear_velocities(3 * i), frame.linear_velocities(3 * i + 1),
-                   frame.linear_velocities(3 * i + 2)};
-      body["w"] = {frame.angular_velocities(3 * i), frame.angular_velocities(3 * i + 1),
-                   frame.angular_velocities(3 * i + 2)};
-    }
-    bodies.push_back(std::move(body));
-  }
-  line["bodies"] = std::move(bodies);
-  std::printf("%s\n", line.dump().c_str());
+void print_line(const std::string& text) {
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  std::fputc('\n', stdout);
 }
 
-void print_csv_frame(const v1::Frame& frame) {
-  for (int i = 0; i < frame.ids_size(); ++i)
-    std::printf("%llu,%.17g,%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                static_cast<unsigned long long>(frame.step()), frame.time(),
-                static_cast<unsigned long long>(frame.ids(i)), frame.positions(3 * i),
-                frame.positions(3 * i + 1), frame.positions(3 * i + 2), frame.orientations(4 * i),
-                frame.orientations(4 * i + 1), frame.orientations(4 * i + 2),
-                frame.orientations(4 * i + 3));
+Result<std::string> read_file(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return Status::error(path + ": cannot open");
+  std::stringstream bytes;
+  bytes << file.rdbuf();
+  return std::move(bytes).str();
+}
+
+struct SpawnOptions {
+  std::string shape;
+  std::vector<double> size{1, 1, 1}, position{0, 0, 0}, velocity{0, 0, 0}, spin{0, 0, 0};
+  double radius = 0.5, half_height = 0.5, mass = 0;
+  std::uint32_t colour = 0;
+  bool is_static = false;
+
+  v1::BodySpec spec() const {
+    v1::BodySpec spec;
+    if (shape == "box") {
+      set_vec(size, spec.mutable_shape()->mutable_box()->mutable_size());
+    } else if (shape == "sphere") {
+      spec.mutable_shape()->mutable_sphere()->set_radius(radius);
+    } else {
+      spec.mutable_shape()->mutable_capsule()->set_radius(radius);
+      spec.mutable_shape()->mutable_capsule()->set_half_height(half_height);
+    }
+    if (mass > 0) spec.set_mass(mass);
+    if (is_static) spec.set_type(v1::BODY_TYPE_STATIC);
+    set_vec(position, spec.mutable_position());
+    set_vec(velocity, spec.mutable_linear_velocity());
+    set_vec(spin, spec.mutable_angular_velocity());
+    spec.set_color(colour);
+    return spec;
+  }
+};
+
+struct StreamOptions {
+  std::string format = "jsonl";
+  std::uint64_t frames = 0;
+  double rate = 0;
+  bool velocities = false, contacts = false, stats = false;
+
+  void add_to(CLI::App* command, bool with_format) {
+    if (with_format)
+      command->add_option("--format", format, "jsonl or csv")
+          ->check(CLI::IsMember({"jsonl", "csv"}));
+    command->add_option("--frames", frames, "stop after this many frames (0: until interrupted)");
+    command->add_option("--rate", rate, "at most this many frames per second (0: every step)")
+        ->check(CLI::NonNegativeNumber);
+    command->add_flag("--velocities", velocities, "include velocities");
+    command->add_flag("--contacts", contacts, "include contact points");
+    command->add_flag("--stats", stats, "include the step statistics");
+  }
+  v1::StreamFramesRequest request() const {
+    v1::StreamFramesRequest request;
+    request.set_max_rate(rate);
+    request.set_velocities(velocities);
+    request.set_contacts(contacts);
+    request.set_stats(stats);
+    return request;
+  }
+};
+
+void print_frame(const v1::Frame& frame, const StreamOptions& options) {
+  if (options.format == "csv")
+    std::fputs(client::frame_to_csv_rows(frame, options.velocities).c_str(), stdout);
+  else
+    print_line(client::frame_to_json_line(frame));
+  std::fflush(stdout);
+}
+
+std::optional<v1::SolverKind> solver_kind(const std::string& name) {
+  if (name == "exact") return v1::SOLVER_KIND_EXACT;
+  if (name == "pgs") return v1::SOLVER_KIND_PGS;
+  if (name == "soft") return v1::SOLVER_KIND_SOFT;
+  if (name == "auto") return v1::SOLVER_KIND_AUTO;
+  return std::nullopt;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"tumble: talks to a tumble-server (spawn, remove, control, stream)."};
+  CLI::App app{"tumble: talks to a tumble-server (spawn, remove, control, stream, record)."};
   app.require_subcommand(1);
   client::Connection connection;
   app.add_option("--server", connection.address, "the server's address")->envname("TUMBLE_SERVER");
   app.add_option("--token", connection.token, "bearer token, when the server asks for one")
       ->envname("TUMBLE_TOKEN");
+  app.add_option("--tls-ca", connection.tls_ca_file,
+                 "use TLS, trusting the certificate authority in this PEM file")
+      ->envname("TUMBLE_TLS_CA");
 
   CLI::App* info = app.add_subcommand("info", "the server's version, step, time and bodies");
+  CLI::App* health =
+      app.add_subcommand("health", "the standard gRPC health check; exit 0 when serving");
 
   CLI::App* spawn = app.add_subcommand("spawn", "add one body; prints its id");
-  std::string shape;
-  std::vector<double> size{1, 1, 1}, position{0, 0, 0}, velocity{0, 0, 0}, spin{0, 0, 0};
-  double radius = 0.5, half_height = 0.5, mass = 0;
-  bool is_static = false;
-  spawn->add_option("shape", shape, "box, sphere or capsule")
+  SpawnOptions body;
+  spawn->add_option("shape", body.shape, "box, sphere or capsule")
       ->required()
       ->check(CLI::IsMember({"box", "sphere", "capsule"}));
-  spawn->add_option("--size", size, "box: full extents x,y,z (m)")->delimiter(',')->expected(3);
-  spawn->add_option("--radius", radius, "sphere, capsule: radius (m)");
-  spawn->add_option("--half-height", half_height, "capsule: half the core length (m)");
-  spawn->add_option("--mass", mass, "kg (default: from a density of 1000 kg/m^3)");
-  spawn->add_option("--pos", position, "x,y,z (m)")->delimiter(',')->expected(3);
-  spawn->add_option("--vel", velocity, "x,y,z (m/s)")->delimiter(',')->expected(3);
-  spawn->add_option("--spin", spin, "angular velocity x,y,z (rad/s)")->delimiter(',')->expected(3);
-  spawn->add_flag("--static", is_static, "a body that never moves");
+  spawn->add_option("--size", body.size, "box: full extents x,y,z (m)")
+      ->delimiter(',')
+      ->expected(3);
+  spawn->add_option("--radius", body.radius, "sphere, capsule: radius (m)");
+  spawn->add_option("--half-height", body.half_height, "capsule: half the core length (m)");
+  spawn->add_option("--mass", body.mass, "kg (default: from a density of 1000 kg/m^3)");
+  spawn->add_option("--pos", body.position, "x,y,z (m)")->delimiter(',')->expected(3);
+  spawn->add_option("--vel", body.velocity, "x,y,z (m/s)")->delimiter(',')->expected(3);
+  spawn->add_option("--spin", body.spin, "angular velocity x,y,z (rad/s)")
+      ->delimiter(',')
+      ->expected(3);
+  spawn->add_option("--color", body.colour, "drawing colour 0xRRGGBBAA (0: the viewer's choice)");
+  spawn->add_flag("--static", body.is_static, "a body that never moves");
 
   CLI::App* spawn_scene = app.add_subcommand("spawn-scene", "replace the world with a scene file");
   std::string scene_file;
@@ -97,93 +159,198 @@ int main(int argc, char** argv) {
   std::vector<std::uint64_t> ids;
   remove->add_option("ids", ids, "body ids")->required();
 
+  CLI::App* bodies = app.add_subcommand("bodies", "bodies' states as JSON lines");
+  bodies->add_option("ids", ids, "body ids (default: all)");
+
   CLI::App* play = app.add_subcommand("play", "run continuously");
   CLI::App* pause = app.add_subcommand("pause", "stop after the current step");
   CLI::App* reset = app.add_subcommand("reset", "back to the scene as loaded");
-  CLI::App* step = app.add_subcommand("step", "run N steps, then pause");
+  CLI::App* step = app.add_subcommand("step", "run N steps, pause, and return when they are done");
   std::uint32_t steps = 1;
   step->add_option("n", steps, "steps")->check(CLI::PositiveNumber);
 
-  CLI::App* stream = app.add_subcommand("stream", "frames to stdout, one per line");
-  std::string format = "jsonl";
-  std::uint64_t frames = 0;
-  double rate = 0;
-  bool velocities = false;
-  stream->add_option("--format", format, "jsonl or csv")->check(CLI::IsMember({"jsonl", "csv"}));
-  stream->add_option("--frames", frames, "stop after this many frames (0: until interrupted)");
-  stream->add_option("--rate", rate, "at most this many frames per second (0: every step)");
-  stream->add_flag("--velocities", velocities, "include velocities (jsonl)");
+  CLI::App* set = app.add_subcommand("set", "change run settings (only those given)");
+  std::optional<double> dt, real_time_factor;
+  std::optional<std::uint32_t> substeps;
+  std::string solver;
+  std::vector<double> gravity;
+  set->add_option("--dt", dt, "s per step");
+  set->add_option("--real-time-factor", real_time_factor, "1: real time; 0: as fast as possible");
+  set->add_option("--substeps", substeps, "substeps of the soft solver");
+  set->add_option("--solver", solver, "exact, pgs, soft or auto")
+      ->check(CLI::IsMember({"exact", "pgs", "soft", "auto"}));
+  set->add_option("--gravity", gravity, "x,y,z (m/s^2)")->delimiter(',')->expected(3);
+
+  CLI::App* snapshot = app.add_subcommand("snapshot", "save the whole world to a file");
+  CLI::App* restore = app.add_subcommand("restore", "replace the world with a saved one");
+  std::string state_file;
+  snapshot->add_option("file", state_file, "where to write")->required();
+  restore->add_option("file", state_file, "a file written by snapshot")
+      ->required()
+      ->check(CLI::ExistingFile);
+
+  CLI::App* stream = app.add_subcommand("stream", "frames to stdout, one per line (csv: per body)");
+  StreamOptions stream_options;
+  stream_options.add_to(stream, true);
+
+  CLI::App* record = app.add_subcommand("record", "frames into a recording file");
+  std::string recording_file;
+  record->add_option("file", recording_file, "where to write")->required();
+  StreamOptions record_options;
+  record_options.add_to(record, false);
+
+  CLI::App* replay = app.add_subcommand("replay", "a recording to stdout, as stream prints it");
+  replay->add_option("file", recording_file, "a file written by record")
+      ->required()
+      ->check(CLI::ExistingFile);
+  StreamOptions replay_options;
+  bool paced = false;
+  replay->add_option("--format", replay_options.format, "jsonl or csv")
+      ->check(CLI::IsMember({"jsonl", "csv"}));
+  replay->add_flag("--paced", paced, "at the recorded simulated-time pace, not at once");
   CLI11_PARSE(app, argc, argv);
 
-  client::Client client(connection);
+  if (*replay) {  // needs no server
+    Result<client::RecordingReader> reader = client::RecordingReader::open(recording_file);
+    if (!reader) return fail("replay", reader.status());
+    if (replay_options.format == "csv") print_line(client::csv_header(true));
+    replay_options.velocities = true;
+    v1::Frame frame;
+    double first_time = -1;
+    const auto start = std::chrono::steady_clock::now();
+    while (reader.value().next(&frame)) {
+      if (paced) {
+        if (first_time < 0) first_time = frame.time();
+        std::this_thread::sleep_until(
+            start + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                        std::chrono::duration<double>(frame.time() - first_time)));
+      }
+      print_frame(frame, replay_options);
+    }
+    if (reader.value().truncated())
+      std::fprintf(stderr, "tumble: replay: %s ends inside a frame (recording cut short)\n",
+                   recording_file.c_str());
+    return 0;
+  }
+
+  Result<client::Client> connected = client::Client::connect(connection);
+  if (!connected) return fail("--tls-ca", connected.status());
+  client::Client& client = connected.value();
   if (*info) {
     Result<v1::GetInfoResponse> got = client.info();
     if (!got) return fail("info", got.status());
     const v1::GetInfoResponse& i = got.value();
-    std::printf("%s\n", nlohmann::json{{"version", i.version()},
-                                       {"step", i.step()},
-                                       {"time", i.time()},
-                                       {"bodies", i.body_count()},
-                                       {"running", i.running()},
-                                       {"subscribers", i.subscribers()}}
-                            .dump()
-                            .c_str());
+    print_line(nlohmann::json{{"version", i.version()},
+                              {"step", i.step()},
+                              {"time", i.time()},
+                              {"bodies", i.body_count()},
+                              {"running", i.running()},
+                              {"subscribers", i.subscribers()}}
+                   .dump());
+  } else if (*health) {
+    Result<bool> serving = client.healthy();
+    if (!serving) return fail("health", serving.status());
+    print_line(serving.value() ? "SERVING" : "NOT_SERVING");
+    return serving.value() ? 0 : 1;
   } else if (*spawn) {
-    v1::BodySpec spec;
-    if (shape == "box")
-      set_vec(size, spec.mutable_shape()->mutable_box()->mutable_size());
-    else if (shape == "sphere")
-      spec.mutable_shape()->mutable_sphere()->set_radius(radius);
-    else {
-      spec.mutable_shape()->mutable_capsule()->set_radius(radius);
-      spec.mutable_shape()->mutable_capsule()->set_half_height(half_height);
-    }
-    if (mass > 0) spec.set_mass(mass);
-    if (is_static) spec.set_type(v1::BODY_TYPE_STATIC);
-    set_vec(position, spec.mutable_position());
-    set_vec(velocity, spec.mutable_linear_velocity());
-    set_vec(spin, spec.mutable_angular_velocity());
-    Result<std::vector<std::uint64_t>> made = client.spawn({spec});
+    Result<std::vector<std::uint64_t>> made = client.spawn({body.spec()});
     if (!made) return fail("spawn", made.status());
-    std::printf("%llu\n", static_cast<unsigned long long>(made.value()[0]));
+    print_line(std::to_string(made.value()[0]));
   } else if (*spawn_scene) {
-    std::ifstream file(scene_file);
-    std::stringstream text;
-    text << file.rdbuf();
+    Result<std::string> text = read_file(scene_file);
+    if (!text) return fail("spawn-scene", text.status());
     v1::LoadSceneRequest request;
-    request.set_scene_json(text.str());
+    request.set_scene_json(text.value());
     Result<v1::LoadSceneResponse> loaded = client.load_scene(request);
     if (!loaded) return fail(scene_file, loaded.status());
     std::printf("%s: %d bodies\n", loaded.value().name().c_str(), loaded.value().ids_size());
   } else if (*remove) {
     if (Status s = client.remove(ids); !s) return fail("remove", s);
-  } else if (*play || *pause || *reset || *step) {
+  } else if (*bodies) {
+    Result<v1::GetBodiesResponse> got = client.bodies(ids);
+    if (!got) return fail("bodies", got.status());
+    for (const v1::BodyState& s : got.value().states()) {
+      const auto v = [](const v1::Vec3& x) { return nlohmann::json{x.x(), x.y(), x.z()}; };
+      const v1::Quat& q = s.orientation();
+      print_line(nlohmann::json{{"id", s.id()},
+                                {"p", v(s.position())},
+                                {"q", {q.w(), q.x(), q.y(), q.z()}},
+                                {"v", v(s.linear_velocity())},
+                                {"w", v(s.angular_velocity())},
+                                {"asleep", s.asleep()}}
+                     .dump());
+    }
+  } else if (*play || *pause || *reset || *step || *set) {
     v1::ControlRequest request;
     if (*play) request.set_play(true);
     if (*pause) request.set_pause(true);
     if (*reset) request.set_reset(true);
     if (*step) request.set_step(steps);
+    v1::RunSettings* settings = request.mutable_settings();
+    if (dt) settings->set_dt(*dt);
+    if (real_time_factor) settings->set_real_time_factor(*real_time_factor);
+    if (substeps) settings->set_substeps(*substeps);
+    if (!solver.empty()) settings->set_solver(*solver_kind(solver));
+    if (!gravity.empty()) set_vec(gravity, settings->mutable_gravity());
     Result<v1::ControlResponse> done = client.control(request);
     if (!done) return fail("control", done.status());
-    std::printf("%s\n",
-                nlohmann::json{{"running", done.value().running()}, {"step", done.value().step()}}
-                    .dump()
-                    .c_str());
+    if (*step) {  // returns once the steps are done, so that the next command sees them
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(10);
+      while (done.value().running() && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        Result<v1::GetInfoResponse> now = client.info();
+        if (!now) return fail("step", now.status());
+        done.value().set_running(now.value().running());
+        done.value().set_step(now.value().step());
+      }
+    }
+    const v1::RunSettings& now = done.value().settings();
+    print_line(
+        nlohmann::json{{"running", done.value().running()},
+                       {"step", done.value().step()},
+                       {"dt", now.dt()},
+                       {"real_time_factor", now.real_time_factor()},
+                       {"substeps", now.substeps()},
+                       {"gravity", {now.gravity().x(), now.gravity().y(), now.gravity().z()}}}
+            .dump());
+  } else if (*snapshot) {
+    Result<v1::SnapshotResponse> saved = client.snapshot();
+    if (!saved) return fail("snapshot", saved.status());
+    std::ofstream file(state_file, std::ios::binary | std::ios::trunc);
+    file << saved.value().state();
+    if (!file.flush()) return fail("snapshot", Status::error(state_file + ": cannot write"));
+    std::printf("step %llu: %zu bytes to %s\n",
+                static_cast<unsigned long long>(saved.value().step()), saved.value().state().size(),
+                state_file.c_str());
+  } else if (*restore) {
+    Result<std::string> state = read_file(state_file);
+    if (!state) return fail("restore", state.status());
+    Result<v1::RestoreResponse> restored = client.restore(state.value());
+    if (!restored) return fail(state_file, restored.status());
+    std::printf("restored step %llu\n", static_cast<unsigned long long>(restored.value().step()));
   } else if (*stream) {
-    v1::StreamFramesRequest request;
-    request.set_max_rate(rate);
-    request.set_velocities(velocities);
-    if (format == "csv") std::printf("step,time,id,x,y,z,qw,qx,qy,qz\n");
+    if (stream_options.format == "csv") print_line(client::csv_header(stream_options.velocities));
     std::uint64_t received = 0;
-    const Status ended = client.stream(request, [&](const v1::Frame& frame) {
-      if (format == "csv")
-        print_csv_frame(frame);
-      else
-        print_json_frame(frame);
-      std::fflush(stdout);
-      return frames == 0 || ++received < frames;
+    const Status ended = client.stream(stream_options.request(), [&](const v1::Frame& frame) {
+      print_frame(frame, stream_options);
+      return stream_options.frames == 0 || ++received < stream_options.frames;
     });
     if (!ended) return fail("stream", ended);
+  } else if (*record) {
+    Result<client::RecordingWriter> writer = client::RecordingWriter::create(recording_file);
+    if (!writer) return fail("record", writer.status());
+    std::uint64_t received = 0, dropped = 0;
+    Status written = Status::ok();
+    const Status ended = client.stream(record_options.request(), [&](const v1::Frame& frame) {
+      written = writer.value().write(frame);
+      dropped += frame.dropped();
+      return written && (record_options.frames == 0 || ++received < record_options.frames);
+    });
+    if (!written) return fail("record", written);
+    if (!ended) return fail("record", ended);
+    std::fprintf(stderr, "tumble: recorded %llu frames to %s (%llu dropped on the way)\n",
+                 static_cast<unsigned long long>(received), recording_file.c_str(),
+                 static_cast<unsigned long long>(dropped));
   }
   return 0;
 }

@@ -9,10 +9,24 @@
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
 #include "scenes/scene.h"
 #include "scenes/standard.h"
 #include "service.h"
+
+namespace {
+
+tumble::Result<std::string> read_pem(const std::string& path, const char* flag) {
+  std::ifstream file(path);
+  if (!file) return tumble::Status::error(std::string(flag) + ": cannot read " + path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return std::move(text).str();
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace tumble;
@@ -22,7 +36,8 @@ int main(int argc, char** argv) {
   double real_time_factor = 1;
   std::size_t max_bodies = 100000;
   bool paused = false;
-  std::string token;
+  std::string token, tls_cert, tls_key;
+  int max_message_mb = 256;
   app.add_option("--listen", listen, "address to listen on (loopback by default)")
       ->envname("TUMBLE_LISTEN");
   app.add_option("--scene", scene_file, "a scene file (JSON, docs/SCENES.md)")
@@ -42,7 +57,33 @@ int main(int argc, char** argv) {
   app.add_option("--token", token,
                  "require 'authorization: Bearer TOKEN' on every call (prefer the variable)")
       ->envname("TUMBLE_TOKEN");
+  app.add_option("--tls-cert", tls_cert, "serve TLS with this certificate chain (PEM)")
+      ->envname("TUMBLE_TLS_CERT");
+  app.add_option("--tls-key", tls_key, "the certificate's private key (PEM)")
+      ->envname("TUMBLE_TLS_KEY");
+  app.add_option("--max-message-mb", max_message_mb,
+                 "largest request accepted (MiB; a Restore of a big world needs room); larger "
+                 "ones are refused with RESOURCE_EXHAUSTED")
+      ->envname("TUMBLE_MAX_MESSAGE_MB")
+      ->check(CLI::Range(1, 2047));
   CLI11_PARSE(app, argc, argv);
+  if (tls_cert.empty() != tls_key.empty()) {
+    std::fprintf(stderr, "tumble-server: --tls-cert and --tls-key go together\n");
+    return 2;
+  }
+  std::shared_ptr<grpc::ServerCredentials> credentials = grpc::InsecureServerCredentials();
+  if (!tls_cert.empty()) {
+    const tumble::Result<std::string> cert = read_pem(tls_cert, "--tls-cert");
+    const tumble::Result<std::string> key = read_pem(tls_key, "--tls-key");
+    for (const auto* pem : {&cert, &key})
+      if (!*pem) {
+        std::fprintf(stderr, "tumble-server: %s\n", pem->error().c_str());
+        return 2;
+      }
+    grpc::SslServerCredentialsOptions options;
+    options.pem_key_cert_pairs.push_back({key.value(), cert.value()});
+    credentials = grpc::SslServerCredentials(options);
+  }
 
   // SIGINT and SIGTERM are blocked in every thread (threads inherit the mask) and taken by the
   // main thread with sigwait, so shutting down runs as ordinary code, not in a signal handler.
@@ -72,7 +113,8 @@ int main(int argc, char** argv) {
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int port = 0;
-  builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &port);
+  builder.AddListeningPort(listen, credentials, &port);
+  builder.SetMaxReceiveMessageSize(max_message_mb << 20);
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> grpc_server = builder.BuildAndStart();
   if (grpc_server == nullptr || port == 0) {
@@ -81,8 +123,9 @@ int main(int argc, char** argv) {
   }
   // With port 0 the system picks one: print the one in use, for scripts and tests to read.
   const std::string bound = listen.substr(0, listen.rfind(':')) + ":" + std::to_string(port);
-  std::printf("tumble-server: scene %s, %zu bodies, listening on %s\n", scene.value().name.c_str(),
-              host.status().bodies, bound.c_str());
+  std::printf("tumble-server: scene %s, %zu bodies, listening on %s%s\n",
+              scene.value().name.c_str(), host.status().bodies, bound.c_str(),
+              tls_cert.empty() ? "" : " (TLS)");
   std::fflush(stdout);
   if (!paused) host.play();
 

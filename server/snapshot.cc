@@ -168,9 +168,9 @@ Result<Shape> take_shape(const pb::Shape& in) {
     for (int i = 0; i < p.vertices_size(); i += 3)
       poly->vertices.emplace_back(p.vertices(i), p.vertices(i + 1), p.vertices(i + 2));
     for (int i = 0; i < faces; ++i)
-      poly->faces.push_back({Vec3(p.face_normals(3 * i), p.face_normals(3 * i + 1),
-                                  p.face_normals(3 * i + 2)),
-                             p.face_offsets(i), p.face_first(i), p.face_count(i)});
+      poly->faces.push_back(
+          {Vec3(p.face_normals(3 * i), p.face_normals(3 * i + 1), p.face_normals(3 * i + 2)),
+           p.face_offsets(i), p.face_first(i), p.face_count(i)});
     poly->face_vertices.assign(p.face_vertices().begin(), p.face_vertices().end());
     for (int i = 0; i < p.edges_size(); i += 4)
       poly->edges.push_back({p.edges(i), p.edges(i + 1), p.edges(i + 2), p.edges(i + 3)});

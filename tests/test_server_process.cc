@@ -1,5 +1,6 @@
 // tumble-server as its own process on loopback: it starts on a port of the system's choosing,
-// answers and streams, and stops cleanly on SIGTERM.
+// answers and streams, serves TLS when given a certificate, refuses oversized requests, and stops
+// cleanly on SIGTERM (open streams end with OK). The `tumble` CLI drives it as a user would.
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -7,109 +8,251 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "tumble/v1/world.grpc.pb.h"
 
 namespace {
 
+namespace fs = std::filesystem;
+
 // The server process; killed if a failed assertion leaves the test before it stopped it.
-struct Child {
+struct Server {
   pid_t pid = -1;
   FILE* out = nullptr;
   bool reaped = false;
-  ~Child() {
+  std::string address;  // read from its banner
+
+  ~Server() {
     if (pid > 0 && !reaped) {
       kill(pid, SIGKILL);
       waitpid(pid, nullptr, 0);
     }
     if (out != nullptr) fclose(out);
   }
+
+  // Starts the server with its stdout on a pipe and reads the address it listens on.
+  void start(std::vector<std::string> args = {}) {
+    int fds[2];
+    ASSERT_EQ(pipe(fds), 0);
+    args.insert(args.begin(),
+                {TUMBLE_SERVER_BINARY, "--listen", "127.0.0.1:0", "--real-time-factor", "0"});
+    pid = fork();
+    if (pid == 0) {
+      dup2(fds[1], STDOUT_FILENO);
+      close(fds[0]);
+      close(fds[1]);
+      std::vector<char*> argv;
+      for (std::string& arg : args)
+        argv.push_back(arg.data());
+      argv.push_back(nullptr);
+      execv(TUMBLE_SERVER_BINARY, argv.data());
+      _exit(127);
+    }
+    close(fds[1]);
+    out = fdopen(fds[0], "r");
+    char line[256] = {};
+    ASSERT_NE(fgets(line, sizeof line, out), nullptr);
+    const std::string banner = line;
+    const auto at = banner.find("listening on ");
+    ASSERT_NE(at, std::string::npos) << banner;
+    address = banner.substr(at + 13);
+    address.erase(address.find_first_of(" \n"));
+  }
+
+  // SIGTERM, then the exit status and the last line it printed.
+  void stop(int* exit_code, std::string* last_line) {
+    ASSERT_EQ(kill(pid, SIGTERM), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    reaped = true;
+    ASSERT_TRUE(WIFEXITED(status));
+    *exit_code = WEXITSTATUS(status);
+    char line[256] = {};
+    if (fgets(line, sizeof line, out) != nullptr) *last_line = line;
+  }
 };
 
-// Starts the server with its stdout on a pipe.
-void start_server(Child* child) {
-  int fds[2];
-  if (pipe(fds) != 0) return;
-  const pid_t pid = fork();
-  if (pid == 0) {
-    dup2(fds[1], STDOUT_FILENO);
-    close(fds[0]);
-    close(fds[1]);
-    execl(TUMBLE_SERVER_BINARY, TUMBLE_SERVER_BINARY, "--listen", "127.0.0.1:0",
-          "--real-time-factor", "0", static_cast<char*>(nullptr));
-    _exit(127);
+struct Output {
+  int code = -1;
+  std::string text;  // stdout and stderr
+};
+
+Output run(const std::string& command) {
+  Output result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0)
+    result.text.append(buffer, n);
+  const int status = pclose(pipe);
+  result.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string cli(const Server& server) {
+  return std::string(TUMBLE_CLI_BINARY) + " --server " + server.address + " ";
+}
+
+// A fresh directory for one test's files, removed afterwards.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    char name[] = "/tmp/tumble-test-XXXXXX";
+    path = mkdtemp(name);
   }
-  close(fds[1]);
-  child->pid = pid;
-  child->out = fdopen(fds[0], "r");
+  ~TempDir() { fs::remove_all(path); }
+  std::string operator/(const std::string& file) const { return (path / file).string(); }
+};
+
+std::unique_ptr<tumble::v1::World::Stub> connect(const std::string& address) {
+  auto channel = grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
+  EXPECT_TRUE(
+      channel->WaitForConnected(std::chrono::system_clock::now() + std::chrono::seconds(10)));
+  return tumble::v1::World::NewStub(channel);
 }
 
 TEST(ServerProcess, ServesOverLoopbackAndStopsOnSigterm) {
-  Child server;
-  start_server(&server);
-  ASSERT_GT(server.pid, 0);
-  char line[256] = {};
-  ASSERT_NE(fgets(line, sizeof line, server.out), nullptr);
-  const std::string banner = line;
-  const auto at = banner.find("listening on ");
-  ASSERT_NE(at, std::string::npos) << banner;
-  std::string address = banner.substr(at + 13);
-  address.erase(address.find_last_not_of("\n") + 1);
-
-  auto channel = grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
-  ASSERT_TRUE(
-      channel->WaitForConnected(std::chrono::system_clock::now() + std::chrono::seconds(10)));
-  auto stub = tumble::v1::World::NewStub(channel);
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start());
+  auto stub = connect(server.address);
   {
     grpc::ClientContext context;
     tumble::v1::GetInfoResponse info;
     ASSERT_TRUE(stub->GetInfo(&context, {}, &info).ok());
     EXPECT_EQ(info.body_count(), 51u);  // the default scene
   }
-  {
-    grpc::ClientContext context;
-    tumble::v1::StreamFramesRequest request;
-    auto reader = stub->StreamFrames(&context, request);
-    tumble::v1::Frame frame;
-    ASSERT_TRUE(reader->Read(&frame));
-    EXPECT_EQ(frame.ids_size(), 51);
-    EXPECT_EQ(frame.added_size(), 51);
-    context.TryCancel();
-    reader->Finish();
-  }
   {  // the command-line client: spawn a box, then one frame as a JSON line that holds it
-    const std::string cli = std::string(TUMBLE_CLI_BINARY) + " --server " + address + " ";
-    FILE* spawn = popen((cli + "spawn box --size 1,1,1 --mass 2 --pos 0,0,5").c_str(), "r");
-    ASSERT_NE(spawn, nullptr);
-    char id[64] = {};
-    ASSERT_NE(fgets(id, sizeof id, spawn), nullptr);
-    EXPECT_EQ(pclose(spawn), 0);
-    FILE* stream = popen((cli + "stream --format jsonl --frames 1").c_str(), "r");
-    ASSERT_NE(stream, nullptr);
-    std::string json;
-    char buffer[4096];
-    while (fgets(buffer, sizeof buffer, stream) != nullptr)
-      json += buffer;
-    EXPECT_EQ(pclose(stream), 0);
-    EXPECT_EQ(json.rfind("{", 0), 0u);
-    const std::string spawned = std::string("\"id\":") + std::string(id, strcspn(id, "\n"));
-    EXPECT_NE(json.find(spawned), std::string::npos) << spawned;
-    FILE* bad = popen((cli + "spawn sphere --radius -1 2>&1").c_str(), "r");
-    ASSERT_NE(bad, nullptr);
-    ASSERT_NE(fgets(buffer, sizeof buffer, bad), nullptr);
-    EXPECT_NE(std::string(buffer).find("shape.sphere.radius"), std::string::npos) << buffer;
-    EXPECT_NE(pclose(bad), 0);
+    const Output spawned = run(cli(server) + "spawn box --size 1,1,1 --mass 2 --pos 0,0,5");
+    ASSERT_EQ(spawned.code, 0) << spawned.text;
+    const Output stream = run(cli(server) + "stream --format jsonl --frames 1");
+    EXPECT_EQ(stream.code, 0);
+    EXPECT_EQ(stream.text.rfind("{", 0), 0u);
+    const std::string id = spawned.text.substr(0, spawned.text.find('\n'));
+    EXPECT_NE(stream.text.find("\"id\":" + id), std::string::npos) << id;
+    const Output bad = run(cli(server) + "spawn sphere --radius -1");
+    EXPECT_NE(bad.text.find("shape.sphere.radius"), std::string::npos) << bad.text;
+    EXPECT_NE(bad.code, 0);
   }
-  ASSERT_EQ(kill(server.pid, SIGTERM), 0);
-  int status = 0;
-  ASSERT_EQ(waitpid(server.pid, &status, 0), server.pid);
-  server.reaped = true;
-  EXPECT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0);
-  ASSERT_NE(fgets(line, sizeof line, server.out), nullptr);
-  EXPECT_NE(std::string(line).find("stopped at step"), std::string::npos) << line;
+  // A stream open at shutdown ends with OK after its frames, not with an error.
+  grpc::ClientContext context;
+  auto reader = stub->StreamFrames(&context, {});
+  tumble::v1::Frame frame;
+  ASSERT_TRUE(reader->Read(&frame));
+  EXPECT_EQ(frame.added_size(), 52);
+  int code = -1;
+  std::string last;
+  server.stop(&code, &last);
+  EXPECT_EQ(code, 0);
+  EXPECT_NE(last.find("stopped at step"), std::string::npos) << last;
+  while (reader->Read(&frame)) {
+  }
+  EXPECT_TRUE(reader->Finish().ok());
+}
+
+TEST(ServerProcess, CliCommandsHealthSnapshotRecordAndReplay) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  TempDir dir;
+  for (const char* command :
+       {"info", "health", "spawn", "spawn-scene", "remove", "bodies", "play", "pause", "reset",
+        "step", "set", "snapshot", "restore", "stream", "record", "replay"}) {
+    const Output help = run(tumble + command + " --help");
+    EXPECT_EQ(help.code, 0) << command;
+    EXPECT_NE(help.text.find("Usage"), std::string::npos) << command << ": " << help.text;
+  }
+  const Output health = run(tumble + "health");
+  EXPECT_EQ(health.code, 0) << health.text;
+  EXPECT_EQ(health.text, "SERVING\n");
+
+  const Output set = run(tumble + "set --dt 0.01 --solver soft --gravity 0,0,-5");
+  ASSERT_EQ(set.code, 0) << set.text;
+  EXPECT_NE(set.text.find("\"dt\":0.01"), std::string::npos) << set.text;
+  EXPECT_NE(run(tumble + "set --dt -1").code, 0);
+
+  ASSERT_EQ(run(tumble + "step 30").code, 0);
+  const Output saved = run(tumble + "snapshot " + dir / "world.snapshot");
+  ASSERT_EQ(saved.code, 0) << saved.text;
+  const Output before = run(tumble + "bodies");
+  ASSERT_EQ(before.code, 0);
+  EXPECT_EQ(std::count(before.text.begin(), before.text.end(), '\n'), 51);
+
+  // Record 5 frames of the world running in real time; replay them without the server.
+  ASSERT_EQ(run(tumble + "set --real-time-factor 1").code, 0);
+  ASSERT_EQ(run(tumble + "play").code, 0);
+  const Output recorded = run(tumble + "record " + dir / "run.rec" + " --frames 5");
+  ASSERT_EQ(recorded.code, 0) << recorded.text;
+  EXPECT_NE(recorded.text.find("recorded 5 frames"), std::string::npos) << recorded.text;
+  ASSERT_EQ(run(tumble + "pause").code, 0);
+  const Output replay = run(std::string(TUMBLE_CLI_BINARY) + " replay " + dir / "run.rec");
+  ASSERT_EQ(replay.code, 0) << replay.text;
+  EXPECT_EQ(std::count(replay.text.begin(), replay.text.end(), '\n'), 5) << replay.text;
+  EXPECT_NE(replay.text.find("\"added\""), std::string::npos);  // the first frame describes all
+  const Output csv =
+      run(std::string(TUMBLE_CLI_BINARY) + " replay --format csv " + dir / "run.rec");
+  EXPECT_EQ(std::count(csv.text.begin(), csv.text.end(), '\n'), 1 + 5 * 51);
+  // A recording cut inside its last frame replays the whole frames and says so.
+  fs::resize_file(dir / "run.rec", fs::file_size(dir / "run.rec") - 10);
+  const Output cut = run(std::string(TUMBLE_CLI_BINARY) + " replay " + dir / "run.rec");
+  EXPECT_EQ(std::count(cut.text.begin(), cut.text.end(), '\n'), 5);  // 4 frames and a warning
+  EXPECT_NE(cut.text.find("cut short"), std::string::npos);
+  const Output garbage = run(std::string(TUMBLE_CLI_BINARY) + " replay " + dir / "world.snapshot");
+  EXPECT_NE(garbage.code, 0);
+  EXPECT_NE(garbage.text.find("not a tumble recording"), std::string::npos) << garbage.text;
+
+  // Back to step 30 exactly as it was.
+  const Output restored = run(tumble + "restore " + dir / "world.snapshot");
+  ASSERT_EQ(restored.code, 0) << restored.text;
+  EXPECT_EQ(run(tumble + "bodies").text, before.text);
+  const Output refused = run(tumble + "restore " + dir / "run.rec");
+  EXPECT_NE(refused.code, 0);
+  EXPECT_NE(refused.text.find("state"), std::string::npos) << refused.text;
+}
+
+TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--max-message-mb", "1"}));
+  auto stub = connect(server.address);
+  tumble::v1::RestoreRequest request;
+  request.set_state(std::string(2 << 20, 'x'));
+  grpc::ClientContext context;
+  tumble::v1::RestoreResponse response;
+  const grpc::Status status = stub->Restore(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  grpc::ClientContext info_context;
+  tumble::v1::GetInfoResponse info;
+  ASSERT_TRUE(stub->GetInfo(&info_context, {}, &info).ok());
+  EXPECT_EQ(info.body_count(), 51u);
+}
+
+TEST(ServerProcess, ServesTlsWithACertificate) {
+  TempDir dir;
+  const Output made =
+      run("openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=localhost "
+          "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout " +
+          dir / "key.pem" + " -out " + dir / "cert.pem");
+  ASSERT_EQ(made.code, 0) << made.text;
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(
+      server.start({"--tls-cert", dir / "cert.pem", "--tls-key", dir / "key.pem"}));
+  const Output secure = run(cli(server) + "--tls-ca " + dir / "cert.pem" + " info");
+  EXPECT_EQ(secure.code, 0) << secure.text;
+  EXPECT_NE(secure.text.find("\"bodies\":51"), std::string::npos) << secure.text;
+  // A plaintext client gets nothing from a TLS server.
+  const Output plain = run("timeout 20 " + cli(server) + "info");
+  EXPECT_NE(plain.code, 0) << plain.text;
+  // Half a TLS configuration is refused at start.
+  const Output half = run(std::string(TUMBLE_SERVER_BINARY) + " --listen 127.0.0.1:0 --tls-cert " +
+                          dir / "cert.pem");
+  EXPECT_EQ(half.code, 2);
+  EXPECT_NE(half.text.find("--tls-key"), std::string::npos) << half.text;
 }
 
 }  // namespace

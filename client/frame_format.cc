@@ -1,0 +1,109 @@
+#include "frame_format.h"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+namespace tumble::client {
+namespace {
+
+using Json = nlohmann::json;
+
+template <class Field>
+Json slice(const Field& values, int first, int count) {
+  Json out = Json::array();
+  for (int k = 0; k < count; ++k)
+    out.push_back(values[first + k]);
+  return out;
+}
+
+Json shape_json(const v1::Shape& shape) {
+  switch (shape.kind_case()) {
+    case v1::Shape::kBox:
+      return {{"box", {shape.box().size().x(), shape.box().size().y(), shape.box().size().z()}}};
+    case v1::Shape::kSphere:
+      return {{"sphere", shape.sphere().radius()}};
+    case v1::Shape::kCapsule:
+      return {{"capsule", {shape.capsule().radius(), shape.capsule().half_height()}}};
+    case v1::Shape::kHull:
+      return {{"hull", slice(shape.hull().points(), 0, shape.hull().points_size())}};
+    default:
+      return {{"plane", true}};
+  }
+}
+
+}  // namespace
+
+std::string frame_to_json_line(const v1::Frame& frame) {
+  Json line = {{"step", frame.step()}, {"time", frame.time()}, {"dropped", frame.dropped()}};
+  const bool velocities = frame.linear_velocities_size() == 3 * frame.ids_size();
+  Json bodies = Json::array();
+  for (int i = 0; i < frame.ids_size(); ++i) {
+    Json body = {{"id", frame.ids(i)},
+                 {"p", slice(frame.positions(), 3 * i, 3)},
+                 {"q", slice(frame.orientations(), 4 * i, 4)}};
+    if (velocities) {
+      body["v"] = slice(frame.linear_velocities(), 3 * i, 3);
+      body["w"] = slice(frame.angular_velocities(), 3 * i, 3);
+    }
+    bodies.push_back(std::move(body));
+  }
+  line["bodies"] = std::move(bodies);
+  if (frame.has_contacts()) {
+    const v1::Contacts& c = frame.contacts();
+    Json contacts = Json::array();
+    for (int i = 0; i < c.body_a_size(); ++i)
+      contacts.push_back({{"a", c.body_a(i)},
+                          {"b", c.body_b(i)},
+                          {"p", slice(c.points(), 3 * i, 3)},
+                          {"n", slice(c.normals(), 3 * i, 3)},
+                          {"depth", c.depths(i)},
+                          {"impulse", c.impulses(i)}});
+    line["contacts"] = std::move(contacts);
+  }
+  if (frame.added_size() > 0) {
+    Json added = Json::array();
+    for (const v1::BodyDescription& d : frame.added())
+      added.push_back({{"id", d.id()},
+                       {"shape", shape_json(d.shape())},
+                       {"static", d.type() == v1::BODY_TYPE_STATIC},
+                       {"mass", d.mass()},
+                       {"color", d.color()}});
+    line["added"] = std::move(added);
+  }
+  if (frame.removed_size() > 0) line["removed"] = slice(frame.removed(), 0, frame.removed_size());
+  return line.dump();
+}
+
+std::string csv_header(bool velocities) {
+  return velocities ? "step,time,id,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz"
+                    : "step,time,id,x,y,z,qw,qx,qy,qz";
+}
+
+std::string frame_to_csv_rows(const v1::Frame& frame, bool velocities) {
+  velocities = velocities && frame.linear_velocities_size() == 3 * frame.ids_size();
+  std::string rows;
+  char cell[32];
+  auto add = [&](double value) {
+    std::snprintf(cell, sizeof cell, ",%.17g", value);
+    rows += cell;
+  };
+  for (int i = 0; i < frame.ids_size(); ++i) {
+    rows += std::to_string(frame.step());
+    add(frame.time());
+    rows += "," + std::to_string(frame.ids(i));
+    for (int k = 0; k < 3; ++k)
+      add(frame.positions(3 * i + k));
+    for (int k = 0; k < 4; ++k)
+      add(frame.orientations(4 * i + k));
+    if (velocities) {
+      for (int k = 0; k < 3; ++k)
+        add(frame.linear_velocities(3 * i + k));
+      for (int k = 0; k < 3; ++k)
+        add(frame.angular_velocities(3 * i + k));
+    }
+    rows += '\n';
+  }
+  return rows;
+}
+
+}  // namespace tumble::client

@@ -1,0 +1,19 @@
+// Frames as text for other tools: one JSON object per line, or CSV rows (one per body).
+#pragma once
+
+#include <string>
+
+#include "tumble/v1/world.pb.h"
+
+namespace tumble::client {
+
+// {"step", "time", "dropped", "bodies": [{"id", "p": [x,y,z], "q": [w,x,y,z], "v", "w"}],
+//  "contacts": [{"a", "b", "p", "n", "depth", "impulse"}], "added": [...], "removed": [...]}
+// Velocities and contacts appear when the frame has them. Numbers round-trip exactly.
+std::string frame_to_json_line(const v1::Frame& frame);
+
+// "step,time,id,x,y,z,qw,qx,qy,qz" (and ",vx,vy,vz,wx,wy,wz" with velocities).
+std::string csv_header(bool velocities);
+std::string frame_to_csv_rows(const v1::Frame& frame, bool velocities);
+
+}  // namespace tumble::client
