@@ -75,6 +75,7 @@ struct StreamOptions {
   std::uint64_t frames = 0;
   double rate = 0;
   bool velocities = false, contacts = false, stats = false;
+  std::vector<std::uint64_t> ids;
 
   void add_to(CLI::App* command, bool with_format) {
     if (with_format)
@@ -86,6 +87,7 @@ struct StreamOptions {
     command->add_flag("--velocities", velocities, "include velocities");
     command->add_flag("--contacts", contacts, "include contact points");
     command->add_flag("--stats", stats, "include the step statistics");
+    command->add_option("--ids", ids, "only these bodies (default: all)")->delimiter(',');
   }
   v1::StreamFramesRequest request() const {
     v1::StreamFramesRequest request;
@@ -93,6 +95,7 @@ struct StreamOptions {
     request.set_velocities(velocities);
     request.set_contacts(contacts);
     request.set_stats(stats);
+    request.mutable_ids()->Add(ids.begin(), ids.end());
     return request;
   }
 };

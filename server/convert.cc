@@ -180,8 +180,20 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
 void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out) {
   out->set_step(frame.step);
   out->set_time(frame.time);
+  out->set_stepped_at_unix_ns(frame.stepped_at_unix_ns);
   const bool all = options.ids.empty();
-  for (std::size_t i = 0; i < frame.ids.size(); ++i) {
+  if (all) {  // whole arrays at once: the common case, and the one worth being fast
+    out->mutable_ids()->Add(frame.ids.begin(), frame.ids.end());
+    out->mutable_positions()->Add(frame.positions.begin(), frame.positions.end());
+    out->mutable_orientations()->Add(frame.orientations.begin(), frame.orientations.end());
+    if (options.velocities) {
+      out->mutable_linear_velocities()->Add(frame.linear_velocities.begin(),
+                                            frame.linear_velocities.end());
+      out->mutable_angular_velocities()->Add(frame.angular_velocities.begin(),
+                                             frame.angular_velocities.end());
+    }
+  }
+  for (std::size_t i = 0; !all && i < frame.ids.size(); ++i) {
     if (!all && !std::binary_search(options.ids.begin(), options.ids.end(), frame.ids[i])) continue;
     out->add_ids(frame.ids[i]);
     for (int k = 0; k < 3; ++k)

@@ -227,6 +227,10 @@ void WorldHost::run() {
 std::shared_ptr<const FrameData> WorldHost::make_frame() const {
   const World& world = hosted_.world;
   auto frame = std::make_shared<FrameData>();
+  frame->stepped_at_unix_ns =
+      static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     std::chrono::system_clock::now().time_since_epoch())
+                                     .count());
   frame->epoch = hosted_.epoch;
   frame->catalogue = catalogue_;
   frame->step = world.step_count();

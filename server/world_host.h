@@ -63,6 +63,7 @@ struct HostedWorld {
 // One step of the world, shared read-only by every subscriber.
 struct FrameData {
   std::uint64_t epoch = 0;  // HostedWorld::epoch
+  std::uint64_t stepped_at_unix_ns = 0;
   std::shared_ptr<const Catalogue> catalogue;
   std::uint64_t step = 0;
   double time = 0;                                            // s, simulated

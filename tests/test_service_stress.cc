@@ -149,7 +149,7 @@ TEST(ServiceStress, SpawnersAndStreamersTogether) {
   server.host().pause();
   EXPECT_EQ(failures, 0);
   EXPECT_EQ(batches_seen, kSpawners * kBatchesEach);  // every spawned body reached every streamer
-  EXPECT_EQ(torn_frames, 0);                           // no frame showed part of a batch
+  EXPECT_EQ(torn_frames, 0);                          // no frame showed part of a batch
   EXPECT_GT(frames_read, kStreamers);
   EXPECT_EQ(server.host().status().bodies, 9u + 1u);  // all batches removed; the scene and poke
 }

@@ -1,0 +1,154 @@
+// The service end to end over loopback TCP: a server in this process steps 1000 bodies; N
+// subscribers (each its own connection and thread) stream every frame. Reports the step rate with
+// and without subscribers, the frames each subscriber received per second, and the latency from
+// the end of a step to the frame's arrival (p50, p99), with the world paced at 1 kHz (dt 1 ms,
+// real time) and running flat out. Usage: bench_service [seconds per row, default 3]
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "scenes/scene.h"
+#include "service.h"
+
+namespace {
+
+using namespace tumble;
+using Clock = std::chrono::steady_clock;
+
+// 1000 spheres drifting apart without gravity: cheap steps, so the table shows the service's
+// cost, not the solver's; frames are the full 1000 poses (64 kB).
+SceneDef drifting_spheres() {
+  SceneDef scene;
+  scene.name = "drift-1000";
+  scene.dt = 0.001;
+  scene.world.gravity = Vec3::Zero();
+  scene.world.solver.sleeping = false;
+  for (int i = 0; i < 1000; ++i) {
+    BodyDef ball;
+    ball.shape = SphereDef{0.2};
+    ball.position = Vec3(i % 10, (i / 10) % 10, i / 100);
+    ball.linear_velocity = Vec3(0.01 * (i % 3), 0.01 * (i % 5), 0.01);
+    scene.bodies.push_back(ball);
+  }
+  return scene;
+}
+
+std::uint64_t unix_ns() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
+struct Row {
+  double step_rate = 0;       // steps per second of wall time
+  double frames_per_sub = 0;  // frames per second, mean over subscribers
+  double p50_ms = 0, p99_ms = 0;
+};
+
+Row measure(const SceneDef& scene, double real_time_factor, int subscribers, double seconds) {
+  server::WorldHost host(make_world(scene).value(), scene.dt, real_time_factor);
+  server::WorldService service(host, {}, scene);
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+  builder.RegisterService(&service);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  const std::string address = "127.0.0.1:" + std::to_string(port);
+
+  std::atomic<bool> stop{false};
+  std::mutex mutex;
+  std::vector<double> latencies_ms;
+  std::vector<std::uint64_t> received(subscribers, 0);
+  std::vector<std::thread> readers;
+  std::atomic<int> connected{0};
+  for (int s = 0; s < subscribers; ++s) {
+    readers.emplace_back([&, s] {
+      grpc::ChannelArguments arguments;
+      arguments.SetInt("grpc.use_local_subchannel_pool", 1);  // a connection of its own
+      auto stub = v1::World::NewStub(
+          grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), arguments));
+      grpc::ClientContext context;
+      auto reader = stub->StreamFrames(&context, {});
+      v1::Frame frame;
+      std::vector<double> mine;
+      bool first = true;
+      while (!stop && reader->Read(&frame)) {
+        if (first) {
+          first = false;
+          ++connected;
+          continue;
+        }
+        mine.push_back((unix_ns() - frame.stepped_at_unix_ns()) * 1e-6);
+        ++received[s];
+      }
+      context.TryCancel();
+      reader->Finish();
+      std::lock_guard lock(mutex);
+      latencies_ms.insert(latencies_ms.end(), mine.begin(), mine.end());
+    });
+  }
+  for (int i = 0; i < 1000 && connected < subscribers; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const std::uint64_t step0 = host.status().step;
+  std::fill(received.begin(), received.end(), 0);
+  const auto start = Clock::now();
+  host.play();
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  const std::uint64_t steps = host.status().step - step0;
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  std::vector<std::uint64_t> counts = received;
+  stop = true;
+  host.pause();
+  service.shut_down();
+  server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  for (std::thread& t : readers)
+    t.join();
+
+  Row row;
+  row.step_rate = steps / elapsed;
+  for (std::uint64_t c : counts)
+    row.frames_per_sub += c / elapsed / std::max(1, subscribers);
+  if (!latencies_ms.empty()) {
+    std::sort(latencies_ms.begin(), latencies_ms.end());
+    row.p50_ms = latencies_ms[latencies_ms.size() / 2];
+    row.p99_ms = latencies_ms[latencies_ms.size() * 99 / 100];
+  }
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
+  const SceneDef scene = drifting_spheres();
+  // The bare engine on this machine now, for the flat-out rows' ceiling.
+  {
+    World world = make_world(scene).value();
+    const auto start = Clock::now();
+    int steps = 0;
+    while (std::chrono::duration<double>(Clock::now() - start).count() < 1.0) {
+      world.step(scene.dt);
+      ++steps;
+    }
+    std::printf("bench_service: %s, the engine alone: %.0f steps/s\n", scene.name.c_str(),
+                steps / std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  std::printf("%-9s %5s %11s %11s %9s %9s\n", "pace", "subs", "steps/s", "frames/s/sub",
+              "p50 ms", "p99 ms");
+  for (double factor : {1.0, 0.0}) {
+    for (int subscribers : {0, 1, 4, 8, 16}) {
+      const Row row = measure(scene, factor, subscribers, seconds);
+      std::printf("%-9s %5d %11.0f %11.0f %9.3f %9.3f\n", factor > 0 ? "1 kHz" : "flat out",
+                  subscribers, row.step_rate, row.frames_per_sub, row.p50_ms, row.p99_ms);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
