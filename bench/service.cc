@@ -140,8 +140,8 @@ int main(int argc, char** argv) {
     std::printf("bench_service: %s, the engine alone: %.0f steps/s\n", scene.name.c_str(),
                 steps / std::chrono::duration<double>(Clock::now() - start).count());
   }
-  std::printf("%-9s %5s %11s %11s %9s %9s\n", "pace", "subs", "steps/s", "frames/s/sub",
-              "p50 ms", "p99 ms");
+  std::printf("%-9s %5s %11s %11s %9s %9s\n", "pace", "subs", "steps/s", "frames/s/sub", "p50 ms",
+              "p99 ms");
   for (double factor : {1.0, 0.0}) {
     for (int subscribers : {0, 1, 4, 8, 16}) {
       const Row row = measure(scene, factor, subscribers, seconds);
