@@ -2,7 +2,8 @@
 // subscribers (each its own connection and thread) stream every frame. Reports the step rate with
 // and without subscribers, the frames each subscriber received per second, and the latency from
 // the end of a step to the frame's arrival (p50, p99), with the world paced at 1 kHz (dt 1 ms,
-// real time) and running flat out. Usage: bench_service [seconds per row, default 3]
+// real time) and running flat out. Usage: bench_service [seconds per row, default 3] [step
+// threads, default 1: on a 2-core machine the other core serves the streams]
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -24,8 +25,9 @@ using Clock = std::chrono::steady_clock;
 
 // 1000 spheres drifting apart without gravity: cheap steps, so the table shows the service's
 // cost, not the solver's; frames are the full 1000 poses (64 kB).
-SceneDef drifting_spheres() {
+SceneDef drifting_spheres(int threads) {
   SceneDef scene;
+  scene.world.threads = threads;
   scene.name = "drift-1000";
   scene.dt = 0.001;
   scene.world.gravity = Vec3::Zero();
@@ -127,7 +129,7 @@ Row measure(const SceneDef& scene, double real_time_factor, int subscribers, dou
 
 int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
-  const SceneDef scene = drifting_spheres();
+  const SceneDef scene = drifting_spheres(argc > 2 ? std::atoi(argv[2]) : 1);
   // The bare engine on this machine now, for the flat-out rows' ceiling.
   {
     World world = make_world(scene).value();
@@ -137,7 +139,8 @@ int main(int argc, char** argv) {
       world.step(scene.dt);
       ++steps;
     }
-    std::printf("bench_service: %s, the engine alone: %.0f steps/s\n", scene.name.c_str(),
+    std::printf("bench_service: %s, %d step thread(s); the engine alone: %.0f steps/s\n",
+                scene.name.c_str(), scene.world.threads,
                 steps / std::chrono::duration<double>(Clock::now() - start).count());
   }
   std::printf("%-9s %5s %11s %11s %9s %9s\n", "pace", "subs", "steps/s", "frames/s/sub", "p50 ms",
