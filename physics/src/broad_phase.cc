@@ -3,12 +3,17 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace tumble {
 namespace {
 
 constexpr int kMaxLevels = 48;
+// Level 0 cells this many times the median body extent: bodies a little above the median stay on
+// level 0 (with cells exactly the median, half of a uniform scene went a level up and looked up
+// every cell it covers there).
+constexpr double kCellPerMedianExtent = 2.0;
 
 std::uint64_t cell_key(int level, std::int64_t x, std::int64_t y, std::int64_t z) {
   // SplitMix64 finaliser over the packed cell: equal cells give equal keys; a collision between
@@ -64,7 +69,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   if (!sizes_.empty()) {
     auto middle = sizes_.begin() + static_cast<std::ptrdiff_t>(sizes_.size() / 2);
     std::nth_element(sizes_.begin(), middle, sizes_.end());
-    if (*middle > 0) base = *middle;
+    if (*middle > 0) base = kCellPerMedianExtent * *middle;
   }
   level_.assign(n, -1);
   std::uint64_t occupied = 0;  // bit per level
@@ -128,10 +133,10 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
       const int own = level_[i];
       if (own < 0) continue;
       const Aabb& box = bounds[i];
-      double cell = base * std::ldexp(1.0, own);
-      for (int level = own + 1; level < kMaxLevels; ++level) {
-        cell *= 2;
-        if (!(occupied >> level & 1)) continue;
+      // Only the occupied coarser levels (most scenes have one or two levels in all).
+      for (std::uint64_t above = occupied & ~((2ull << own) - 1); above != 0; above &= above - 1) {
+        const int level = std::countr_zero(above);
+        const double cell = base * std::ldexp(1.0, level);
         const Eigen::Array3d lo = (box.min / cell).array().floor();
         const Eigen::Array3d hi = (box.max / cell).array().floor();
         for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x());
