@@ -2,8 +2,9 @@
 // subscribers (each its own connection and thread) stream every frame. Reports the step rate with
 // and without subscribers, the frames each subscriber received per second, and the latency from
 // the end of a step to the frame's arrival (p50, p99), with the world paced at 1 kHz (dt 1 ms,
-// real time) and running flat out. Usage: bench_service [seconds per row, default 3] [step
-// threads, default 1: on a 2-core machine the other core serves the streams]
+// real time) and running flat out; and with subscribers that never read. Usage: bench_service
+// [seconds per row, default 3] [step threads, default 1: on a 2-core machine the other core serves
+// the streams]
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -54,7 +55,9 @@ struct Row {
   double p50_ms = 0, p99_ms = 0;
 };
 
-Row measure(const SceneDef& scene, double real_time_factor, int subscribers, double seconds) {
+// `stalled`: the subscribers open their streams and never read one frame.
+Row measure(const SceneDef& scene, double real_time_factor, int subscribers, bool stalled,
+            double seconds) {
   server::WorldHost host(make_world(scene).value(), scene.dt, real_time_factor);
   server::WorldService service(host, {}, scene);
   grpc::ServerBuilder builder;
@@ -81,6 +84,13 @@ Row measure(const SceneDef& scene, double real_time_factor, int subscribers, dou
       v1::Frame frame;
       std::vector<double> mine;
       bool first = true;
+      if (stalled) {
+        ++connected;
+        while (!stop)
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        context.TryCancel();
+        return;
+      }
       while (!stop && reader->Read(&frame)) {
         if (first) {
           first = false;
@@ -97,6 +107,9 @@ Row measure(const SceneDef& scene, double real_time_factor, int subscribers, dou
     });
   }
   for (int i = 0; i < 1000 && connected < subscribers; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (int i = 0; i < 1000 && host.status().subscribers < static_cast<std::size_t>(subscribers);
+       ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const std::uint64_t step0 = host.status().step;
   std::fill(received.begin(), received.end(), 0);
@@ -143,13 +156,19 @@ int main(int argc, char** argv) {
                 scene.name.c_str(), scene.world.threads,
                 steps / std::chrono::duration<double>(Clock::now() - start).count());
   }
-  std::printf("%-9s %5s %11s %11s %9s %9s\n", "pace", "subs", "steps/s", "frames/s/sub", "p50 ms",
-              "p99 ms");
+  std::printf("%-9s %-12s %11s %11s %9s %9s\n", "pace", "subscribers", "steps/s", "frames/s/sub",
+              "p50 ms", "p99 ms");
+  struct Case {
+    int subscribers;
+    bool stalled;
+  };
   for (double factor : {1.0, 0.0}) {
-    for (int subscribers : {0, 1, 4, 8, 16}) {
-      const Row row = measure(scene, factor, subscribers, seconds);
-      std::printf("%-9s %5d %11.0f %11.0f %9.3f %9.3f\n", factor > 0 ? "1 kHz" : "flat out",
-                  subscribers, row.step_rate, row.frames_per_sub, row.p50_ms, row.p99_ms);
+    for (Case c :
+         {Case{0, false}, {1, false}, {4, false}, {8, false}, {16, false}, {1, true}, {8, true}}) {
+      const Row row = measure(scene, factor, c.subscribers, c.stalled, seconds);
+      const std::string who = std::to_string(c.subscribers) + (c.stalled ? " stalled" : "");
+      std::printf("%-9s %-12s %11.0f %11.0f %9.3f %9.3f\n", factor > 0 ? "1 kHz" : "flat out",
+                  who.c_str(), row.step_rate, row.frames_per_sub, row.p50_ms, row.p99_ms);
       std::fflush(stdout);
     }
   }
