@@ -15,7 +15,7 @@ constexpr int kMaxLevels = 48;
 // every cell it covers there).
 constexpr double kCellPerMedianExtent = 2.0;
 
-std::uint64_t cell_key(int level, std::int64_t x, std::int64_t y, std::int64_t z) {
+std::uint32_t cell_key(int level, std::int64_t x, std::int64_t y, std::int64_t z) {
   // SplitMix64 finaliser over the packed cell: equal cells give equal keys; a collision between
   // different cells only adds candidates, which the exact box test removes.
   std::uint64_t h = static_cast<std::uint64_t>(level) * 0x9E3779B97F4A7C15ull;
@@ -25,7 +25,33 @@ std::uint64_t cell_key(int level, std::int64_t x, std::int64_t y, std::int64_t z
     h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
     h ^= h >> 31;
   }
-  return h;
+  return static_cast<std::uint32_t>(h >> 32);
+}
+
+// Sorts words whose low halves already ascend by their high halves, keeping that order among
+// equal high halves: LSD radix sort, a byte per pass (stable, so the result is fully sorted).
+// Several times faster than a comparison sort on the few thousand entries of a step.
+template <class Word>
+void sort_by_high_half(std::vector<Word>* words, std::vector<Word>* scratch) {
+  const std::size_t n = words->size();
+  if (n < 64) {
+    std::sort(words->begin(), words->end());
+    return;
+  }
+  scratch->resize(n);
+  Word* from = words->data();
+  Word* to = scratch->data();
+  for (int shift = 32; shift < 64; shift += 8) {
+    std::size_t start[257] = {};
+    for (std::size_t i = 0; i < n; ++i)
+      ++start[(from[i].bits >> shift & 0xFF) + 1];
+    for (int b = 0; b < 256; ++b)
+      start[b + 1] += start[b];
+    for (std::size_t i = 0; i < n; ++i)
+      to[start[from[i].bits >> shift & 0xFF]++] = from[i];
+    std::swap(from, to);
+  }
+  // Four passes: the sorted words are back in `words`.
 }
 
 bool is_dead(const Aabb& box) {
@@ -52,6 +78,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   const std::size_t n = bounds.size();
   const int threads = std::max(1, input.threads);
   thread_entries_.resize(threads);
+  thread_scratch_.resize(threads);
   thread_pairs_.resize(threads);
 
   // Base cell size: the median extent of the bounded bodies.
@@ -100,9 +127,9 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
              ++y)
           for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z());
                ++z)
-            out.push_back({cell_key(level, x, y, z), static_cast<std::uint32_t>(i)});
+            out.emplace_back(cell_key(level, x, y, z), static_cast<std::uint32_t>(i));
     }
-    std::sort(out.begin(), out.end());
+    sort_by_high_half(&out, &thread_scratch_[t]);
   }
   // (2) One sorted array: the threads' sorted runs merged in thread order.
   merge_sorted(thread_entries_, threads, &entries_, &merge_buffer_);
@@ -122,10 +149,10 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     // Same cell: each run of equal keys, visited from its first entry.
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < entry_count; ++i) {
-      if (i > 0 && entries_[i - 1].key == entries_[i].key) continue;
-      for (std::int64_t j = i; j < entry_count && entries_[j].key == entries_[i].key; ++j)
-        for (std::int64_t k = j + 1; k < entry_count && entries_[k].key == entries_[i].key; ++k)
-          emit(entries_[j].body, entries_[k].body, out);
+      if (i > 0 && entries_[i - 1].key() == entries_[i].key()) continue;
+      for (std::int64_t j = i; j < entry_count && entries_[j].key() == entries_[i].key(); ++j)
+        for (std::int64_t k = j + 1; k < entry_count && entries_[k].key() == entries_[i].key(); ++k)
+          emit(entries_[j].body(), entries_[k].body(), out);
     }
     // Coarser levels: each body looks up the cells it covers there.
 #pragma omp for schedule(static)
@@ -145,10 +172,11 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
                ++y)
             for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z());
                  ++z) {
-              const std::uint64_t key = cell_key(level, x, y, z);
-              auto it = std::lower_bound(entries_.begin(), entries_.end(), Entry{key, 0});
-              for (; it != entries_.end() && it->key == key; ++it)
-                if (level_[it->body] == level) emit(static_cast<std::uint32_t>(i), it->body, out);
+              const std::uint32_t key = cell_key(level, x, y, z);
+              auto it = std::lower_bound(entries_.begin(), entries_.end(), Entry(key, 0));
+              for (; it != entries_.end() && it->key() == key; ++it)
+                if (level_[it->body()] == level)
+                  emit(static_cast<std::uint32_t>(i), it->body(), out);
             }
       }
     }
