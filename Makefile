@@ -8,7 +8,7 @@ CMAKE_FLAGS ?=
 all: build
 
 deps:
-	@scripts/install-deps core service
+	@scripts/install-deps core service viewer
 
 configure: deps
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
@@ -34,7 +34,7 @@ test-sanitize: deps
 
 bench: CMAKE_FLAGS += -DTUMBLE_BENCH_PEERS=ON
 bench:
-	@scripts/install-deps core service bench
+	@scripts/install-deps core service viewer bench
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DTUMBLE_BENCH_PEERS=ON >/dev/null
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 	@scripts/run-bench $(BUILD_DIR)

@@ -1,0 +1,136 @@
+// The renderer off screen (OSMesa): a known box under a fixed camera lands on the pixels its
+// projection says, the face turned to the light is brighter than the faces turned away, and a
+// specular highlight appears where the light's reflection points at the camera.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "offscreen.h"
+#include "renderer.h"
+
+namespace tumble::viewer {
+namespace {
+
+constexpr int kWidth = 320, kHeight = 240;
+
+struct Picture {
+  std::vector<std::uint8_t> rgba;
+  int brightness(int x, int y) const {  // sum of R, G, B at pixel (x, y), y from the top
+    const std::size_t i = (static_cast<std::size_t>(y) * kWidth + x) * 4;
+    return rgba[i] + rgba[i + 1] + rgba[i + 2];
+  }
+  bool is_background(int x, int y, const Lighting& l) const {
+    const std::size_t i = (static_cast<std::size_t>(y) * kWidth + x) * 4;
+    return std::abs(rgba[i] - l.background.x() * 255) < 2 &&
+           std::abs(rgba[i + 1] - l.background.y() * 255) < 2 &&
+           std::abs(rgba[i + 2] - l.background.z() * 255) < 2;
+  }
+};
+
+// Where a world point lands, in pixels from the top left.
+Eigen::Vector2f project(const Camera& camera, const Eigen::Vector3f& point) {
+  const Eigen::Vector4f clip = camera.projection(static_cast<float>(kWidth) / kHeight) *
+                               camera.view() * point.homogeneous();
+  const Eigen::Vector2f ndc = clip.head<2>() / clip.w();
+  return {(ndc.x() + 1) / 2 * kWidth, (1 - ndc.y()) / 2 * kHeight};
+}
+
+class RenderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string error;
+    ASSERT_TRUE(context_.create(kWidth, kHeight, &error)) << error;
+    renderer_ = std::make_unique<Renderer>(context_.gl());
+    ASSERT_TRUE(renderer_->init(&error)) << error;
+  }
+  // A grey unit cube (half extent 0.5) at the origin.
+  Picture draw_cube(const Camera& camera, const Lighting& lighting, float grey = 0.6f) {
+    std::vector<std::vector<Instance>> instances(3);
+    Instance cube;
+    cube.model.topLeftCorner<3, 3>() = Eigen::Matrix3f::Identity() * 0.5f;
+    cube.colour = {grey, grey, grey, 1};
+    instances[renderer_->box_mesh()].push_back(cube);
+    renderer_->draw(instances, camera, lighting, kWidth, kHeight);
+    return {context_.read_rgba()};
+  }
+  OffscreenContext context_;
+  std::unique_ptr<Renderer> renderer_;
+};
+
+TEST_F(RenderTest, TheBoxCoversItsProjectionAndNothingElse) {
+  Camera camera;
+  camera.eye = {3, -4, 2.5f};
+  camera.target = {0, 0, 0};
+  Lighting lighting;
+  const Picture picture = draw_cube(camera, lighting);
+  // The centre of the cube and the centres of its three visible faces are covered.
+  for (const Eigen::Vector3f& p : {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(0, 0, 0.5f),
+                                   Eigen::Vector3f(0, -0.5f, 0), Eigen::Vector3f(0.5f, 0, 0)}) {
+    const Eigen::Vector2f at = project(camera, p);
+    EXPECT_FALSE(picture.is_background(static_cast<int>(at.x()), static_cast<int>(at.y()),
+                                       lighting))
+        << p.transpose();
+  }
+  // Just outside each corner's projection, and the picture's corners, is background.
+  int outside = 0, covered = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      (picture.is_background(x, y, lighting) ? outside : covered)++;
+  EXPECT_TRUE(picture.is_background(0, 0, lighting));
+  EXPECT_TRUE(picture.is_background(kWidth - 1, kHeight - 1, lighting));
+  // The covered area matches the projected silhouette's bounding box roughly: more than a
+  // hundredth of the picture and less than its half.
+  EXPECT_GT(covered, kWidth * kHeight / 100);
+  EXPECT_LT(covered, kWidth * kHeight / 2);
+  Eigen::Vector2f lo(1e9f, 1e9f), hi(-1e9f, -1e9f);
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3f p(corner & 1 ? 0.5f : -0.5f, corner & 2 ? 0.5f : -0.5f,
+                            corner & 4 ? 0.5f : -0.5f);
+    const Eigen::Vector2f at = project(camera, p);
+    lo = lo.cwiseMin(at);
+    hi = hi.cwiseMax(at);
+  }
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      if (x < lo.x() - 2 || x > hi.x() + 2 || y < lo.y() - 2 || y > hi.y() + 2)
+        ASSERT_TRUE(picture.is_background(x, y, lighting)) << x << "," << y;
+  std::string error;
+  const auto path = std::filesystem::temp_directory_path() / "tumble-render-test.png";
+  EXPECT_TRUE(write_png(path.string(), picture.rgba, kWidth, kHeight, &error)) << error;
+  EXPECT_GT(std::filesystem::file_size(path), 100u);
+  std::filesystem::remove(path);
+}
+
+TEST_F(RenderTest, TheLitFaceIsBrighterAndAHighlightFacesTheCamera) {
+  Camera camera;
+  camera.eye = {3, -4, 2.5f};
+  camera.target = {0, 0, 0};
+  Lighting lighting;
+  lighting.towards_light = Eigen::Vector3f(0, 0, 1);  // straight above: the top face is lit
+  lighting.specular = 0;
+  const Picture matte = draw_cube(camera, lighting);
+  auto at = [&](const Picture& picture, const Eigen::Vector3f& p) {
+    const Eigen::Vector2f q = project(camera, p);
+    return picture.brightness(static_cast<int>(q.x()), static_cast<int>(q.y()));
+  };
+  const int top = at(matte, {0, 0, 0.5f}), front = at(matte, {0, -0.5f, 0});
+  EXPECT_GT(top, front + 100) << top << " vs " << front;  // front face: ambient only
+  // Light from behind the camera, mirrored about the front face's normal towards the camera:
+  // with specular on, the front face's centre gets brighter, and by more than elsewhere.
+  const Eigen::Vector3f to_camera = (camera.eye - Eigen::Vector3f(0, -0.5f, 0)).normalized();
+  const Eigen::Vector3f normal(0, -1, 0);
+  lighting.towards_light = 2 * to_camera.dot(normal) * normal - to_camera;  // reflect about n
+  // A dark cube, so that nothing saturates.
+  lighting.specular = 0;
+  lighting.shininess = 200;
+  const Picture without = draw_cube(camera, lighting, 0.3f);
+  lighting.specular = 0.5f;
+  const Picture with = draw_cube(camera, lighting, 0.3f);
+  const int gain_centre = at(with, {0, -0.5f, 0}) - at(without, {0, -0.5f, 0});
+  const int gain_edge = at(with, {0.45f, -0.5f, 0.45f}) - at(without, {0.45f, -0.5f, 0.45f});
+  EXPECT_GT(gain_centre, 200) << gain_centre;
+  EXPECT_GT(gain_centre, gain_edge + 50) << gain_centre << " vs " << gain_edge;
+}
+
+}  // namespace
+}  // namespace tumble::viewer
