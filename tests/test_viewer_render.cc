@@ -29,8 +29,8 @@ struct Picture {
 
 // Where a world point lands, in pixels from the top left.
 Eigen::Vector2f project(const Camera& camera, const Eigen::Vector3f& point) {
-  const Eigen::Vector4f clip = camera.projection(static_cast<float>(kWidth) / kHeight) *
-                               camera.view() * point.homogeneous();
+  const Eigen::Vector4f clip =
+      camera.projection(static_cast<float>(kWidth) / kHeight) * camera.view() * point.homogeneous();
   const Eigen::Vector2f ndc = clip.head<2>() / clip.w();
   return {(ndc.x() + 1) / 2 * kWidth, (1 - ndc.y()) / 2 * kHeight};
 }
@@ -67,8 +67,8 @@ TEST_F(RenderTest, TheBoxCoversItsProjectionAndNothingElse) {
   for (const Eigen::Vector3f& p : {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(0, 0, 0.5f),
                                    Eigen::Vector3f(0, -0.5f, 0), Eigen::Vector3f(0.5f, 0, 0)}) {
     const Eigen::Vector2f at = project(camera, p);
-    EXPECT_FALSE(picture.is_background(static_cast<int>(at.x()), static_cast<int>(at.y()),
-                                       lighting))
+    EXPECT_FALSE(
+        picture.is_background(static_cast<int>(at.x()), static_cast<int>(at.y()), lighting))
         << p.transpose();
   }
   // Just outside each corner's projection, and the picture's corners, is background.

@@ -10,46 +10,46 @@
 
 namespace tumble::viewer {
 
-#define TUMBLE_GL_FUNCTIONS(X)                                      \
-  X(PFNGLGETERRORPROC, GetError)                                    \
-  X(PFNGLGETSTRINGPROC, GetString)                                  \
-  X(PFNGLVIEWPORTPROC, Viewport)                                    \
-  X(PFNGLCLEARCOLORPROC, ClearColor)                                \
-  X(PFNGLCLEARPROC, Clear)                                          \
-  X(PFNGLENABLEPROC, Enable)                                        \
-  X(PFNGLDISABLEPROC, Disable)                                      \
-  X(PFNGLBLENDFUNCPROC, BlendFunc)                                  \
-  X(PFNGLDEPTHMASKPROC, DepthMask)                                  \
-  X(PFNGLREADPIXELSPROC, ReadPixels)                                \
-  X(PFNGLPIXELSTOREIPROC, PixelStorei)                              \
-  X(PFNGLFINISHPROC, Finish)                                        \
-  X(PFNGLCREATESHADERPROC, CreateShader)                            \
-  X(PFNGLSHADERSOURCEPROC, ShaderSource)                            \
-  X(PFNGLCOMPILESHADERPROC, CompileShader)                          \
-  X(PFNGLGETSHADERIVPROC, GetShaderiv)                              \
-  X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                    \
-  X(PFNGLDELETESHADERPROC, DeleteShader)                            \
-  X(PFNGLCREATEPROGRAMPROC, CreateProgram)                          \
-  X(PFNGLATTACHSHADERPROC, AttachShader)                            \
-  X(PFNGLLINKPROGRAMPROC, LinkProgram)                              \
-  X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                            \
-  X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)                  \
-  X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                          \
-  X(PFNGLUSEPROGRAMPROC, UseProgram)                                \
-  X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                \
-  X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                    \
-  X(PFNGLUNIFORM3FPROC, Uniform3f)                                  \
-  X(PFNGLUNIFORM1FPROC, Uniform1f)                                  \
-  X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                      \
-  X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                      \
-  X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                \
-  X(PFNGLGENBUFFERSPROC, GenBuffers)                                \
-  X(PFNGLBINDBUFFERPROC, BindBuffer)                                \
-  X(PFNGLBUFFERDATAPROC, BufferData)                                \
-  X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                          \
-  X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)      \
-  X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)              \
-  X(PFNGLVERTEXATTRIBDIVISORPROC, VertexAttribDivisor)              \
+#define TUMBLE_GL_FUNCTIONS(X)                                 \
+  X(PFNGLGETERRORPROC, GetError)                               \
+  X(PFNGLGETSTRINGPROC, GetString)                             \
+  X(PFNGLVIEWPORTPROC, Viewport)                               \
+  X(PFNGLCLEARCOLORPROC, ClearColor)                           \
+  X(PFNGLCLEARPROC, Clear)                                     \
+  X(PFNGLENABLEPROC, Enable)                                   \
+  X(PFNGLDISABLEPROC, Disable)                                 \
+  X(PFNGLBLENDFUNCPROC, BlendFunc)                             \
+  X(PFNGLDEPTHMASKPROC, DepthMask)                             \
+  X(PFNGLREADPIXELSPROC, ReadPixels)                           \
+  X(PFNGLPIXELSTOREIPROC, PixelStorei)                         \
+  X(PFNGLFINISHPROC, Finish)                                   \
+  X(PFNGLCREATESHADERPROC, CreateShader)                       \
+  X(PFNGLSHADERSOURCEPROC, ShaderSource)                       \
+  X(PFNGLCOMPILESHADERPROC, CompileShader)                     \
+  X(PFNGLGETSHADERIVPROC, GetShaderiv)                         \
+  X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)               \
+  X(PFNGLDELETESHADERPROC, DeleteShader)                       \
+  X(PFNGLCREATEPROGRAMPROC, CreateProgram)                     \
+  X(PFNGLATTACHSHADERPROC, AttachShader)                       \
+  X(PFNGLLINKPROGRAMPROC, LinkProgram)                         \
+  X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                       \
+  X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)             \
+  X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                     \
+  X(PFNGLUSEPROGRAMPROC, UseProgram)                           \
+  X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)           \
+  X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)               \
+  X(PFNGLUNIFORM3FPROC, Uniform3f)                             \
+  X(PFNGLUNIFORM1FPROC, Uniform1f)                             \
+  X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                 \
+  X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                 \
+  X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)           \
+  X(PFNGLGENBUFFERSPROC, GenBuffers)                           \
+  X(PFNGLBINDBUFFERPROC, BindBuffer)                           \
+  X(PFNGLBUFFERDATAPROC, BufferData)                           \
+  X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                     \
+  X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray) \
+  X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)         \
+  X(PFNGLVERTEXATTRIBDIVISORPROC, VertexAttribDivisor)         \
   X(PFNGLDRAWELEMENTSINSTANCEDPROC, DrawElementsInstanced)
 
 struct Gl {

@@ -8,7 +8,7 @@
 namespace tumble::viewer {
 
 struct Mesh {
-  std::vector<float> vertices;  // x y z nx ny nz per vertex
+  std::vector<float> vertices;         // x y z nx ny nz per vertex
   std::vector<std::uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
 };
 

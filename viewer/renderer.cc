@@ -139,8 +139,8 @@ void Renderer::draw(const std::vector<std::vector<Instance>>& instances, const C
       camera.projection(static_cast<float>(width) / static_cast<float>(height)) * camera.view();
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(program_, "view_projection"), 1, GL_FALSE,
                        view_projection.data());
-  gl_.Uniform3f(gl_.GetUniformLocation(program_, "camera_position"), camera.eye.x(),
-                camera.eye.y(), camera.eye.z());
+  gl_.Uniform3f(gl_.GetUniformLocation(program_, "camera_position"), camera.eye.x(), camera.eye.y(),
+                camera.eye.z());
   const Eigen::Vector3f light = lighting.towards_light.normalized();
   gl_.Uniform3f(gl_.GetUniformLocation(program_, "light_direction"), light.x(), light.y(),
                 light.z());

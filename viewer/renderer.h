@@ -21,7 +21,7 @@ struct Camera {
 
 struct Instance {
   Eigen::Matrix4f model = Eigen::Matrix4f::Identity();  // mesh space to world
-  Eigen::Vector4f colour{0.8f, 0.8f, 0.8f, 1};           // linear RGBA in [0, 1]
+  Eigen::Vector4f colour{0.8f, 0.8f, 0.8f, 1};          // linear RGBA in [0, 1]
 };
 
 struct Lighting {

@@ -1,0 +1,113 @@
+// tumble-viewer: attaches to a running tumble-server and draws its world. Off screen (OSMesa) it
+// writes PNG frames; if the server goes away it keeps the last picture, says so, and reconnects.
+//   tumble-viewer --server 127.0.0.1:50051 --offscreen --out frames --frames 120 --every 2
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "client.h"
+#include "offscreen.h"
+#include "world_view.h"
+
+using namespace tumble;
+
+int main(int argc, char** argv) {
+  CLI::App app{"tumble-viewer: draws a running tumble-server's world."};
+  client::Connection connection;
+  std::string out_dir = "frames", size = "1280x720";
+  std::uint32_t frames = 60, every = 1;
+  double give_up_after = 30;
+  std::vector<float> eye{8, -12, 6}, target{0, 0, 1};
+  bool offscreen = false;
+  app.add_option("--server", connection.address, "the server's address")->envname("TUMBLE_SERVER");
+  app.add_option("--token", connection.token, "bearer token")->envname("TUMBLE_TOKEN");
+  app.add_option("--tls-ca", connection.tls_ca_file, "TLS: the certificate authority (PEM)")
+      ->envname("TUMBLE_TLS_CA");
+  app.add_flag("--offscreen", offscreen, "render with OSMesa into PNG files (no display needed)")
+      ->required();
+  app.add_option("--out", out_dir, "folder for the PNG frames");
+  app.add_option("--frames", frames, "how many pictures to write")->check(CLI::PositiveNumber);
+  app.add_option("--every", every, "draw every Nth frame received")->check(CLI::PositiveNumber);
+  app.add_option("--size", size, "WIDTHxHEIGHT");
+  app.add_option("--eye", eye, "camera position x,y,z (m)")->delimiter(',')->expected(3);
+  app.add_option("--target", target, "point looked at x,y,z (m)")->delimiter(',')->expected(3);
+  app.add_option("--give-up-after", give_up_after,
+                 "seconds without a server before stopping (it reconnects meanwhile)");
+  CLI11_PARSE(app, argc, argv);
+
+  int width = 0, height = 0;
+  if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0) {
+    std::fprintf(stderr, "tumble-viewer: --size: expected WIDTHxHEIGHT, got %s\n", size.c_str());
+    return 2;
+  }
+  std::error_code made;
+  std::filesystem::create_directories(out_dir, made);
+  if (made) {
+    std::fprintf(stderr, "tumble-viewer: --out: %s: %s\n", out_dir.c_str(), made.message().c_str());
+    return 2;
+  }
+  viewer::OffscreenContext context;
+  std::string error;
+  if (!context.create(width, height, &error)) {
+    std::fprintf(stderr, "tumble-viewer: %s\n", error.c_str());
+    return 1;
+  }
+  viewer::Renderer renderer(context.gl());
+  if (!renderer.init(&error)) {
+    std::fprintf(stderr, "tumble-viewer: %s\n", error.c_str());
+    return 1;
+  }
+  Result<client::Client> connected = client::Client::connect(connection);
+  if (!connected) {
+    std::fprintf(stderr, "tumble-viewer: %s\n", connected.error().c_str());
+    return 2;
+  }
+  viewer::Camera camera;
+  camera.eye = {eye[0], eye[1], eye[2]};
+  camera.target = {target[0], target[1], target[2]};
+  const viewer::Lighting lighting;
+
+  std::uint32_t written = 0;
+  std::uint64_t received = 0;
+  auto lost_since = std::chrono::steady_clock::now();
+  while (written < frames) {
+    // A new stream describes every body again; the view starts over with it.
+    viewer::WorldView view;
+    client::FrameStream stream = connected.value().subscribe({});
+    v1::Frame frame;
+    bool any = false;
+    while (written < frames && stream.next(&frame)) {
+      any = true;
+      view.apply(frame);
+      if (received++ % every != 0) continue;
+      renderer.draw(view.instances(renderer), camera, lighting, width, height);
+      char name[64];
+      std::snprintf(name, sizeof name, "frame-%05u.png", written);
+      const std::string path = (std::filesystem::path(out_dir) / name).string();
+      if (!viewer::write_png(path, context.read_rgba(), width, height, &error)) {
+        std::fprintf(stderr, "tumble-viewer: %s\n", error.c_str());
+        return 1;
+      }
+      ++written;
+    }
+    if (written >= frames) break;
+    const Status ended = stream.finish();
+    if (any) {
+      lost_since = std::chrono::steady_clock::now();
+      std::fprintf(stderr, "tumble-viewer: lost the server (%s); keeping the last picture, "
+                   "reconnecting\n", ended ? "stream ended" : ended.message().c_str());
+    }
+    if (std::chrono::steady_clock::now() - lost_since >
+        std::chrono::duration<double>(give_up_after)) {
+      std::fprintf(stderr, "tumble-viewer: no server at %s for %.0f s; %u pictures written\n",
+                   connection.address.c_str(), give_up_after, written);
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  std::printf("tumble-viewer: %u pictures (%dx%d) in %s\n", written, width, height,
+              out_dir.c_str());
+  return 0;
+}

@@ -1,0 +1,90 @@
+#include "world_view.h"
+
+namespace tumble::viewer {
+
+Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t id, bool is_static) {
+  if (rgba != 0)
+    return {static_cast<float>(rgba >> 24 & 0xFF) / 255, static_cast<float>(rgba >> 16 & 0xFF) / 255,
+            static_cast<float>(rgba >> 8 & 0xFF) / 255, static_cast<float>(rgba & 0xFF) / 255};
+  if (is_static) return {0.55f, 0.57f, 0.55f, 1};
+  static const Eigen::Vector4f palette[] = {
+      {0.90f, 0.45f, 0.20f, 1}, {0.25f, 0.55f, 0.85f, 1}, {0.35f, 0.70f, 0.35f, 1},
+      {0.85f, 0.75f, 0.25f, 1}, {0.65f, 0.40f, 0.75f, 1}, {0.85f, 0.35f, 0.40f, 1}};
+  return palette[(id & 0xFFFFFFFFu) % std::size(palette)];
+}
+
+void WorldView::apply(const v1::Frame& frame) {
+  step_ = frame.step();
+  time_ = frame.time();
+  for (std::uint64_t id : frame.removed()) {
+    looks_.erase(id);
+    poses_.erase(id);
+  }
+  for (const v1::BodyDescription& d : frame.added())
+    looks_[d.id()] = d;
+  const int n = frame.ids_size();
+  if (frame.positions_size() != 3 * n || frame.orientations_size() != 4 * n) return;
+  for (int i = 0; i < n; ++i) {
+    Pose& pose = poses_[frame.ids(i)];
+    pose.position = {static_cast<float>(frame.positions(3 * i)),
+                     static_cast<float>(frame.positions(3 * i + 1)),
+                     static_cast<float>(frame.positions(3 * i + 2))};
+    pose.orientation = Eigen::Quaternionf(
+        static_cast<float>(frame.orientations(4 * i)), static_cast<float>(frame.orientations(4 * i + 1)),
+        static_cast<float>(frame.orientations(4 * i + 2)),
+        static_cast<float>(frame.orientations(4 * i + 3)));
+    pose.orientation.normalize();
+  }
+}
+
+std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
+  std::vector<std::vector<Instance>> out(3);
+  auto add = [&](int mesh, const Instance& instance) {
+    if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
+    out[mesh].push_back(instance);
+  };
+  for (const auto& [id, pose] : poses_) {
+    const auto look = looks_.find(id);
+    if (look == looks_.end()) continue;  // not described yet
+    const v1::BodyDescription& d = look->second;
+    Instance instance;
+    instance.colour = body_colour(d.color(), id, d.type() == v1::BODY_TYPE_STATIC);
+    Eigen::Affine3f model = Eigen::Translation3f(pose.position) * pose.orientation;
+    const v1::Shape& shape = d.shape();
+    switch (shape.kind_case()) {
+      case v1::Shape::kBox: {
+        const v1::Vec3& size = shape.box().size();
+        model.scale(Eigen::Vector3f(size.x(), size.y(), size.z()) / 2);
+        instance.model = model.matrix();
+        add(renderer.box_mesh(), instance);
+        break;
+      }
+      case v1::Shape::kSphere:
+        model.scale(static_cast<float>(shape.sphere().radius()));
+        instance.model = model.matrix();
+        add(renderer.sphere_mesh(), instance);
+        break;
+      case v1::Shape::kCapsule: {
+        const std::pair<float, float> key{static_cast<float>(shape.capsule().radius()),
+                                          static_cast<float>(shape.capsule().half_height())};
+        auto mesh = capsule_meshes_.find(key);
+        if (mesh == capsule_meshes_.end())
+          mesh = capsule_meshes_.emplace(key, renderer.add_mesh(capsule(key.first, key.second)))
+                     .first;
+        instance.model = model.matrix();
+        add(mesh->second, instance);
+        break;
+      }
+      case v1::Shape::kPlane:
+        model.scale(Eigen::Vector3f(200, 200, 1));  // the ground, as far as the eye goes
+        instance.model = model.matrix();
+        add(renderer.ground_mesh(), instance);
+        break;
+      default:
+        break;  // hulls: drawn once the viewer builds their meshes (issue 6, to do)
+    }
+  }
+  return out;
+}
+
+}  // namespace tumble::viewer

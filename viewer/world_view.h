@@ -1,0 +1,42 @@
+// What the viewer knows of the world: the bodies' shapes and colours from the stream's
+// descriptions, their latest poses, and from those the instances to draw. Fed with frames only;
+// knows nothing of the engine.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <unordered_map>
+#include <vector>
+
+#include "renderer.h"
+#include "tumble/v1/world.pb.h"
+
+namespace tumble::viewer {
+
+class WorldView {
+ public:
+  // Takes a frame: descriptions of added bodies, removals, and every pose in it.
+  void apply(const v1::Frame& frame);
+  // Instances by the renderer's mesh handles (capsules get meshes of their own on first sight).
+  std::vector<std::vector<Instance>> instances(Renderer& renderer);
+
+  std::uint64_t step() const { return step_; }
+  double time() const { return time_; }
+  std::size_t body_count() const { return poses_.size(); }
+
+ private:
+  struct Pose {
+    Eigen::Vector3f position = Eigen::Vector3f::Zero();
+    Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
+  };
+  std::unordered_map<std::uint64_t, v1::BodyDescription> looks_;
+  std::map<std::uint64_t, Pose> poses_;  // ordered: the same draw order every frame
+  std::map<std::pair<float, float>, int> capsule_meshes_;
+  std::uint64_t step_ = 0;
+  double time_ = 0;
+};
+
+// 0xRRGGBBAA as RGBA in [0, 1]; 0 picks a colour from a fixed palette by the body's id.
+Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t id, bool is_static);
+
+}  // namespace tumble::viewer
