@@ -92,8 +92,9 @@ TEST_F(RenderTest, TheBoxCoversItsProjectionAndNothingElse) {
   }
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x)
-      if (x < lo.x() - 2 || x > hi.x() + 2 || y < lo.y() - 2 || y > hi.y() + 2)
+      if (x < lo.x() - 2 || x > hi.x() + 2 || y < lo.y() - 2 || y > hi.y() + 2) {
         ASSERT_TRUE(picture.is_background(x, y, lighting)) << x << "," << y;
+      }
   std::string error;
   const auto path = std::filesystem::temp_directory_path() / "tumble-render-test.png";
   EXPECT_TRUE(write_png(path.string(), picture.rgba, kWidth, kHeight, &error)) << error;
