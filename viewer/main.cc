@@ -96,8 +96,10 @@ int main(int argc, char** argv) {
     const Status ended = stream.finish();
     if (any) {
       lost_since = std::chrono::steady_clock::now();
-      std::fprintf(stderr, "tumble-viewer: lost the server (%s); keeping the last picture, "
-                   "reconnecting\n", ended ? "stream ended" : ended.message().c_str());
+      std::fprintf(stderr,
+                   "tumble-viewer: lost the server (%s); keeping the last picture, "
+                   "reconnecting\n",
+                   ended ? "stream ended" : ended.message().c_str());
     }
     if (std::chrono::steady_clock::now() - lost_since >
         std::chrono::duration<double>(give_up_after)) {

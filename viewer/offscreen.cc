@@ -86,4 +86,24 @@ bool write_png(const std::string& path, const std::vector<std::uint8_t>& rgba, i
   return std::fclose(file) == 0;
 }
 
+bool read_png(const std::string& path, std::vector<std::uint8_t>* rgba, int* width, int* height,
+              std::string* error) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) {
+    *error = path + ": " + image.message;
+    return false;
+  }
+  image.format = PNG_FORMAT_RGBA;
+  rgba->resize(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, rgba->data(), 0, nullptr)) {
+    *error = path + ": " + image.message;
+    png_image_free(&image);
+    return false;
+  }
+  *width = static_cast<int>(image.width);
+  *height = static_cast<int>(image.height);
+  return true;
+}
+
 }  // namespace tumble::viewer

@@ -34,6 +34,10 @@ class OffscreenContext {
   Gl gl_;
 };
 
+// Reads a PNG as RGBA pixels, rows from the top (for tests and comparisons).
+bool read_png(const std::string& path, std::vector<std::uint8_t>* rgba, int* width, int* height,
+              std::string* error);
+
 // Writes RGBA pixels (rows from the top) as a PNG; the message says why not.
 bool write_png(const std::string& path, const std::vector<std::uint8_t>& rgba, int width,
                int height, std::string* error);

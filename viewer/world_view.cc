@@ -4,12 +4,13 @@ namespace tumble::viewer {
 
 Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t id, bool is_static) {
   if (rgba != 0)
-    return {static_cast<float>(rgba >> 24 & 0xFF) / 255, static_cast<float>(rgba >> 16 & 0xFF) / 255,
-            static_cast<float>(rgba >> 8 & 0xFF) / 255, static_cast<float>(rgba & 0xFF) / 255};
+    return {static_cast<float>(rgba >> 24 & 0xFF) / 255,
+            static_cast<float>(rgba >> 16 & 0xFF) / 255, static_cast<float>(rgba >> 8 & 0xFF) / 255,
+            static_cast<float>(rgba & 0xFF) / 255};
   if (is_static) return {0.55f, 0.57f, 0.55f, 1};
-  static const Eigen::Vector4f palette[] = {
-      {0.90f, 0.45f, 0.20f, 1}, {0.25f, 0.55f, 0.85f, 1}, {0.35f, 0.70f, 0.35f, 1},
-      {0.85f, 0.75f, 0.25f, 1}, {0.65f, 0.40f, 0.75f, 1}, {0.85f, 0.35f, 0.40f, 1}};
+  static const Eigen::Vector4f palette[] = {{0.90f, 0.45f, 0.20f, 1}, {0.25f, 0.55f, 0.85f, 1},
+                                            {0.35f, 0.70f, 0.35f, 1}, {0.85f, 0.75f, 0.25f, 1},
+                                            {0.65f, 0.40f, 0.75f, 1}, {0.85f, 0.35f, 0.40f, 1}};
   return palette[(id & 0xFFFFFFFFu) % std::size(palette)];
 }
 
@@ -29,10 +30,10 @@ void WorldView::apply(const v1::Frame& frame) {
     pose.position = {static_cast<float>(frame.positions(3 * i)),
                      static_cast<float>(frame.positions(3 * i + 1)),
                      static_cast<float>(frame.positions(3 * i + 2))};
-    pose.orientation = Eigen::Quaternionf(
-        static_cast<float>(frame.orientations(4 * i)), static_cast<float>(frame.orientations(4 * i + 1)),
-        static_cast<float>(frame.orientations(4 * i + 2)),
-        static_cast<float>(frame.orientations(4 * i + 3)));
+    pose.orientation = Eigen::Quaternionf(static_cast<float>(frame.orientations(4 * i)),
+                                          static_cast<float>(frame.orientations(4 * i + 1)),
+                                          static_cast<float>(frame.orientations(4 * i + 2)),
+                                          static_cast<float>(frame.orientations(4 * i + 3)));
     pose.orientation.normalize();
   }
 }
@@ -69,8 +70,8 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
                                           static_cast<float>(shape.capsule().half_height())};
         auto mesh = capsule_meshes_.find(key);
         if (mesh == capsule_meshes_.end())
-          mesh = capsule_meshes_.emplace(key, renderer.add_mesh(capsule(key.first, key.second)))
-                     .first;
+          mesh =
+              capsule_meshes_.emplace(key, renderer.add_mesh(capsule(key.first, key.second))).first;
         instance.model = model.matrix();
         add(mesh->second, instance);
         break;

@@ -1,0 +1,92 @@
+// tumble-viewer attached to a tumble-server, both as processes: pictures of different steps
+// differ where the bodies fell and agree where nothing moved, and the viewer outlives a restart
+// of the server.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "offscreen.h"
+#include "process_support.h"
+
+namespace tumble::viewer {
+namespace {
+
+using namespace tumble::testing;
+
+struct Png {
+  std::vector<std::uint8_t> rgba;
+  int width = 0, height = 0;
+};
+
+Png load(const std::string& path) {
+  Png png;
+  std::string error;
+  EXPECT_TRUE(read_png(path, &png.rgba, &png.width, &png.height, &error)) << error;
+  return png;
+}
+
+std::string viewer(const Server& server, const std::string& out, int frames) {
+  return std::string(TUMBLE_VIEWER_BINARY) + " --server " + server.address +
+         " --offscreen --size 320x180 --give-up-after 20 --out " + out + " --frames " +
+         std::to_string(frames);
+}
+
+TEST(ViewerProcess, PicturesOfLaterStepsDifferWhereTheBodiesFell) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  TempDir dir;
+  const Output first = run(viewer(server, dir / "start", 1));
+  ASSERT_EQ(first.code, 0) << first.text;
+  const Output stepped = run(std::string(TUMBLE_CLI_BINARY) + " --server " + server.address +
+                             " step 90");
+  ASSERT_EQ(stepped.code, 0) << stepped.text;
+  const Output later = run(viewer(server, dir / "later", 1));
+  ASSERT_EQ(later.code, 0) << later.text;
+  const Png a = load(dir / "start/frame-00000.png"), b = load(dir / "later/frame-00000.png");
+  ASSERT_EQ(a.width, 320);
+  ASSERT_EQ(a.rgba.size(), b.rgba.size());
+  // The default scene's boxes start 1.5-8 m up, in the middle of the picture, and land on the
+  // floor (some scatter towards the camera): the middle changes, the sky in the top corners
+  // does not.
+  int changed = 0, changed_in_corners = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * a.width + x) * 4;
+      const bool differs = std::abs(a.rgba[i] - b.rgba[i]) + std::abs(a.rgba[i + 1] - b.rgba[i + 1]) +
+                               std::abs(a.rgba[i + 2] - b.rgba[i + 2]) >
+                           30;
+      changed += differs;
+      const bool corner = y < a.height / 5 && (x < a.width / 5 || x >= a.width * 4 / 5);
+      if (corner) changed_in_corners += differs;
+    }
+  EXPECT_GT(changed, a.width * a.height / 50) << changed;
+  EXPECT_EQ(changed_in_corners, 0);
+}
+
+TEST(ViewerProcess, SurvivesTheServerStoppingAndStartingAgain) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start());  // running, real time factor 0
+  TempDir dir;
+  FILE* viewing = popen((viewer(server, dir / "frames", 400) + " 2>&1").c_str(), "r");
+  ASSERT_NE(viewing, nullptr);
+  for (int i = 0; i < 500 && !std::filesystem::exists(dir / "frames/frame-00010.png"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(std::filesystem::exists(dir / "frames/frame-00010.png"));
+  int code = -1;
+  std::string last;
+  const std::string address = server.address;
+  server.stop(&code, &last);
+  Server again;
+  ASSERT_NO_FATAL_FAILURE(again.start({}, address));
+  std::string output;
+  char buffer[512];
+  while (fgets(buffer, sizeof buffer, viewing) != nullptr)
+    output += buffer;
+  EXPECT_EQ(pclose(viewing), 0) << output;
+  EXPECT_NE(output.find("lost the server"), std::string::npos) << output;
+  EXPECT_NE(output.find("400 pictures"), std::string::npos) << output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "frames/frame-00399.png"));
+}
+
+}  // namespace
+}  // namespace tumble::viewer
