@@ -37,8 +37,8 @@ TEST(ViewerProcess, PicturesOfLaterStepsDifferWhereTheBodiesFell) {
   TempDir dir;
   const Output first = run(viewer(server, dir / "start", 1));
   ASSERT_EQ(first.code, 0) << first.text;
-  const Output stepped = run(std::string(TUMBLE_CLI_BINARY) + " --server " + server.address +
-                             " step 90");
+  const Output stepped =
+      run(std::string(TUMBLE_CLI_BINARY) + " --server " + server.address + " step 90");
   ASSERT_EQ(stepped.code, 0) << stepped.text;
   const Output later = run(viewer(server, dir / "later", 1));
   ASSERT_EQ(later.code, 0) << later.text;
@@ -52,7 +52,8 @@ TEST(ViewerProcess, PicturesOfLaterStepsDifferWhereTheBodiesFell) {
   for (int y = 0; y < a.height; ++y)
     for (int x = 0; x < a.width; ++x) {
       const std::size_t i = (static_cast<std::size_t>(y) * a.width + x) * 4;
-      const bool differs = std::abs(a.rgba[i] - b.rgba[i]) + std::abs(a.rgba[i + 1] - b.rgba[i + 1]) +
+      const bool differs = std::abs(a.rgba[i] - b.rgba[i]) +
+                               std::abs(a.rgba[i + 1] - b.rgba[i + 1]) +
                                std::abs(a.rgba[i + 2] - b.rgba[i + 2]) >
                            30;
       changed += differs;

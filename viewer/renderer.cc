@@ -8,8 +8,9 @@
 namespace tumble::viewer {
 namespace {
 
-// The instance buffer is the Instance array itself: 16 floats of matrix, then 4 of colour.
-static_assert(sizeof(Instance) == 20 * sizeof(float));
+// The instance buffer is the Instance array itself: 16 floats of matrix, 4 of colour, 4 of
+// material.
+static_assert(sizeof(Instance) == 24 * sizeof(float));
 
 GLuint compile(const Gl& gl, GLenum kind, const char* source, std::string* error) {
   const GLuint shader = gl.CreateShader(kind);
@@ -123,6 +124,10 @@ int Renderer::add_mesh(const Mesh& mesh) {
   gl_.VertexAttribPointer(6, 4, GL_FLOAT, GL_FALSE, stride,
                           reinterpret_cast<void*>(16 * sizeof(float)));
   gl_.VertexAttribDivisor(6, 1);
+  gl_.EnableVertexAttribArray(7);
+  gl_.VertexAttribPointer(7, 4, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(20 * sizeof(float)));
+  gl_.VertexAttribDivisor(7, 1);
   gl_.BindVertexArray(0);
   meshes_.push_back(gpu);
   return static_cast<int>(meshes_.size()) - 1;

@@ -22,6 +22,8 @@ struct Camera {
 struct Instance {
   Eigen::Matrix4f model = Eigen::Matrix4f::Identity();  // mesh space to world
   Eigen::Vector4f colour{0.8f, 0.8f, 0.8f, 1};          // linear RGBA in [0, 1]
+  // x: spacing (m) of grid lines drawn on the surface in world x and y (the ground); 0: none.
+  Eigen::Vector4f material = Eigen::Vector4f::Zero();
 };
 
 struct Lighting {

@@ -79,6 +79,7 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
       case v1::Shape::kPlane:
         model.scale(Eigen::Vector3f(200, 200, 1));  // the ground, as far as the eye goes
         instance.model = model.matrix();
+        instance.material.x() = 1;  // a metre grid
         add(renderer.ground_mesh(), instance);
         break;
       default:
