@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "hull_mesh.h"
 #include "offscreen.h"
 #include "renderer.h"
 
@@ -131,6 +132,23 @@ TEST_F(RenderTest, TheLitFaceIsBrighterAndAHighlightFacesTheCamera) {
   const int gain_edge = at(with, {0.45f, -0.5f, 0.45f}) - at(without, {0.45f, -0.5f, 0.45f});
   EXPECT_GT(gain_centre, 200) << gain_centre;
   EXPECT_GT(gain_centre, gain_edge + 50) << gain_centre << " vs " << gain_edge;
+}
+
+// A hull's mesh: every facet a triangle, wound counter-clockwise about an outward normal.
+TEST(HullMesh, TrianglesFaceOutward) {
+  const std::vector<double> points = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.2, 0.2, 0.2};
+  const Mesh mesh = hull_mesh(points);  // the inner point is not a vertex
+  ASSERT_EQ(mesh.indices.size(), 12u);
+  const Eigen::Vector3f centroid(0.25f, 0.25f, 0.25f);
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    Eigen::Vector3f corner[3], normal;
+    for (int k = 0; k < 3; ++k)
+      corner[k] = Eigen::Map<const Eigen::Vector3f>(&mesh.vertices[6 * mesh.indices[t + k]]);
+    normal = Eigen::Map<const Eigen::Vector3f>(&mesh.vertices[6 * mesh.indices[t] + 3]);
+    EXPECT_GT(normal.dot(corner[0] - centroid), 0);
+    EXPECT_GT((corner[1] - corner[0]).cross(corner[2] - corner[0]).dot(normal), 0);
+  }
+  EXPECT_TRUE(hull_mesh(std::vector<double>{0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}).indices.empty());
 }
 
 }  // namespace

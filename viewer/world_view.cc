@@ -82,8 +82,20 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
         instance.material.x() = 1;  // a metre grid
         add(renderer.ground_mesh(), instance);
         break;
+      case v1::Shape::kHull: {
+        auto mesh = hull_meshes_.find(id);
+        if (mesh == hull_meshes_.end())
+          mesh = hull_meshes_
+                     .emplace(id, renderer.add_mesh(hull_mesh(std::span<const double>(
+                                      shape.hull().points().data(),
+                                      static_cast<std::size_t>(shape.hull().points_size())))))
+                     .first;
+        instance.model = model.matrix();
+        add(mesh->second, instance);
+        break;
+      }
       default:
-        break;  // hulls: drawn once the viewer builds their meshes (issue 6, to do)
+        break;
     }
   }
   return out;

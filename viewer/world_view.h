@@ -8,6 +8,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "hull_mesh.h"
 #include "renderer.h"
 #include "tumble/v1/world.pb.h"
 
@@ -32,6 +33,7 @@ class WorldView {
   std::unordered_map<std::uint64_t, v1::BodyDescription> looks_;
   std::map<std::uint64_t, Pose> poses_;  // ordered: the same draw order every frame
   std::map<std::pair<float, float>, int> capsule_meshes_;
+  std::unordered_map<std::uint64_t, int> hull_meshes_;  // by body id: each hull its own mesh
   std::uint64_t step_ = 0;
   double time_ = 0;
 };
