@@ -32,6 +32,8 @@ class FrameStream {
   ~FrameStream();  // cancels the stream if it is still open
   FrameStream(FrameStream&&) noexcept;
   bool next(v1::Frame* frame);
+  // Ends a next() waiting on another thread (it returns false); safe from any thread.
+  void cancel() { context_->TryCancel(); }
   // Cancels the stream if frames are still coming; the stream's final status.
   Status finish();
 

@@ -1,6 +1,6 @@
 // tumble-viewer attached to a tumble-server, both as processes: pictures of different steps
-// differ where the bodies fell and agree where nothing moved, and the viewer outlives a restart
-// of the server.
+// differ where the bodies fell and agree where nothing moved, the viewer outlives a restart of
+// the server, and its window (under Xvfb) draws what its off-screen renderer draws.
 #include <gtest/gtest.h>
 
 #include <thread>
@@ -87,6 +87,32 @@ TEST(ViewerProcess, SurvivesTheServerStoppingAndStartingAgain) {
   EXPECT_NE(output.find("lost the server"), std::string::npos) << output;
   EXPECT_NE(output.find("400 pictures"), std::string::npos) << output;
   EXPECT_TRUE(std::filesystem::exists(dir / "frames/frame-00399.png"));
+}
+
+// The window under Xvfb and the off-screen renderer draw the same state alike.
+TEST(ViewerProcess, TheWindowAndTheOffscreenPictureAgree) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  TempDir dir;
+  const Output window = run("timeout 60 xvfb-run -a -s '-screen 0 1280x720x24' " +
+                            std::string(TUMBLE_VIEWER_BINARY) + " --server " + server.address +
+                            " --size 320x180 --frames 3 --screenshot " + dir / "window.png");
+  ASSERT_EQ(window.code, 0) << window.text;
+  const Output offscreen = run(viewer(server, dir / "offscreen", 1));
+  ASSERT_EQ(offscreen.code, 0) << offscreen.text;
+  const Png a = load(dir / "window.png"), b = load(dir / "offscreen/frame-00000.png");
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  int differing = 0, bodies = 0;
+  for (std::size_t i = 0; i < a.rgba.size(); i += 4) {
+    int difference = 0;
+    for (int k = 0; k < 3; ++k)
+      difference = std::max(difference, std::abs(a.rgba[i + k] - b.rgba[i + k]));
+    differing += difference > 8;
+    bodies += a.rgba[i] > a.rgba[i + 2] + 40;  // orange, red, yellow boxes: warm pixels
+  }
+  EXPECT_LT(differing, a.width * a.height / 100) << differing;
+  EXPECT_GT(bodies, a.width * a.height / 100);  // and the picture is not just floor and sky
 }
 
 }  // namespace

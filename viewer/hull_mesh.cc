@@ -20,7 +20,8 @@ Mesh hull_mesh(std::span<const double> xyz) {
   if (qh_new_qhull(qh, 3, count, coords.data(), False, options, nullptr, quiet) == 0) {
     facetT* facet;
     FORALLfacets {
-      const float n[3] = {static_cast<float>(facet->normal[0]), static_cast<float>(facet->normal[1]),
+      const float n[3] = {static_cast<float>(facet->normal[0]),
+                          static_cast<float>(facet->normal[1]),
                           static_cast<float>(facet->normal[2])};
       std::vector<const coordT*> corners;
       vertexT* vertex;

@@ -1,5 +1,7 @@
-// tumble-viewer: attaches to a running tumble-server and draws its world. Off screen (OSMesa) it
-// writes PNG frames; if the server goes away it keeps the last picture, says so, and reconnects.
+// tumble-viewer: attaches to a running tumble-server and draws its world, in a window (GLFW) or
+// off screen (OSMesa) into PNG frames; if the server goes away it keeps the last picture, says
+// so, and reconnects.
+//   tumble-viewer --server 127.0.0.1:50051
 //   tumble-viewer --server 127.0.0.1:50051 --offscreen --out frames --frames 120 --every 2
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -9,6 +11,7 @@
 
 #include "client.h"
 #include "offscreen.h"
+#include "window.h"
 #include "world_view.h"
 
 using namespace tumble;
@@ -25,8 +28,10 @@ int main(int argc, char** argv) {
   app.add_option("--token", connection.token, "bearer token")->envname("TUMBLE_TOKEN");
   app.add_option("--tls-ca", connection.tls_ca_file, "TLS: the certificate authority (PEM)")
       ->envname("TUMBLE_TLS_CA");
-  app.add_flag("--offscreen", offscreen, "render with OSMesa into PNG files (no display needed)")
-      ->required();
+  std::string screenshot;
+  app.add_flag("--offscreen", offscreen, "render with OSMesa into PNG files (no display needed)");
+  app.add_option("--screenshot", screenshot,
+                 "window: save the picture after --frames drawn frames into this PNG and close");
   app.add_option("--out", out_dir, "folder for the PNG frames");
   app.add_option("--frames", frames, "how many pictures to write")->check(CLI::PositiveNumber);
   app.add_option("--every", every, "draw every Nth frame received")->check(CLI::PositiveNumber);
@@ -42,6 +47,24 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tumble-viewer: --size: expected WIDTHxHEIGHT, got %s\n", size.c_str());
     return 2;
   }
+  Result<client::Client> connected = client::Client::connect(connection);
+  if (!connected) {
+    std::fprintf(stderr, "tumble-viewer: %s\n", connected.error().c_str());
+    return 2;
+  }
+  viewer::Camera camera;
+  camera.eye = {eye[0], eye[1], eye[2]};
+  camera.target = {target[0], target[1], target[2]};
+  if (!offscreen) {
+    viewer::WindowOptions options;
+    options.width = width;
+    options.height = height;
+    options.camera = camera;
+    options.screenshot = screenshot;
+    options.frames = static_cast<int>(frames);
+    return viewer::run_window(connected.value(), options);
+  }
+
   std::error_code made;
   std::filesystem::create_directories(out_dir, made);
   if (made) {
@@ -59,14 +82,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tumble-viewer: %s\n", error.c_str());
     return 1;
   }
-  Result<client::Client> connected = client::Client::connect(connection);
-  if (!connected) {
-    std::fprintf(stderr, "tumble-viewer: %s\n", connected.error().c_str());
-    return 2;
-  }
-  viewer::Camera camera;
-  camera.eye = {eye[0], eye[1], eye[2]};
-  camera.target = {target[0], target[1], target[2]};
   const viewer::Lighting lighting;
 
   std::uint32_t written = 0;

@@ -14,6 +14,24 @@ Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t id, bool is_static
   return palette[(id & 0xFFFFFFFFu) % std::size(palette)];
 }
 
+std::uint64_t WorldView::next_dynamic_body(std::uint64_t id) const {
+  auto is_dynamic = [&](std::uint64_t candidate) {
+    const auto look = looks_.find(candidate);
+    return look != looks_.end() && look->second.type() == v1::BODY_TYPE_DYNAMIC;
+  };
+  for (auto it = poses_.upper_bound(id); it != poses_.end(); ++it)
+    if (is_dynamic(it->first)) return it->first;
+  for (const auto& [candidate, pose] : poses_)
+    if (is_dynamic(candidate)) return candidate;
+  return 0;
+}
+
+std::optional<Eigen::Vector3f> WorldView::position_of(std::uint64_t id) const {
+  const auto pose = poses_.find(id);
+  if (pose == poses_.end()) return std::nullopt;
+  return pose->second.position;
+}
+
 void WorldView::apply(const v1::Frame& frame) {
   step_ = frame.step();
   time_ = frame.time();

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -24,6 +25,9 @@ class WorldView {
   std::uint64_t step() const { return step_; }
   double time() const { return time_; }
   std::size_t body_count() const { return poses_.size(); }
+  // The first dynamic body after `id` in id order (wrapping), or 0 when there is none.
+  std::uint64_t next_dynamic_body(std::uint64_t id) const;
+  std::optional<Eigen::Vector3f> position_of(std::uint64_t id) const;
 
  private:
   struct Pose {

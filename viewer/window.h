@@ -1,0 +1,25 @@
+// The window front end (GLFW): draws the stream as it comes, with orbit (left drag), pan (right
+// drag) and zoom (wheel); Space plays or pauses the server, N steps it once, F follows the next
+// body (again: the one after; Backspace: stop following), Esc closes. Step, simulated time,
+// bodies and frame rate show in the title.
+#pragma once
+
+#include <string>
+
+#include "client.h"
+#include "renderer.h"
+
+namespace tumble::viewer {
+
+struct WindowOptions {
+  int width = 1280, height = 720;
+  Camera camera;
+  // With a path: save the picture after `frames` drawn frames and close (for tests).
+  std::string screenshot;
+  int frames = 0;
+};
+
+// Runs until the window is closed; the exit code.
+int run_window(client::Client& client, const WindowOptions& options);
+
+}  // namespace tumble::viewer
