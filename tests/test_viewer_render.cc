@@ -7,6 +7,9 @@
 
 #include "hull_mesh.h"
 #include "offscreen.h"
+#ifdef TUMBLE_HAVE_WORLD_VIEW  // needs the API (proto/), built with the server
+#include "world_view.h"
+#endif
 #include "renderer.h"
 
 namespace tumble::viewer {
@@ -150,6 +153,48 @@ TEST(HullMesh, TrianglesFaceOutward) {
   }
   EXPECT_TRUE(hull_mesh(std::vector<double>{0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}).indices.empty());
 }
+
+#ifdef TUMBLE_HAVE_WORLD_VIEW
+// A frame's bodies become instances of their meshes; contacts add a ball and a rod each, only
+// when asked.
+TEST_F(RenderTest, FramesBecomeInstancesWithAnOptionalContactOverlay) {
+  v1::Frame frame;
+  v1::BodyDescription* box = frame.add_added();
+  box->set_id(7);
+  box->mutable_shape()->mutable_box()->mutable_size()->set_x(2);
+  box->mutable_shape()->mutable_box()->mutable_size()->set_y(1);
+  box->mutable_shape()->mutable_box()->mutable_size()->set_z(1);
+  frame.add_ids(7);
+  for (double v : {1.0, 2.0, 3.0})
+    frame.add_positions(v);
+  for (double v : {1.0, 0.0, 0.0, 0.0})
+    frame.add_orientations(v);
+  for (int c = 0; c < 2; ++c) {
+    v1::Contacts* contacts = frame.mutable_contacts();
+    contacts->add_body_a(7);
+    contacts->add_body_b(7);
+    for (double v : {0.0, 0.0, 0.5})
+      contacts->add_points(v);
+    for (double v : {0.0, 0.0, 1.0})
+      contacts->add_normals(v);
+    contacts->add_depths(0.01);
+    contacts->add_impulses(1);
+  }
+  WorldView view;
+  view.apply(frame);
+  const auto plain = view.instances(*renderer_);
+  ASSERT_EQ(plain[renderer_->box_mesh()].size(), 1u);
+  EXPECT_TRUE(plain[renderer_->sphere_mesh()].empty());
+  const Eigen::Matrix4f& model = plain[renderer_->box_mesh()][0].model;
+  EXPECT_FLOAT_EQ(model(0, 0), 1.0f);  // half of the 2 m size: the unit cube spans [-1, 1]
+  EXPECT_FLOAT_EQ(model(0, 3), 1.0f);
+  EXPECT_FLOAT_EQ(model(2, 3), 3.0f);
+  const auto overlay = view.instances(*renderer_, true);
+  EXPECT_EQ(overlay[renderer_->box_mesh()].size(), 3u);  // the body and two rods
+  EXPECT_EQ(overlay[renderer_->sphere_mesh()].size(), 2u);
+}
+
+#endif
 
 }  // namespace
 }  // namespace tumble::viewer

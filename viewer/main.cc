@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   app.add_option("--tls-ca", connection.tls_ca_file, "TLS: the certificate authority (PEM)")
       ->envname("TUMBLE_TLS_CA");
   std::string screenshot;
+  bool contacts = false;
+  app.add_flag("--contacts", contacts, "draw contact points and normals");
   app.add_flag("--offscreen", offscreen, "render with OSMesa into PNG files (no display needed)");
   app.add_option("--screenshot", screenshot,
                  "window: save the picture after --frames drawn frames into this PNG and close");
@@ -62,6 +64,7 @@ int main(int argc, char** argv) {
     options.camera = camera;
     options.screenshot = screenshot;
     options.frames = static_cast<int>(frames);
+    options.contacts = contacts;
     return viewer::run_window(connected.value(), options);
   }
 
@@ -90,14 +93,16 @@ int main(int argc, char** argv) {
   while (written < frames) {
     // A new stream describes every body again; the view starts over with it.
     viewer::WorldView view;
-    client::FrameStream stream = connected.value().subscribe({});
+    v1::StreamFramesRequest request;
+    request.set_contacts(contacts);
+    client::FrameStream stream = connected.value().subscribe(request);
     v1::Frame frame;
     bool any = false;
     while (written < frames && stream.next(&frame)) {
       any = true;
       view.apply(frame);
       if (received++ % every != 0) continue;
-      renderer.draw(view.instances(renderer), camera, lighting, width, height);
+      renderer.draw(view.instances(renderer, contacts), camera, lighting, width, height);
       char name[64];
       std::snprintf(name, sizeof name, "frame-%05u.png", written);
       const std::string path = (std::filesystem::path(out_dir) / name).string();

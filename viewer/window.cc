@@ -40,7 +40,7 @@ struct Input {
   Orbit* orbit = nullptr;
   double last_x = 0, last_y = 0;
   bool rotating = false, panning = false;
-  int play_toggles = 0, steps = 0, follow_next = 0;
+  int play_toggles = 0, steps = 0, follow_next = 0, contact_toggles = 0;
   bool stop_following = false;
 };
 
@@ -80,6 +80,7 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
   if (key == GLFW_KEY_SPACE) ++input->play_toggles;
   if (key == GLFW_KEY_N) ++input->steps;
   if (key == GLFW_KEY_F) ++input->follow_next;
+  if (key == GLFW_KEY_C) ++input->contact_toggles;
   if (key == GLFW_KEY_BACKSPACE) input->stop_following = true;
 }
 
@@ -128,7 +129,9 @@ int run_window(client::Client& client, const WindowOptions& options) {
     client::FrameStream* current = nullptr;  // under `mutex`: what closing the window cancels
     std::thread reader([&] {
       while (!closing) {
-        client::FrameStream stream = client.subscribe({});
+        v1::StreamFramesRequest request;
+        request.set_contacts(true);  // cheap to carry, drawn when toggled on
+        client::FrameStream stream = client.subscribe(request);
         {
           std::lock_guard lock(mutex);
           view = WorldView();  // a new stream describes everything again
@@ -161,7 +164,7 @@ int run_window(client::Client& client, const WindowOptions& options) {
 
     const Lighting lighting;
     std::uint64_t following = 0;
-    bool running = true;
+    bool running = true, contacts = options.contacts;
     int drawn = 0;
     auto second = std::chrono::steady_clock::now();
     int frames_this_second = 0;
@@ -195,7 +198,9 @@ int run_window(client::Client& client, const WindowOptions& options) {
         if (input.stop_following) following = 0, input.stop_following = false;
         if (following != 0)
           if (const auto at = view.position_of(following)) orbit.target = *at;
-        instances = view.instances(renderer);
+        if (input.contact_toggles % 2 == 1) contacts = !contacts;
+        input.contact_toggles = 0;
+        instances = view.instances(renderer, contacts);
         step = view.step();
         time = view.time();
         bodies = view.body_count();

@@ -1,6 +1,7 @@
 // The window front end (GLFW): draws the stream as it comes, with orbit (left drag), pan (right
-// drag) and zoom (wheel); Space plays or pauses the server, N steps it once, F follows the next
-// body (again: the one after; Backspace: stop following), Esc closes. Step, simulated time,
+// drag) and zoom (wheel); Space plays or pauses the server, N steps it once, C shows or hides
+// contacts, F follows the next body (again: the one after; Backspace: stop following), Esc
+// closes. Step, simulated time,
 // bodies and frame rate show in the title.
 #pragma once
 
@@ -17,6 +18,7 @@ struct WindowOptions {
   // With a path: save the picture after `frames` drawn frames and close (for tests).
   std::string screenshot;
   int frames = 0;
+  bool contacts = false;  // the overlay at start
 };
 
 // Runs until the window is closed; the exit code.

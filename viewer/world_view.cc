@@ -41,6 +41,7 @@ void WorldView::apply(const v1::Frame& frame) {
   }
   for (const v1::BodyDescription& d : frame.added())
     looks_[d.id()] = d;
+  contacts_ = frame.contacts();
   const int n = frame.ids_size();
   if (frame.positions_size() != 3 * n || frame.orientations_size() != 4 * n) return;
   for (int i = 0; i < n; ++i) {
@@ -56,7 +57,7 @@ void WorldView::apply(const v1::Frame& frame) {
   }
 }
 
-std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
+std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer, bool contacts) {
   std::vector<std::vector<Instance>> out(3);
   auto add = [&](int mesh, const Instance& instance) {
     if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
@@ -114,6 +115,31 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
       }
       default:
         break;
+    }
+  }
+  const int points = contacts_.body_a_size();
+  if (contacts && contacts_.points_size() == 3 * points && contacts_.normals_size() == 3 * points) {
+    for (int i = 0; i < points; ++i) {
+      const Eigen::Vector3f p(static_cast<float>(contacts_.points(3 * i)),
+                              static_cast<float>(contacts_.points(3 * i + 1)),
+                              static_cast<float>(contacts_.points(3 * i + 2)));
+      const Eigen::Vector3f n = Eigen::Vector3f(static_cast<float>(contacts_.normals(3 * i)),
+                                                static_cast<float>(contacts_.normals(3 * i + 1)),
+                                                static_cast<float>(contacts_.normals(3 * i + 2)))
+                                    .normalized();
+      Instance point;
+      point.model = (Eigen::Translation3f(p) * Eigen::Scaling(0.04f)).matrix();
+      point.colour = {0.9f, 0.1f, 0.1f, 1};
+      add(renderer.sphere_mesh(), point);
+      // The rod: the unit cube squeezed to 1 cm and stretched to 0.2 m along the normal.
+      Instance rod;
+      const Eigen::Quaternionf turn =
+          Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), n);
+      rod.model = (Eigen::Translation3f(p + 0.1f * n) * turn *
+                   Eigen::Scaling(Eigen::Vector3f(0.005f, 0.005f, 0.1f)))
+                      .matrix();
+      rod.colour = {0.95f, 0.95f, 0.95f, 1};
+      add(renderer.box_mesh(), rod);
     }
   }
   return out;

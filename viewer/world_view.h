@@ -20,7 +20,9 @@ class WorldView {
   // Takes a frame: descriptions of added bodies, removals, and every pose in it.
   void apply(const v1::Frame& frame);
   // Instances by the renderer's mesh handles (capsules get meshes of their own on first sight).
-  std::vector<std::vector<Instance>> instances(Renderer& renderer);
+  // With `contacts`, the last frame's contact points (small red balls) and normals (thin white
+  // rods, 0.2 m from the point along the normal) are added, when the stream carries them.
+  std::vector<std::vector<Instance>> instances(Renderer& renderer, bool contacts = false);
 
   std::uint64_t step() const { return step_; }
   double time() const { return time_; }
@@ -38,6 +40,7 @@ class WorldView {
   std::map<std::uint64_t, Pose> poses_;  // ordered: the same draw order every frame
   std::map<std::pair<float, float>, int> capsule_meshes_;
   std::unordered_map<std::uint64_t, int> hull_meshes_;  // by body id: each hull its own mesh
+  v1::Contacts contacts_;
   std::uint64_t step_ = 0;
   double time_ = 0;
 };
