@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
   std::printf("bench_viewer: %s, %dx%d, median of %d frames\n",
               reinterpret_cast<const char*>(context.gl().GetString(GL_RENDERER)), kWidth, kHeight,
               frames);
-  std::printf("| boxes | draw ms | frames/s | read back ms | PNG write ms |\n|---|---|---|---|---|\n");
+  std::printf(
+      "| boxes | draw ms | frames/s | read back ms | PNG write ms |\n|---|---|---|---|---|\n");
   for (int count : {1000, 10000}) {
     std::vector<std::vector<Instance>> instances(3);
     const int side = static_cast<int>(std::ceil(std::cbrt(count)));
@@ -52,7 +53,8 @@ int main(int argc, char** argv) {
       const Eigen::Vector3f at(1.5f * (i % side) - side * 0.75f,
                                1.5f * ((i / side) % side) - side * 0.75f,
                                0.5f + 1.5f * (i / (side * side)));
-      const Eigen::Quaternionf turn(Eigen::AngleAxisf(0.1f * i, Eigen::Vector3f(1, 2, 3).normalized()));
+      const Eigen::Quaternionf turn(
+          Eigen::AngleAxisf(0.1f * i, Eigen::Vector3f(1, 2, 3).normalized()));
       box.model = (Eigen::Translation3f(at) * turn * Eigen::Scaling(0.5f)).matrix();
       box.colour = {0.3f + 0.5f * (i % 3) / 2, 0.4f, 0.8f - 0.5f * (i % 5) / 4, 1};
       instances[renderer.box_mesh()].push_back(box);
@@ -72,7 +74,8 @@ int main(int argc, char** argv) {
       const double got = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
       start = Clock::now();
       write_png("/tmp/bench_viewer.png", rgba, kWidth, kHeight, &error);
-      const double written = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+      const double written =
+          std::chrono::duration<double, std::milli>(Clock::now() - start).count();
       if (f < 2) continue;  // warm-up
       draw.push_back(drawn);
       read.push_back(got);

@@ -4,8 +4,10 @@
 //   tumble-viewer --server 127.0.0.1:50051
 //   tumble-viewer --server 127.0.0.1:50051 --offscreen --out frames --frames 120 --every 2
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <thread>
 
@@ -37,6 +39,12 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "folder for the PNG frames");
   app.add_option("--frames", frames, "how many pictures to write")->check(CLI::PositiveNumber);
   app.add_option("--every", every, "draw every Nth frame received")->check(CLI::PositiveNumber);
+  double fps = 0;
+  std::string video;
+  app.add_option("--fps", fps,
+                 "pictures per simulated second (instead of --every), and the video's frame rate")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--video", video, "also encode the pictures into this video (needs ffmpeg)");
   app.add_option("--size", size, "WIDTHxHEIGHT");
   app.add_option("--eye", eye, "camera position x,y,z (m)")->delimiter(',')->expected(3);
   app.add_option("--target", target, "point looked at x,y,z (m)")->delimiter(',')->expected(3);
@@ -86,8 +94,26 @@ int main(int argc, char** argv) {
     return 1;
   }
   const viewer::Lighting lighting;
+  // The video: raw frames piped to ffmpeg, which encodes them as they come.
+  FILE* encoder = nullptr;
+  if (!video.empty()) {
+    if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0) {
+      std::fprintf(stderr, "tumble-viewer: --video: ffmpeg is not installed\n");
+      return 2;
+    }
+    const std::string command = "ffmpeg -loglevel error -y -f rawvideo -pix_fmt rgba -s " +
+                                std::to_string(width) + "x" + std::to_string(height) + " -r " +
+                                std::to_string(fps > 0 ? fps : 30) + " -i - -pix_fmt yuv420p '" +
+                                video + "'";
+    encoder = popen(command.c_str(), "w");
+    if (encoder == nullptr) {
+      std::fprintf(stderr, "tumble-viewer: --video: cannot start ffmpeg\n");
+      return 1;
+    }
+  }
 
   std::uint32_t written = 0;
+  double next_picture_time = -1;  // with --fps: simulated time of the next picture
   std::uint64_t received = 0;
   auto lost_since = std::chrono::steady_clock::now();
   while (written < frames) {
@@ -101,15 +127,22 @@ int main(int argc, char** argv) {
     while (written < frames && stream.next(&frame)) {
       any = true;
       view.apply(frame);
-      if (received++ % every != 0) continue;
+      if (fps > 0) {
+        if (frame.time() < next_picture_time) continue;
+        next_picture_time = std::max(next_picture_time, frame.time()) + 1 / fps;
+      } else if (received++ % every != 0) {
+        continue;
+      }
       renderer.draw(view.instances(renderer, contacts), camera, lighting, width, height);
+      const std::vector<std::uint8_t> picture = context.read_rgba();
       char name[64];
       std::snprintf(name, sizeof name, "frame-%05u.png", written);
       const std::string path = (std::filesystem::path(out_dir) / name).string();
-      if (!viewer::write_png(path, context.read_rgba(), width, height, &error)) {
+      if (!viewer::write_png(path, picture, width, height, &error)) {
         std::fprintf(stderr, "tumble-viewer: %s\n", error.c_str());
         return 1;
       }
+      if (encoder != nullptr) std::fwrite(picture.data(), 1, picture.size(), encoder);
       ++written;
     }
     if (written >= frames) break;
@@ -131,5 +164,12 @@ int main(int argc, char** argv) {
   }
   std::printf("tumble-viewer: %u pictures (%dx%d) in %s\n", written, width, height,
               out_dir.c_str());
+  if (encoder != nullptr) {
+    if (pclose(encoder) != 0) {
+      std::fprintf(stderr, "tumble-viewer: --video: ffmpeg failed\n");
+      return 1;
+    }
+    std::printf("tumble-viewer: video %s\n", video.c_str());
+  }
   return 0;
 }
