@@ -27,7 +27,7 @@ demo: build
 test-sanitize: deps
 	@cmake -S . -B $(BUILD_DIR)-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTUMBLE_SANITIZE=address -DTUMBLE_BUILD_BENCH=OFF >/dev/null
 	@cmake --build $(BUILD_DIR)-asan -j $(JOBS)
-	@cd $(BUILD_DIR)-asan && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j $(JOBS)
+	@cd $(BUILD_DIR)-asan && ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp ctest --output-on-failure -j $(JOBS)
 	@cmake -S . -B $(BUILD_DIR)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTUMBLE_SANITIZE=thread -DTUMBLE_BUILD_BENCH=OFF >/dev/null
 	@cmake --build $(BUILD_DIR)-tsan -j $(JOBS) --target test_world_host
 	@cd $(BUILD_DIR)-tsan && OMP_NUM_THREADS=1 TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -j $(JOBS) -R '^(Mailbox|WorldHost)[.]'
