@@ -68,7 +68,10 @@ bool Renderer::init(std::string* error) {
   const GLuint vertex = compile(gl_, GL_VERTEX_SHADER, kPhongVertexShader, error);
   if (vertex == 0) return false;
   const GLuint fragment = compile(gl_, GL_FRAGMENT_SHADER, kPhongFragmentShader, error);
-  if (fragment == 0) return false;
+  if (fragment == 0) {
+    gl_.DeleteShader(vertex);
+    return false;
+  }
   program_ = gl_.CreateProgram();
   gl_.AttachShader(program_, vertex);
   gl_.AttachShader(program_, fragment);
