@@ -54,9 +54,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-sleep", no_sleep, "keep every body awake");
   CLI11_PARSE(app, argc, argv);
 
-  Result<SceneDef> scene = !scene_file.empty() ? load_scene_file(scene_file)
-                           : !standard.empty() ? standard_scene(standard)
-                                               : parse_scene(default_scene_json());
+  Result<SceneDef> scene = chosen_scene(scene_file, standard);
   if (!scene) {
     std::fprintf(stderr, "tumble-run: %s\n", scene.error().c_str());
     return 2;

@@ -93,9 +93,7 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
-  Result<SceneDef> scene = !scene_file.empty()   ? load_scene_file(scene_file)
-                           : !scene_name.empty() ? standard_scene(scene_name)
-                                                 : parse_scene(default_scene_json());
+  Result<SceneDef> scene = chosen_scene(scene_file, scene_name);
   if (!scene) {
     std::fprintf(stderr, "tumble-server: %s\n", scene.error().c_str());
     return 2;

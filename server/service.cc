@@ -462,6 +462,7 @@ grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
   std::shared_ptr<FrameMailbox> mailbox = host_.subscribe();
   std::vector<std::uint64_t> known;  // ids this subscriber has descriptions of, sorted
   std::uint64_t dropped = 0, epoch = 0;
+  std::shared_ptr<const Catalogue> known_catalogue;  // held, so its address cannot be reused
   auto last_sent = std::chrono::steady_clock::time_point{};
   while (!context->IsCancelled() && !shutting_down_) {
     auto delivery = mailbox->take(std::chrono::milliseconds(100));
@@ -476,27 +477,32 @@ grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
     v1::Frame frame;
     frame_to_proto(data, options, &frame);
     frame.set_dropped(dropped);
-    // Bodies new to this subscriber get their descriptions; vanished ones are listed.
-    std::vector<std::uint64_t> current(frame.ids().begin(), frame.ids().end());
-    std::sort(current.begin(), current.end());
-    if (data.epoch != epoch) {  // a new world: every body it had before is gone
-      for (std::uint64_t wire : known)
+    // Bodies new to this subscriber get their descriptions; vanished ones are listed. The host
+    // makes a new catalogue (and a new world a new epoch) whenever the set of bodies changes, so
+    // a frame sharing the last one's catalogue has nothing to diff.
+    if (data.catalogue != known_catalogue) {
+      std::vector<std::uint64_t> current(frame.ids().begin(), frame.ids().end());
+      std::sort(current.begin(), current.end());
+      if (data.epoch != epoch) {  // a new world: every body it had before is gone
+        for (std::uint64_t wire : known)
+          frame.add_removed(wire);
+        known.clear();
+        epoch = data.epoch;
+      }
+      std::vector<std::uint64_t> added, removed;
+      std::set_difference(current.begin(), current.end(), known.begin(), known.end(),
+                          std::back_inserter(added));
+      std::set_difference(known.begin(), known.end(), current.begin(), current.end(),
+                          std::back_inserter(removed));
+      for (std::uint64_t wire : added) {
+        const auto look = data.catalogue->find(wire);
+        if (look != data.catalogue->end()) describe(wire, look->second, frame.add_added());
+      }
+      for (std::uint64_t wire : removed)
         frame.add_removed(wire);
-      known.clear();
-      epoch = data.epoch;
+      known = std::move(current);
+      known_catalogue = data.catalogue;
     }
-    std::vector<std::uint64_t> added, removed;
-    std::set_difference(current.begin(), current.end(), known.begin(), known.end(),
-                        std::back_inserter(added));
-    std::set_difference(known.begin(), known.end(), current.begin(), current.end(),
-                        std::back_inserter(removed));
-    for (std::uint64_t wire : added) {
-      const auto look = data.catalogue->find(wire);
-      if (look != data.catalogue->end()) describe(wire, look->second, frame.add_added());
-    }
-    for (std::uint64_t wire : removed)
-      frame.add_removed(wire);
-    known = std::move(current);
     if (!writer->Write(frame)) break;  // the client went away
     dropped = 0;
     last_sent = now;

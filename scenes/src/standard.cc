@@ -168,4 +168,10 @@ Result<SceneDef> standard_scene(std::string_view spec) {
                        "mass-ratio-inv, bullet, slide, spin, bounce, default");
 }
 
+Result<SceneDef> chosen_scene(const std::string& file, const std::string& standard) {
+  if (!file.empty()) return load_scene_file(file);
+  if (!standard.empty()) return standard_scene(standard);
+  return parse_scene(default_scene_json());
+}
+
 }  // namespace tumble

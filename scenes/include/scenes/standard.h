@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "scenes/scene.h"
@@ -40,5 +41,9 @@ SceneDef bounce_scene(double height = 1,
 // A standard scene by name, with an optional size: "pile", "pile:250", "pyramid:10", "tower:5",
 // "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "default".
 Result<SceneDef> standard_scene(std::string_view name);
+
+// What a program was asked to run: the scene file when given, else the standard scene when
+// named, else the built-in default scene.
+Result<SceneDef> chosen_scene(const std::string& file, const std::string& standard);
 
 }  // namespace tumble
