@@ -62,6 +62,8 @@ void put_settings(const WorldSettings& s, pb::WorldSettings* out) {
   o->set_exact_max_points(v.exact_max_points);
   o->set_friction_directions(v.friction_directions);
   o->set_lemke_pivots_per_unknown(v.lemke_pivots_per_unknown);
+  o->set_exact_max_island_points(v.exact_max_island_points);
+  o->set_exact_velocity_tolerance(v.exact_velocity_tolerance);
   o->set_sleeping(v.sleeping);
   o->set_sleep_linear_speed(v.sleep_linear_speed);
   o->set_sleep_angular_speed(v.sleep_angular_speed);
@@ -107,6 +109,8 @@ Result<WorldSettings> take_settings(const pb::WorldSettings& in) {
   v.exact_max_points = o.exact_max_points();
   v.friction_directions = o.friction_directions();
   v.lemke_pivots_per_unknown = o.lemke_pivots_per_unknown();
+  if (o.exact_max_island_points() != 0) v.exact_max_island_points = o.exact_max_island_points();
+  if (o.exact_velocity_tolerance() != 0) v.exact_velocity_tolerance = o.exact_velocity_tolerance();
   v.sleeping = o.sleeping();
   v.sleep_linear_speed = o.sleep_linear_speed();
   v.sleep_angular_speed = o.sleep_angular_speed();

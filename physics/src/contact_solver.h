@@ -29,6 +29,9 @@ struct SolverBody {
   // and the rotation vector (sum of w h over substeps; a step turns a body by little).
   Vec3 delta_position = Vec3::Zero();
   Vec3 delta_angle = Vec3::Zero();
+  // Pseudo-velocities that push the body out of penetration (exact solver): the position update
+  // moves the body by them once, and no velocity is left behind.
+  Vec3 push_v = Vec3::Zero(), push_w = Vec3::Zero();
 };
 
 // One contact point between bodies `a` and `b` (slot indices).

@@ -20,11 +20,26 @@ namespace tumble {
 
 struct ExactSolveResult {
   LemkeResult lemke;
+  // The largest velocity error of the accepted answer (m/s; exact_velocity_error).
+  double velocity_error = 0;
+  // Penetration was pushed out (or there was none); false leaves it to position correction.
+  bool pushed_out = false;
   bool solved() const { return lemke.outcome == LemkeOutcome::kSolved; }
 };
 
+// How far an LCP answer z is from right, in m/s: the worst violation of w = M z + q >= 0 and of
+// its complementarity with z, over the velocity rows with M's true diagonal `diagonal` (M itself
+// may be regularised) and over the friction-cone rows that follow them, whose impulses are made
+// velocities by the stiffness of their point's normal row.
+double exact_velocity_error(const Eigen::Ref<const Eigen::MatrixXd>& m,
+                            std::span<const double> diagonal,
+                            const Eigen::Ref<const Eigen::VectorXd>& q,
+                            const Eigen::Ref<const Eigen::VectorXd>& z, int velocity_rows);
+
 // Solves the island's rows over a step h and applies the impulses to `bodies` on success; on
-// failure nothing is changed.
+// failure nothing is changed. An answer whose velocity error exceeds
+// settings.exact_velocity_tolerance is a failure (kInaccurate). On success, penetration is
+// pushed out through the bodies' pseudo-velocities (push_v, push_w), not their velocities.
 ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
                                       std::span<const std::uint32_t> ids,
                                       std::span<SolverBody> bodies, const SolverSettings& settings,

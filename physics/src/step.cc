@@ -95,6 +95,8 @@ void advance_island(const IslandContext& c, double dt, IslandReport* report) {
     if (!exact.solved()) {
       report->exact_failed = true;
       solve_pgs(c, dt, report);
+    } else {
+      report->needs_position_correction = !exact.pushed_out;
     }
   } else if (!c.rows.empty()) {
     solve_pgs(c, dt, report);
@@ -365,7 +367,14 @@ void World::prepare_contacts(double /*dt*/) {
     IslandSolver kind = IslandSolver::kSoft;
     switch (solver.kind) {
       case SolverKind::kExact:
-        kind = IslandSolver::kExact;
+        // A dense LCP of 10 unknowns a point: past the bound, memory and pivots would grow
+        // with the square and cube of the island (a pyramid of 20 is 2,360 points, 8.7 GB).
+        if (points > static_cast<std::uint32_t>(solver.exact_max_island_points)) {
+          kind = IslandSolver::kSoft;
+          s.reports[i].exact_oversized = true;
+        } else {
+          kind = IslandSolver::kExact;
+        }
         break;
       case SolverKind::kPgs:
         kind = IslandSolver::kPgs;
@@ -379,7 +388,9 @@ void World::prepare_contacts(double /*dt*/) {
         // solve's cost (8-direction pyramids make 10 unknowns per point). A body touching
         // nothing takes the plain step of dt.
         const bool alone = s.islands.body_begin[i + 1] - s.islands.body_begin[i] == 1;
-        const bool small = points <= static_cast<std::uint32_t>(solver.exact_max_points);
+        const bool small =
+            points <= static_cast<std::uint32_t>(
+                          std::min(solver.exact_max_points, solver.exact_max_island_points));
         kind = points == 0 || (!alone && small) ? IslandSolver::kExact : IslandSolver::kSoft;
         break;
       }
@@ -446,6 +457,7 @@ void World::solve_islands(double dt) {
     else
       ++stats_.iterative_islands;
     stats_.exact_fallbacks += report.exact_failed ? 1 : 0;
+    stats_.exact_oversized += report.exact_oversized ? 1 : 0;
     stats_.lemke_pivots += report.lemke_pivots;
     stats_.velocity_iterations += report.velocity_iterations;
     stats_.gyroscopic_limit_hits += report.gyroscopic_limit_hits;
@@ -456,15 +468,17 @@ void World::solve_islands(double dt) {
 void World::correct_positions() {
   StepScratch& s = *scratch_;
   const SolverSettings& solver = settings_.solver;
-  // Soft islands corrected their penetration inside the substeps, exact ones in the LCP.
+  // Soft islands corrected their penetration inside the substeps, exact ones by their push-out
+  // LCP unless it failed.
   auto needs_correction = [&](std::uint32_t i) {
     const IslandReport& report = s.reports[i];
     return report.solver == IslandSolver::kPgs ||
-           (report.solver == IslandSolver::kExact && report.exact_failed);
+           (report.solver == IslandSolver::kExact &&
+            (report.exact_failed || report.needs_position_correction));
   };
   bool any = false;
-  for (const IslandReport& report : s.reports)
-    any |= report.solver == IslandSolver::kPgs || report.exact_failed;
+  for (std::uint32_t i = 0; i < s.reports.size(); ++i)
+    any |= needs_correction(i);
   if (!any || solver.position_iterations == 0) return;
   const int threads = team_size(settings_.threads);
   const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());

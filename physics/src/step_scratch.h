@@ -15,6 +15,8 @@ enum class IslandSolver : std::uint8_t { kExact, kPgs, kSoft };
 struct IslandReport {
   IslandSolver solver = IslandSolver::kSoft;
   bool exact_failed = false;
+  bool exact_oversized = false;            // asked for exact, too large: solved soft
+  bool needs_position_correction = false;  // exact, but its push-out LCP failed
   std::uint32_t gyroscopic_limit_hits = 0;
   std::uint64_t lemke_pivots = 0, velocity_iterations = 0;
   double residual = 0;

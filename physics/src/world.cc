@@ -54,6 +54,10 @@ Status validate(const WorldSettings& s) {
     return Status::error("solver.friction_directions: must be in [4, 32]");
   if (v.lemke_pivots_per_unknown < 1)
     return Status::error("solver.lemke_pivots_per_unknown: must be >= 1");
+  if (v.exact_max_island_points < 1 || v.exact_max_island_points > 256)
+    return Status::error("solver.exact_max_island_points: must be in [1, 256]");
+  if (!(v.exact_velocity_tolerance > 0) || !std::isfinite(v.exact_velocity_tolerance))
+    return Status::error("solver.exact_velocity_tolerance: must be finite and > 0");
   auto non_negative = [](double x) { return std::isfinite(x) && x >= 0; };
   if (!non_negative(v.velocity_tolerance))
     return Status::error("solver.velocity_tolerance: must be finite and >= 0");

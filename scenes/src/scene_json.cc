@@ -181,6 +181,10 @@ SceneDef read_scene(const Json& json) {
       r.integer("position_iterations", solver.position_iterations, 0, 1000);
   solver.exact_max_points = r.integer("exact_max_points", solver.exact_max_points, 0, 100000);
   solver.friction_directions = r.integer("friction_directions", solver.friction_directions, 4, 32);
+  solver.exact_max_island_points =
+      r.integer("exact_max_island_points", solver.exact_max_island_points, 1, 256);
+  solver.exact_velocity_tolerance =
+      r.number("exact_velocity_tolerance", solver.exact_velocity_tolerance);
   solver.velocity_tolerance = r.number("velocity_tolerance", solver.velocity_tolerance);
   solver.sleeping = r.boolean("sleeping", solver.sleeping);
   solver.sleep_linear_speed = r.number("sleep_linear_speed", solver.sleep_linear_speed);
@@ -289,6 +293,8 @@ std::string scene_to_json(const SceneDef& scene) {
               {"position_iterations", s.position_iterations},
               {"exact_max_points", s.exact_max_points},
               {"friction_directions", s.friction_directions},
+              {"exact_max_island_points", s.exact_max_island_points},
+              {"exact_velocity_tolerance", s.exact_velocity_tolerance},
               {"velocity_tolerance", s.velocity_tolerance},
               {"sleeping", s.sleeping},
               {"sleep_linear_speed", s.sleep_linear_speed},

@@ -37,6 +37,13 @@ struct SolverSettings {
   int friction_directions = 8;
   // Lemke: pivots allowed per unknown before the island falls back to pgs.
   int lemke_pivots_per_unknown = 20;
+  // Exact solver: islands with more contact points than this go to the soft solver instead, so
+  // that memory (the LCP is dense: (10 points)^2 doubles with 8 friction directions) and time
+  // stay bounded whatever the scene; StepStats::exact_oversized counts them. 1 to 256.
+  int exact_max_island_points = 48;
+  // Exact solver: the largest velocity error (m/s) an answer may have, measured on the problem
+  // without its regularisation; a worse answer is refused and the island falls back to pgs.
+  double exact_velocity_tolerance = 5e-3;
   // Islands whose bodies all stay below both speeds for `sleep_delay` fall asleep and cost nothing
   // until a moving body touches them or a body they rest on is removed.
   bool sleeping = true;
@@ -76,8 +83,11 @@ struct StepStats {
   // Large islands split over the team by graph colouring: how many, their colours in all, and
   // the manifolds left to the serial overflow colour.
   std::uint32_t coloured_islands = 0, colours = 0, overflow_manifolds = 0;
-  // Islands the exact solver could not finish (pivot bound, ray termination): solved by pgs.
+  // Islands the exact solver could not finish (pivot bound, ray termination, an answer off by
+  // more than exact_velocity_tolerance): solved by pgs.
   std::uint32_t exact_fallbacks = 0;
+  // Islands the exact solver was asked for but were larger than exact_max_island_points: soft.
+  std::uint32_t exact_oversized = 0;
   std::uint64_t lemke_pivots = 0;
   std::uint64_t velocity_iterations = 0;  // pgs and soft, summed over islands and substeps
   // Largest complementarity residual of a normal contact row after the solve, m/s:
@@ -89,7 +99,8 @@ struct StepStats {
   std::uint32_t swept_bodies = 0, continuous_impacts = 0, continuous_limit_hits = 0;
   double max_penetration = 0;  // m, the deepest contact point found this step
   std::uint32_t collision_flags = 0;
-  // Bodies whose implicit gyroscopic step hit its Newton iteration bound.
+  // Bodies whose implicit gyroscopic step hit its Newton iteration bound or spun too fast for
+  // kGyroscopicMaxPieces; they kept their body-frame spin for the step.
   std::uint32_t gyroscopic_limit_hits = 0;
   StageTimes time;
 };
