@@ -3,12 +3,14 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test test-sanitize demo bench format clean
+.PHONY: all deps configure build test test-sanitize demo bench report format clean
 
 all: build
 
+# The peer engines (bench) are installed for the tests too: the quick report in `make test`
+# measures them beside ours.
 deps:
-	@scripts/install-deps core service viewer
+	@scripts/install-deps core service viewer bench
 
 configure: deps
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
@@ -38,6 +40,20 @@ bench:
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DTUMBLE_BENCH_PEERS=ON >/dev/null
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 	@scripts/run-bench $(BUILD_DIR)
+
+# Error against run time and stability on extreme cases, ours beside Bullet, ODE and MuJoCo:
+# docs/report/REPORT.md with its CSV and plots (about 20 minutes; QUICK=1: about 1 minute, into
+# build/report-quick unless REPORT_DIR is given).
+QUICK ?=
+REPORT_DIR ?= $(if $(QUICK),$(BUILD_DIR)/report-quick,docs/report)
+report:
+	@scripts/install-deps core service viewer bench report
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target tumble-report
+	@$(BUILD_DIR)/bench/tumble-report $(if $(QUICK),--quick) --out $(REPORT_DIR) \
+	  --commit $$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+	@/usr/bin/python3 scripts/report-plots $(REPORT_DIR)
+	@echo "report: $(REPORT_DIR)/REPORT.md"
 
 format:
 	@git ls-files '*.h' '*.cc' | xargs clang-format -i

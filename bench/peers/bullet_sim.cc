@@ -1,0 +1,136 @@
+// Bullet 3.24 as SCENES.md maps it: btDiscreteDynamicsWorld, sequential impulses (10 iterations,
+// split impulse), btDbvtBroadphase, default margins, one stepSimulation(dt, 0) per step. Compiled
+// twice: into the benchmarks against Debian's float build, and with BT_USE_DOUBLE_PRECISION into
+// a module of its own against the float64 build (both export the same symbols, so the module is
+// loaded with RTLD_DEEPBIND and hands out its simulations through one C entry point).
+#include <btBulletDynamicsCommon.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "peers/simulation.h"
+
+namespace tumble::bench {
+namespace {
+
+#ifdef BT_USE_DOUBLE_PRECISION
+constexpr const char* kEngine = "Bullet 3.24 double";
+#else
+constexpr const char* kEngine = "Bullet 3.24 float";
+#endif
+
+btVector3 to_bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
+Vec3 from_bt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
+
+class BulletSimulation final : public Simulation {
+ public:
+  BulletSimulation(const SceneDef& scene, const PeerOptions& options)
+      : dispatcher_(&configuration_),
+        world_(&dispatcher_, &broadphase_, &solver_, &configuration_),
+        dt_(scene.dt) {
+    engine_ = kEngine;
+    settings_ = std::string("sequential impulse, 10 iterations, split impulse, sleeping ") +
+                (options.sleeping ? "on" : "off") + (options.ccd ? ", swept-sphere CCD" : "");
+    world_.setGravity(to_bt(scene.world.gravity));
+  }
+
+  ~BulletSimulation() override {
+    for (auto& body : bodies_)
+      world_.removeRigidBody(body.get());
+  }
+
+  // False (with the reason) for a shape this adapter does not map.
+  bool add(const BodyDef& def, double mass, const Vec3& inertia, const PeerOptions& options,
+           std::string* why_not) {
+    std::unique_ptr<btCollisionShape> shape;
+    btTransform pose(btQuaternion(def.orientation.x(), def.orientation.y(), def.orientation.z(),
+                                  def.orientation.w()),
+                     to_bt(def.position));
+    if (std::holds_alternative<HalfSpaceDef>(def.shape)) {
+      const Vec3 normal = def.orientation * Vec3::UnitZ();
+      shape = std::make_unique<btStaticPlaneShape>(to_bt(normal), normal.dot(def.position));
+      pose.setIdentity();
+    } else if (const auto* box = std::get_if<BoxDef>(&def.shape)) {
+      shape = std::make_unique<btBoxShape>(to_bt(box->half_extents));
+    } else if (const auto* sphere = std::get_if<SphereDef>(&def.shape)) {
+      shape = std::make_unique<btSphereShape>(sphere->radius);
+    } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
+      shape = std::make_unique<btCapsuleShapeZ>(capsule->radius, 2 * capsule->half_height);
+    } else {
+      *why_not = "hulls are not mapped to Bullet";
+      return false;
+    }
+    const bool is_static = def.type == BodyType::kStatic;
+    states_.push_back(std::make_unique<btDefaultMotionState>(pose));
+    btRigidBody::btRigidBodyConstructionInfo info(is_static ? 0 : mass, states_.back().get(),
+                                                  shape.get(),
+                                                  is_static ? btVector3(0, 0, 0) : to_bt(inertia));
+    // Bullet multiplies the two bodies' values; ours takes sqrt(fa fb) for friction and the
+    // larger restitution, which the square roots reproduce whenever both bodies agree.
+    info.m_friction = std::sqrt(def.friction);
+    info.m_restitution = std::sqrt(def.restitution);
+    shapes_.push_back(std::move(shape));
+    bodies_.push_back(std::make_unique<btRigidBody>(info));
+    btRigidBody* body = bodies_.back().get();
+    body->setLinearVelocity(to_bt(def.linear_velocity));
+    body->setAngularVelocity(to_bt(def.angular_velocity));
+    if (!options.sleeping) body->setActivationState(DISABLE_DEACTIVATION);
+    if (options.ccd && !is_static) {
+      body->setCcdMotionThreshold(0.05);
+      body->setCcdSweptSphereRadius(0.04);
+    }
+    world_.addRigidBody(body);
+    if (!is_static) dynamic_.push_back(body);
+    return true;
+  }
+
+  bool step() override {
+    world_.stepSimulation(dt_, 0);
+    return true;
+  }
+  std::size_t body_count() const override { return dynamic_.size(); }
+  BodyState body(std::size_t i) const override {
+    const btRigidBody* b = dynamic_[i];
+    const btTransform& t = b->getCenterOfMassTransform();
+    const btQuaternion r = t.getRotation();
+    return {from_bt(t.getOrigin()), Quat(r.w(), r.x(), r.y(), r.z()),
+            from_bt(b->getLinearVelocity()), from_bt(b->getAngularVelocity())};
+  }
+
+ private:
+  btDefaultCollisionConfiguration configuration_;
+  btCollisionDispatcher dispatcher_;
+  btDbvtBroadphase broadphase_;
+  btSequentialImpulseConstraintSolver solver_;
+  btDiscreteDynamicsWorld world_;
+  double dt_;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes_;
+  std::vector<std::unique_ptr<btDefaultMotionState>> states_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  std::vector<btRigidBody*> dynamic_;
+};
+
+Simulation* build(const PeerScene& peer, const PeerOptions& options, std::string* why_not) {
+  auto simulation = std::make_unique<BulletSimulation>(*peer.scene, options);
+  for (std::size_t i = 0; i < peer.scene->bodies.size(); ++i)
+    if (!simulation->add(peer.scene->bodies[i], peer.mass[i], peer.inertia[i], options, why_not))
+      return nullptr;
+  return simulation.release();
+}
+
+}  // namespace
+
+#ifdef BT_USE_DOUBLE_PRECISION
+extern "C" __attribute__((visibility("default"))) Simulation* tumble_make_bullet_double(
+    const PeerScene* scene, const PeerOptions* options, std::string* why_not) {
+  return build(*scene, *options, why_not);
+}
+#else
+std::unique_ptr<Simulation> make_bullet(const PeerScene& scene, const PeerOptions& options,
+                                        std::string* why_not) {
+  return std::unique_ptr<Simulation>(build(scene, options, why_not));
+}
+#endif
+
+}  // namespace tumble::bench

@@ -1,0 +1,68 @@
+#include "engines.h"
+
+namespace tumble::report {
+namespace {
+
+Engine tumble(std::string label, const std::function<void(WorldSettings&)>& configure) {
+  return {std::move(label), true,
+          [configure](const SceneDef& scene, const bench::PeerOptions&, std::string* why_not) {
+            SceneDef ours = scene;
+            if (ours.world.threads == 0) ours.world.threads = 1;
+            configure(ours.world);
+            return bench::make_tumble(ours, why_not);
+          }};
+}
+
+void solver(WorldSettings& w, SolverKind kind) { w.solver.kind = kind; }
+
+}  // namespace
+
+std::vector<Engine> tumble_engines(bool quick) {
+  std::vector<Engine> out;
+  out.push_back(tumble("Tumble exact", [](WorldSettings& w) { solver(w, SolverKind::kExact); }));
+  out.push_back(tumble("Tumble auto", [](WorldSettings& w) { solver(w, SolverKind::kAuto); }));
+  out.push_back(tumble("Tumble soft-4", [](WorldSettings& w) { solver(w, SolverKind::kSoft); }));
+  out.push_back(tumble("Tumble pgs-10", [](WorldSettings& w) { solver(w, SolverKind::kPgs); }));
+  if (quick) return out;
+  out.push_back(tumble("Tumble soft-8", [](WorldSettings& w) {
+    solver(w, SolverKind::kSoft);
+    w.solver.substeps = 8;
+  }));
+  out.push_back(tumble("Tumble pgs-50", [](WorldSettings& w) {
+    solver(w, SolverKind::kPgs);
+    w.solver.iterations = 50;
+  }));
+  out.push_back(tumble("Tumble auto x2", [](WorldSettings& w) {
+    solver(w, SolverKind::kAuto);
+    w.threads = 2;
+  }));
+  return out;
+}
+
+std::vector<Engine> peer_engines() {
+  std::vector<Engine> out;
+#ifdef TUMBLE_HAVE_PEERS
+  auto peer = [](std::string label, auto make) {
+    return Engine{std::move(label), false,
+                  [make](const SceneDef& scene, const bench::PeerOptions& options,
+                         std::string* why_not) {
+                    const bench::PeerScene peer_scene = bench::peer_scene(scene);
+                    return make(peer_scene, options, why_not);
+                  }};
+  };
+  out.push_back(peer("Bullet float", bench::make_bullet));
+  out.push_back(peer("Bullet double", bench::make_bullet_double));
+  out.push_back(peer("ODE", bench::make_ode));
+  out.push_back(peer("MuJoCo", bench::make_mujoco));
+#endif
+  return out;
+}
+
+std::vector<std::string> built_peers() {
+  std::vector<std::string> names;
+  for (const Engine& engine : peer_engines())
+    names.push_back(engine.label);
+  return names;
+}
+
+}  // namespace tumble::report

@@ -1,0 +1,39 @@
+// Stability on stiff and extreme cases: named scenarios, each swept along one axis (mass ratio,
+// tower height, speed, distance from the origin, ...) until an engine fails its pass criterion.
+// For every engine: the largest value it survives and how it fails at the first it does not.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "engines.h"
+
+namespace tumble::report {
+
+struct ScenarioInfo {
+  std::string name, axis, criterion;
+  std::vector<double> values;
+};
+
+struct StabilityRow {
+  std::string scenario, engine, settings;
+  double value = 0;
+  bool passed = false;
+  std::string failure;   // the failure mode when not passed
+  double wall_seconds = 0;
+};
+
+struct StabilityOptions {
+  bool quick = false;
+  double time_limit = 60;  // s of wall time per run
+  // Called after each run: what ran, runs done, runs in all.
+  std::function<void(const std::string&, std::size_t, std::size_t)> progress;
+};
+
+std::vector<ScenarioInfo> stability_scenarios(bool quick);
+// Each engine climbs each scenario's values in order and stops at its first failure.
+std::vector<StabilityRow> measure_stability(const std::vector<Engine>& engines,
+                                            const StabilityOptions& options);
+
+}  // namespace tumble::report

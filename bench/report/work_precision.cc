@@ -1,0 +1,320 @@
+#include "work_precision.h"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+
+#include "run.h"
+#include "scenes/standard.h"
+
+namespace tumble::report {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Measures one run's error from the states after each step.
+class ErrorMeter {
+ public:
+  virtual ~ErrorMeter() = default;
+  virtual void observe(const bench::Simulation& sim, double t) = 0;
+  virtual double error() const = 0;
+};
+
+struct Reference {
+  ReferenceInfo info;
+  SceneDef scene;  // dt is set per run
+  std::function<std::unique_ptr<ErrorMeter>()> meter;
+};
+
+BodyDef ground() {
+  BodyDef def;
+  def.shape = HalfSpaceDef{};
+  def.type = BodyType::kStatic;
+  return def;
+}
+
+BodyDef unit_box(const Vec3& position, double mass = 1) {
+  BodyDef def;
+  def.shape = BoxDef{Vec3::Constant(0.5)};
+  def.mass = mass;
+  def.position = position;
+  return def;
+}
+
+// The error of the final value of f(states) against a known one, relative.
+class FinalValue final : public ErrorMeter {
+ public:
+  FinalValue(std::function<double(const bench::Simulation&)> value, double exact)
+      : value_(std::move(value)), exact_(exact) {}
+  void observe(const bench::Simulation& sim, double) override { last_ = value_(sim); }
+  double error() const override { return std::abs(last_ / exact_ - 1); }
+
+ private:
+  std::function<double(const bench::Simulation&)> value_;
+  double exact_, last_ = kNaN;
+};
+
+// S6: stop distance v0^2 / (2 mu g).
+Reference slide() {
+  SceneDef scene = slide_scene();
+  const double exact = 25.0 / (2 * 0.5 * 9.81);
+  return {{"slide", "stop distance of a box sliding at 5 m/s, mu 0.5, after 3 s",
+           "v0^2/(2 mu g) = 2.548 m", "relative"},
+          scene, [exact] {
+            return std::make_unique<FinalValue>(
+                [](const bench::Simulation& s) { return s.body(0).position.x(); }, exact);
+          }};
+}
+
+// A box dropped from 1 m with e = 0.5 rises to e^2 h = 0.25 m after its first bounce.
+class ReboundHeight final : public ErrorMeter {
+ public:
+  void observe(const bench::Simulation& sim, double) override {
+    const bench::BodyState s = sim.body(0);
+    const double bottom = s.position.z() - 0.5;
+    if (!bounced_ && falling_ && s.linear_velocity.z() > 0) bounced_ = true;
+    falling_ = s.linear_velocity.z() < 0;
+    if (bounced_) apex_ = std::max(apex_, bottom);
+    if (!std::isfinite(bottom)) apex_ = kNaN;
+  }
+  double error() const override { return bounced_ ? std::abs(apex_ / 0.25 - 1) : kNaN; }
+
+ private:
+  bool falling_ = false, bounced_ = false;
+  double apex_ = 0;
+};
+
+Reference bounce() {
+  SceneDef scene = bounce_scene(1.0, 0.5);
+  scene.duration = 1.2;  // the apex is at 0.68 s
+  return {{"bounce", "height of the first rebound of a box dropped 1 m onto the ground, e = 0.5",
+           "e^2 h = 0.25 m", "relative"},
+          scene, [] { return std::make_unique<ReboundHeight>(); }};
+}
+
+// S7: a free 1x2x3 box keeps its kinetic energy and world angular momentum.
+class Invariants final : public ErrorMeter {
+ public:
+  Invariants(double mass, Vec3 inertia) : mass_(mass), inertia_(std::move(inertia)) {}
+  void observe(const bench::Simulation& sim, double) override {
+    const bench::BodyState s = sim.body(0);
+    if (non_finite(s)) {
+      worst_ = kNaN;
+      return;
+    }
+    const double energy = kinetic_energy(s, mass_, inertia_);
+    const Vec3 momentum = angular_momentum(s, inertia_);
+    if (!started_) {
+      started_ = true;
+      energy0_ = energy;
+      momentum0_ = momentum;
+    }
+    worst_ = std::max({worst_, std::abs(energy / energy0_ - 1),
+                       (momentum - momentum0_).norm() / momentum0_.norm()});
+  }
+  double error() const override { return worst_; }
+
+ private:
+  double mass_;
+  Vec3 inertia_;
+  bool started_ = false;
+  double energy0_ = 0, worst_ = 0;
+  Vec3 momentum0_ = Vec3::Zero();
+};
+
+Reference spin(bool quick) {
+  SceneDef scene = spin_scene();
+  if (quick) scene.duration = 5;
+  // Measured from the first step on: engines differ in when they apply the initial spin.
+  const bench::PeerScene peer = bench::peer_scene(scene);
+  const double mass = peer.mass[0];
+  const Vec3 inertia = peer.inertia[0];
+  return {{"spin",
+           "largest drift of kinetic energy and of world angular momentum of a free 1x2x3 box "
+           "spinning near its intermediate axis (Dzhanibekov), over " +
+               std::to_string(static_cast<int>(scene.duration)) + " s",
+           "both conserved exactly", "relative"},
+          scene, [mass, inertia] { return std::make_unique<Invariants>(mass, inertia); }};
+}
+
+// A ball rolling without slipping down a 20 degree slope: x = 5/14 g sin(theta) t^2. The slope
+// is the ground with gravity turned, so every engine's plane serves.
+Reference roll() {
+  const double theta = 20 * M_PI / 180;
+  SceneDef scene;
+  scene.name = "roll";
+  scene.duration = 2;
+  scene.world.gravity = 9.81 * Vec3(std::sin(theta), 0, -std::cos(theta));
+  BodyDef ball;
+  ball.shape = SphereDef{0.5};
+  ball.mass = 1;
+  ball.position = Vec3(0, 0, 0.5);
+  scene.bodies = {ground(), ball};
+  const double exact = 5.0 / 14 * 9.81 * std::sin(theta) * 4;
+  return {{"roll", "distance a ball (r 0.5 m) rolls from rest down a 20 degree slope in 2 s, mu 0.5",
+           "5/14 g sin(theta) t^2 = 4.792 m (rolling without slipping)", "relative"},
+          scene, [exact] {
+            return std::make_unique<FinalValue>(
+                [](const bench::Simulation& s) { return s.body(0).position.x(); }, exact);
+          }};
+}
+
+// Free flight under gravity: p = p0 + v0 t + g t^2 / 2.
+Reference projectile() {
+  SceneDef scene;
+  scene.name = "projectile";
+  scene.duration = 2;
+  BodyDef ball;
+  ball.shape = SphereDef{0.1};
+  ball.mass = 1;
+  ball.linear_velocity = Vec3(10, 0, 10);
+  scene.bodies = {ball};
+  const Vec3 exact = Vec3(10, 0, 10) * 2 + 0.5 * Vec3(0, 0, -9.81) * 4;
+  return {{"projectile", "position of a ball thrown at (10, 0, 10) m/s after 2 s, no ground",
+           "p0 + v0 t + g t^2/2", "relative"},
+          scene, [exact] {
+            return std::make_unique<FinalValue>(
+                [exact](const bench::Simulation& s) {
+                  return 1 + (s.body(0).position - exact).norm() / exact.norm();
+                },
+                1.0);
+          }};
+}
+
+// Scenes with no closed form: the RMS distance of every body's final position from a converged
+// run of the same scene (ours, pgs with 200 sweeps and no early stop, at a 16th of the step).
+class FinalPositions final : public ErrorMeter {
+ public:
+  explicit FinalPositions(std::shared_ptr<const std::vector<Vec3>> reference)
+      : reference_(std::move(reference)) {}
+  void observe(const bench::Simulation& sim, double) override {
+    double sum = 0;
+    for (std::size_t i = 0; i < sim.body_count(); ++i)
+      sum += (sim.body(i).position - (*reference_)[i]).squaredNorm();
+    error_ = std::sqrt(sum / static_cast<double>(sim.body_count()));
+  }
+  double error() const override { return error_; }
+
+ private:
+  std::shared_ptr<const std::vector<Vec3>> reference_;
+  double error_ = kNaN;
+};
+
+SceneDef converged(SceneDef scene, bool quick) {
+  scene.dt = 1.0 / (quick ? 960 : 1920);
+  scene.world.threads = 1;
+  scene.world.solver.kind = SolverKind::kPgs;
+  scene.world.solver.iterations = 200;
+  scene.world.solver.velocity_tolerance = 0;
+  scene.world.solver.position_iterations = 20;
+  return scene;
+}
+
+// The converged run is made the first time a meter needs it, so listing the scenes costs nothing.
+class ConvergedPositions {
+ public:
+  explicit ConvergedPositions(SceneDef fine) : fine_(std::move(fine)) {}
+  const std::vector<Vec3>& positions() {
+    std::call_once(once_, [this] {
+      World world = make_world(fine_).value();
+      const long steps = std::lround(fine_.duration / fine_.dt);
+      for (long s = 0; s < steps; ++s)
+        (void)world.step(fine_.dt);
+      for (std::uint32_t i = 0; i < world.slot_count(); ++i)
+        if (const Body* b = world.body(world.id_at(i)); b != nullptr && !b->is_static())
+          positions_.push_back(b->position);
+    });
+    return positions_;
+  }
+
+ private:
+  SceneDef fine_;
+  std::once_flag once_;
+  std::vector<Vec3> positions_;
+};
+
+Reference converged_reference(SceneDef scene, std::string what, bool quick) {
+  scene.world.solver.sleeping = false;
+  auto reference = std::make_shared<ConvergedPositions>(converged(scene, quick));
+  std::string name = scene.name;
+  return {{name, std::move(what),
+           std::string("Tumble pgs, 200 sweeps, 20 position sweeps, dt 1/") +
+               (quick ? "960" : "1920"),
+           "m (RMS)"},
+          scene, [reference] {
+            return std::make_unique<FinalPositions>(
+                std::shared_ptr<const std::vector<Vec3>>(reference, &reference->positions()));
+          }};
+}
+
+std::vector<Reference> references(bool quick) {
+  std::vector<Reference> out = {slide(), bounce(), spin(quick), roll(), projectile()};
+  SceneDef pile = pile_scene(27);
+  pile.duration = 1.0;
+  out.push_back(converged_reference(
+      pile, "27 tilted boxes dropped on the ground: final positions after 1 s (landing at 0.55 s)",
+      quick));
+  SceneDef pyramid = pyramid_scene(6);
+  pyramid.duration = 2;
+  out.push_back(converged_reference(
+      pyramid, "pyramid of 21 boxes (base 6): positions after 2 s", quick));
+  SceneDef tower = tower_scene(10);
+  tower.duration = 2;
+  out.push_back(converged_reference(tower, "tower of 10 boxes: positions after 2 s", quick));
+  return out;
+}
+
+}  // namespace
+
+std::vector<int> swept_rates(bool quick) {
+  if (quick) return {30, 60, 120, 240};
+  return {30, 60, 120, 240, 480, 960};
+}
+
+std::vector<ReferenceInfo> reference_scenes(bool quick) {
+  std::vector<ReferenceInfo> out;
+  for (const Reference& r : references(quick))
+    out.push_back(r.info);
+  return out;
+}
+
+std::vector<WorkPrecisionRow> measure_work_precision(const std::vector<Engine>& engines,
+                                                     const WorkPrecisionOptions& options) {
+  std::vector<WorkPrecisionRow> rows;
+  const std::vector<Reference> scenes = references(options.quick);
+  const std::vector<int> rates = swept_rates(options.quick);
+  const std::size_t total = scenes.size() * engines.size() * rates.size();
+  for (const Reference& reference : scenes) {
+    for (const Engine& engine : engines) {
+      for (int rate : rates) {
+        SceneDef scene = reference.scene;
+        scene.dt = 1.0 / rate;
+        std::unique_ptr<ErrorMeter> meter = reference.meter();
+        const RunOutcome outcome = run_scene(
+            engine, scene, {},
+            [&](const bench::Simulation& sim, double t, bool) {
+              meter->observe(sim, t);
+              return true;
+            },
+            options.time_limit);
+        WorkPrecisionRow row;
+        row.scene = reference.info.name;
+        row.engine = engine.label;
+        row.settings = outcome.settings;
+        row.dt = scene.dt;
+        row.error = outcome.ran && !outcome.stopped_early ? meter->error() : kNaN;
+        row.wall_per_second = outcome.step_seconds / (outcome.steps * scene.dt + 1e-300);
+        row.note = outcome.why_not;
+        rows.push_back(row);
+        if (options.progress)
+          options.progress("work-precision " + reference.info.name + ", " + engine.label +
+                               ", dt 1/" + std::to_string(rate),
+                           rows.size(), total);
+      }
+    }
+  }
+  return rows;
+}
+
+}  // namespace tumble::report
