@@ -25,6 +25,14 @@ std::string csv_field(const std::string& s) {
   return out + "\"";
 }
 
+// A table cell: a '|' in a failure mode ("|L| drifted") would split it.
+std::string cell(const std::string& s) {
+  std::string out;
+  for (char c : s)
+    out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
 std::vector<std::string> ordered(const std::vector<std::string>& items) {
   std::vector<std::string> out;
   std::set<std::string> seen;
@@ -144,7 +152,7 @@ bool write_markdown(const std::string& path, const ReportHeader& header,
       const Survival s = survival(stability, scenario.name, engine);
       out << "| " << engine << " | " << number(s.largest_pass, "%g") << " | "
           << (s.mode.empty() ? std::string("none (passed every value)")
-                             : number(s.first_failure, "%g") + ": " + s.mode)
+                             : number(s.first_failure, "%g") + ": " + cell(s.mode))
           << " |\n";
     }
   }
