@@ -1,6 +1,7 @@
 #include "work_precision.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -138,6 +139,63 @@ Reference spin(bool quick) {
           scene, [mass, inertia] { return std::make_unique<Invariants>(mass, inertia); }};
 }
 
+// The Dzhanibekov flip: the first time the intermediate axis turns against the angular momentum,
+// c(t) = (R e_y) . L0 / |L0| passing zero (interpolated between steps).
+class FirstFlip final : public ErrorMeter {
+ public:
+  FirstFlip(Vec3 direction, double exact) : direction_(std::move(direction)), exact_(exact) {}
+  void observe(const bench::Simulation& sim, double t) override {
+    const bench::BodyState s = sim.body(0);
+    const double c = (s.orientation * Vec3::UnitY()).dot(direction_);
+    if (!std::isfinite(c)) flip_ = kNaN;
+    if (std::isnan(flip_) && previous_c_ > 0 && c <= 0)
+      flip_ = previous_t_ + (t - previous_t_) * previous_c_ / (previous_c_ - c);
+    previous_c_ = c;
+    previous_t_ = t;
+  }
+  double error() const override { return std::abs(flip_ - exact_); }
+
+ private:
+  Vec3 direction_;
+  double exact_, previous_c_ = 1, previous_t_ = 0, flip_ = kNaN;
+};
+
+// Euler's equations of the free body, I dw/dt = (I w) x w in body axes, by RK4 with h = 1e-5 s:
+// the first time w_y (and so c) passes zero.
+double exact_first_flip(const Vec3& inertia, Vec3 w) {
+  const auto rate = [&](const Vec3& x) -> Vec3 {
+    return inertia.cwiseInverse().cwiseProduct(inertia.cwiseProduct(x).cross(x));
+  };
+  const double h = 1e-5;
+  for (double t = 0; t < 100; t += h) {
+    const Vec3 k1 = rate(w), k2 = rate(w + 0.5 * h * k1), k3 = rate(w + 0.5 * h * k2),
+               k4 = rate(w + h * k3);
+    const Vec3 next = w + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    if (w.y() > 0 && next.y() <= 0) return t + h * w.y() / (w.y() - next.y());
+    w = next;
+  }
+  return kNaN;
+}
+
+Reference flip() {
+  SceneDef scene = spin_scene();
+  scene.duration = 4;  // the first flip is at 2.77 s
+  const bench::PeerScene peer = bench::peer_scene(scene);
+  const Vec3 w0 = scene.bodies[0].angular_velocity;  // identity orientation: body = world axes
+  const Vec3 momentum = peer.inertia[0].cwiseProduct(w0);
+  const double exact = exact_first_flip(peer.inertia[0], w0);
+  char reference[96];
+  std::snprintf(reference, sizeof reference,
+                "RK4 of Euler's equations, h = 1e-5 s: %.5f s", exact);
+  return {{"flip",
+           "time of the first Dzhanibekov flip of the same 1x2x3 box (its intermediate axis "
+           "turning against L)",
+           reference, "s"},
+          scene, [momentum, exact] {
+            return std::make_unique<FirstFlip>(momentum.normalized(), exact);
+          }};
+}
+
 // A ball rolling without slipping down a 20 degree slope: x = 5/14 g sin(theta) t^2. The slope
 // is the ground with gravity turned, so every engine's plane serves.
 Reference roll() {
@@ -249,7 +307,7 @@ Reference converged_reference(SceneDef scene, std::string what, bool quick) {
 }
 
 std::vector<Reference> references(bool quick) {
-  std::vector<Reference> out = {slide(), bounce(), spin(quick), roll(), projectile()};
+  std::vector<Reference> out = {slide(), bounce(), spin(quick), flip(), roll(), projectile()};
   SceneDef pile = pile_scene(27);
   pile.duration = 1.0;
   out.push_back(converged_reference(

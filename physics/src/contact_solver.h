@@ -32,6 +32,11 @@ struct SolverBody {
   // Pseudo-velocities that push the body out of penetration (exact solver): the position update
   // moves the body by them once, and no velocity is left behind.
   Vec3 push_v = Vec3::Zero(), push_w = Vec3::Zero();
+  // The free rotation over the coming position update (world frame), and the angular velocity it
+  // belongs to: the position update turns the body by free_turn, and by w - w_free only for what
+  // the contacts changed (integrate.h says why).
+  Quat free_turn = Quat::Identity();
+  Vec3 w_free = Vec3::Zero();
 };
 
 // One contact point between bodies `a` and `b` (slot indices).

@@ -18,6 +18,9 @@
 
 namespace tumble {
 
+// Proximal-point passes allowed when the regularised answer misses exact_velocity_tolerance.
+constexpr int kExactRefinements = 3;
+
 struct ExactSolveResult {
   LemkeResult lemke;
   // The largest velocity error of the accepted answer (m/s; exact_velocity_error).

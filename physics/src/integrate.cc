@@ -36,28 +36,54 @@ bool gyroscopic_midpoint(const Mat3& inertia, const Vec3& w0, double h, Vec3* w1
 
 }  // namespace
 
+// The Cayley rotation of the rotation vector a: quaternion (1, a/2) normalised, a turn about a by
+// 2 atan(|a|/2).
+Quat cayley(const Vec3& a) {
+  return Quat(1, 0.5 * a.x(), 0.5 * a.y(), 0.5 * a.z()).normalized();
+}
+
 bool integrate_velocity(const Body& body, const Quat& orientation, const Vec3& gravity, double h,
                         SolverBody* state) {
   if (body.is_static()) return true;
   state->v += h * gravity;
-  if (body.spherical_inertia || state->w.isZero(0)) return true;
-  const Mat3 rotation = orientation.toRotationMatrix();
-  const Vec3 w_start = rotation.transpose() * state->w;
+  // Without a gyroscopic torque the body turns about its constant w.
+  const auto turn_about_w = [&] {
+    state->free_turn = rotation_quaternion(h * state->w);
+    state->w_free = state->w;
+  };
+  if (body.spherical_inertia || state->w.isZero(0)) {
+    turn_about_w();
+    return true;
+  }
+  const Vec3 w_start = orientation.conjugate() * state->w;
   // Newton converges from the old velocity only while the body turns little in the solve; a fast
   // spinner (300 rad/s at dt 1/60 turns 5 rad a step) is advanced in pieces of at most
   // kGyroscopicMaxTurn each. Every piece keeps both invariants, so the pieces do too.
   const double turn = h * w_start.norm();
-  if (!(turn <= kGyroscopicMaxTurn * kGyroscopicMaxPieces)) return false;  // w kept as it was
+  if (!(turn <= kGyroscopicMaxTurn * kGyroscopicMaxPieces)) {
+    turn_about_w();  // w kept as it was: energy and |L| exact, this step's precession lost
+    return false;
+  }
   const int pieces = std::max(1, static_cast<int>(std::ceil(turn / kGyroscopicMaxTurn)));
+  const double piece_h = h / pieces;
   Vec3 w_body = w_start;
+  Quat body_turn = Quat::Identity();
   for (int piece = 0; piece < pieces; ++piece) {
     Vec3 next;
-    // An unconverged answer is not used: the body keeps its body-frame spin, which loses the
-    // precession of this step but keeps energy and |L| exactly.
-    if (!gyroscopic_midpoint(body.inertia_body, w_body, h / pieces, &next)) return false;
+    // An unconverged answer is not used (as above).
+    if (!gyroscopic_midpoint(body.inertia_body, w_body, piece_h, &next)) {
+      turn_about_w();
+      return false;
+    }
+    // The midpoint rule gives L1 = cay(-h wm) L0 in body axes, so turning the body by cay(h wm)
+    // leaves the world momentum exactly where it was.
+    body_turn = body_turn * cayley(piece_h * 0.5 * (w_body + next));
     w_body = next;
   }
-  state->w = rotation * w_body;
+  state->free_turn = (orientation * body_turn * orientation.conjugate()).normalized();
+  // World axes of the body as it will be after the turn, where w_body belongs.
+  state->w = orientation * (body_turn * w_body);
+  state->w_free = state->w;
   return true;
 }
 
@@ -67,11 +93,13 @@ void integrate_position(double h, SolverBody* state, Pose* pose) {
   pose->position += dx;
   state->delta_position += dx;
   const Vec3 angle = h * (state->w + state->push_w);
-  const Quat turn = rotation_quaternion(angle);
-  pose->orientation = (turn * pose->orientation).normalized();
+  const Quat turn = rotation_quaternion(h * (state->w - state->w_free + state->push_w));
+  pose->orientation = (turn * state->free_turn * pose->orientation).normalized();
   state->delta_angle += angle;
   state->push_v.setZero();
   state->push_w.setZero();
+  state->free_turn = Quat::Identity();
+  state->w_free.setZero();
 }
 
 }  // namespace tumble

@@ -17,12 +17,18 @@ constexpr int kGyroscopicMaxPieces = 1024;
 // implicit midpoint rule, which keeps kinetic energy and |L| of a free body exactly (both are
 // quadratic invariants, Hairer-Lubich-Wanner ch. IV). Returns false when Newton hit its bound
 // or the spin needs more pieces than allowed; the body then keeps its body-frame angular
-// velocity for the step (energy and |L| still exact), and the step counts it.
+// velocity for the step (energy and |L| still exact), and the step counts it. Either way it
+// prepares state->free_turn and w_free for integrate_position.
 bool integrate_velocity(const Body& body, const Quat& orientation, const Vec3& gravity, double h,
                         SolverBody* state);
 
 // Positions over h with the new velocities and any push-out pseudo-velocities (used once, then
-// cleared); the rotation is the exact exponential of the angle turned.
+// cleared). The body turns by the free rotation integrate_velocity prepared and by the exact
+// exponential of whatever the contacts changed in w. The free rotation of a body with a
+// gyroscopic torque is the product of its pieces' Cayley rotations cay(h wm): with the midpoint
+// rule's L1 = cay(-h wm) L0 in body axes, that keeps the world angular momentum of a free body
+// exactly (the Lie-Poisson midpoint integrator; Austin, Krishnaprasad and Wang 1993), as well as
+// its energy and |L|. Turning about w1 instead, as before, let the world L turn by O(h) a step.
 void integrate_position(double h, SolverBody* state, Pose* pose);
 
 }  // namespace tumble
