@@ -61,9 +61,11 @@ TEST(Report, ErrorsFallAsTheStepFallsWhereTheSchemeConverges) {
 // round-off at every step size.
 TEST(Report, OursKeepTheSpinInvariantsAtEveryStep) {
   const QuickReport& r = quick_report();
-  for (const WorkPrecisionRow& row : r.work)
-    if (row.scene == "spin" && row.engine.rfind("Tumble", 0) == 0)
+  for (const WorkPrecisionRow& row : r.work) {
+    if (row.scene == "spin" && row.engine.rfind("Tumble", 0) == 0) {
       EXPECT_LT(row.error, 1e-9) << row.engine << ", dt " << row.dt;
+    }
+  }
 }
 
 TEST(Report, EveryPeerBuiltInAppearsWithNumbers) {

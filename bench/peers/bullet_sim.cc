@@ -20,8 +20,12 @@ constexpr const char* kEngine = "Bullet 3.24 double";
 constexpr const char* kEngine = "Bullet 3.24 float";
 #endif
 
-btVector3 to_bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
-Vec3 from_bt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
+btVector3 to_bt(const Vec3& v) {
+  return btVector3(v.x(), v.y(), v.z());
+}
+Vec3 from_bt(const btVector3& v) {
+  return Vec3(v.x(), v.y(), v.z());
+}
 
 class BulletSimulation final : public Simulation {
  public:

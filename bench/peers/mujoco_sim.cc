@@ -58,7 +58,9 @@ class MujocoSimulation final : public Simulation {
   std::size_t dynamic_;
 };
 
-void write_vector(std::ostream& out, const Vec3& v) { out << v.x() << ' ' << v.y() << ' ' << v.z(); }
+void write_vector(std::ostream& out, const Vec3& v) {
+  out << v.x() << ' ' << v.y() << ' ' << v.z();
+}
 
 }  // namespace
 
@@ -97,8 +99,7 @@ std::unique_ptr<Simulation> make_mujoco(const PeerScene& peer, const PeerOptions
       } else if (const auto* sphere = std::get_if<SphereDef>(&def.shape)) {
         geom << "type=\"sphere\" size=\"" << sphere->radius << '"';
       } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
-        geom << "type=\"capsule\" size=\"" << capsule->radius << ' ' << capsule->half_height
-             << '"';
+        geom << "type=\"capsule\" size=\"" << capsule->radius << ' ' << capsule->half_height << '"';
       } else {
         *why_not = "hulls are not mapped to MuJoCo";
         return nullptr;

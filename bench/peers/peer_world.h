@@ -1,5 +1,6 @@
-// Peer engines running the standard scenes of ../shared/SCENES.md (boxes and a ground plane), with
-// the settings SCENES.md gives for each, so their times and stability sit beside ours.
+// Whole runs of the standard scenes of ../shared/SCENES.md in ours and in the peer engines (through
+// simulation.h, with the settings SCENES.md gives for each), so their times and stability sit
+// beside ours in the benchmark tables.
 #pragma once
 
 #include <string>

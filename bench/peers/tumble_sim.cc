@@ -30,9 +30,8 @@ class TumbleSimulation final : public Simulation {
         break;
     }
     const int threads = scene.world.threads;
-    settings_ += "; " + (threads > 0 ? std::to_string(threads) : std::string("all")) +
-                 " thread" + (threads == 1 ? "" : "s") + "; sleeping " +
-                 (s.sleeping ? "on" : "off");
+    settings_ += "; " + (threads > 0 ? std::to_string(threads) : std::string("all")) + " thread" +
+                 (threads == 1 ? "" : "s") + "; sleeping " + (s.sleeping ? "on" : "off");
     for (std::uint32_t i = 0; i < world_.slot_count(); ++i)
       if (const Body* b = world_.body(world_.id_at(i)); b != nullptr && !b->is_static())
         dynamic_.push_back(world_.id_at(i));

@@ -13,7 +13,9 @@ Engine tumble(std::string label, const std::function<void(WorldSettings&)>& conf
           }};
 }
 
-void solver(WorldSettings& w, SolverKind kind) { w.solver.kind = kind; }
+void solver(WorldSettings& w, SolverKind kind) {
+  w.solver.kind = kind;
+}
 
 }  // namespace
 
@@ -43,12 +45,12 @@ std::vector<Engine> peer_engines() {
   std::vector<Engine> out;
 #ifdef TUMBLE_HAVE_PEERS
   auto peer = [](std::string label, auto make) {
-    return Engine{std::move(label), false,
-                  [make](const SceneDef& scene, const bench::PeerOptions& options,
-                         std::string* why_not) {
-                    const bench::PeerScene peer_scene = bench::peer_scene(scene);
-                    return make(peer_scene, options, why_not);
-                  }};
+    return Engine{
+        std::move(label), false,
+        [make](const SceneDef& scene, const bench::PeerOptions& options, std::string* why_not) {
+          const bench::PeerScene peer_scene = bench::peer_scene(scene);
+          return make(peer_scene, options, why_not);
+        }};
   };
   out.push_back(peer("Bullet float", bench::make_bullet));
   out.push_back(peer("Bullet double", bench::make_bullet_double));

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "report_writer.h"
@@ -29,6 +30,16 @@ struct Progress {
                  phase.c_str(), what.c_str());
   }
 };
+
+// "2 cores, <model name>" from /proc/cpuinfo, so that the figures say what they were measured on.
+std::string machine() {
+  std::string model;
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; model.empty() && std::getline(cpuinfo, line);)
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos)
+      model = line.substr(line.find(':') + 2);
+  return std::to_string(omp_get_num_procs()) + " cores" + (model.empty() ? "" : ", " + model);
+}
 
 std::string today() {
   const std::time_t now = std::time(nullptr);
@@ -83,7 +94,7 @@ int main(int argc, char** argv) {
   header.quick = quick;
   header.command = quick ? "make report QUICK=1" : "make report";
   header.date = today();
-  header.machine = std::to_string(omp_get_num_procs()) + " cores";
+  header.machine = machine();
   header.commit = commit;
   const tumble::SceneDef probe = tumble::standard_scene("tower:2").value();
   for (const Engine& engine : engines) {

@@ -110,9 +110,9 @@ bool write_markdown(const std::string& path, const ReportHeader& header,
       engines.push_back(r.engine);
     }
     engines = ordered(engines);
-    out << "\n### " << scene.name << "\n\n" << scene.what << ". Reference: " << scene.reference
-        << ". Error unit: " << scene.unit << ".\n\n![" << scene.name << "](wp_" << scene.name
-        << ".png)\n\n| engine |";
+    out << "\n### " << scene.name << "\n\n"
+        << scene.what << ". Reference: " << scene.reference << ". Error unit: " << scene.unit
+        << ".\n\n![" << scene.name << "](wp_" << scene.name << ".png)\n\n| engine |";
     for (double dt : dts)
       out << " dt 1/" << std::lround(1 / dt) << " |";
     out << "\n|---|";

@@ -5,9 +5,8 @@
 
 namespace tumble::report {
 
-RunOutcome run_scene(const Engine& engine, const SceneDef& scene,
-                     const bench::PeerOptions& options, const Observer& observe,
-                     double time_limit) {
+RunOutcome run_scene(const Engine& engine, const SceneDef& scene, const bench::PeerOptions& options,
+                     const Observer& observe, double time_limit) {
   RunOutcome out;
   std::unique_ptr<bench::Simulation> simulation = engine.make(scene, options, &out.why_not);
   if (!simulation) {

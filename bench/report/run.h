@@ -10,11 +10,11 @@
 namespace tumble::report {
 
 struct RunOutcome {
-  bool ran = false;          // false: the engine could not build the scene (why_not says why)
-  std::string why_not;       // "not supported: ...", "engine stopped: ...", "too slow: ..."
-  std::string settings;      // the engine's own account of its settings
-  double step_seconds = 0;   // wall time inside step() over the whole run
-  long steps = 0;            // steps taken
+  bool ran = false;            // false: the engine could not build the scene (why_not says why)
+  std::string why_not;         // "not supported: ...", "engine stopped: ...", "too slow: ..."
+  std::string settings;        // the engine's own account of its settings
+  double step_seconds = 0;     // wall time inside step() over the whole run
+  long steps = 0;              // steps taken
   bool stopped_early = false;  // the observer (or the time limit) ended the run
 };
 
@@ -24,9 +24,8 @@ using Observer = std::function<bool(const bench::Simulation&, double t, bool las
 
 // Runs `scene` for scene.duration. A run that spends more than `time_limit` seconds of wall time
 // stops there with why_not "too slow".
-RunOutcome run_scene(const Engine& engine, const SceneDef& scene,
-                     const bench::PeerOptions& options, const Observer& observe,
-                     double time_limit);
+RunOutcome run_scene(const Engine& engine, const SceneDef& scene, const bench::PeerOptions& options,
+                     const Observer& observe, double time_limit);
 
 // Kinetic energy of a body from its state and principal inertia (body axes = shape axes).
 double kinetic_energy(const bench::BodyState& s, double mass, const Vec3& inertia);

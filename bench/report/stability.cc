@@ -82,7 +82,8 @@ Checker stays_put(std::vector<Vec3> start, std::size_t i, double horizontal, dou
     if (!last) return "";
     const Vec3 d = sim.body(i).position - start[i];
     if (-d.z() > down) return what + format(" sank or fell %.3g m", -d.z());
-    if (d.head<2>().norm() > horizontal) return what + format(" moved %.3g m sideways", d.head<2>().norm());
+    if (d.head<2>().norm() > horizontal)
+      return what + format(" moved %.3g m sideways", d.head<2>().norm());
     return "";
   };
 }
@@ -109,7 +110,8 @@ Scenario mass_ratio(bool heavy_on_top) {
 
 Scenario tower(bool sleeping) {
   Scenario s;
-  s.info = {sleeping ? "tower, sleeping on" : "tower, sleeping off", "boxes",
+  s.info = {sleeping ? "tower, sleeping on" : "tower, sleeping off",
+            "boxes",
             "unit boxes stacked exactly, 10 s: the top box drifts less than 5 cm sideways and "
             "sinks less than 5 cm",
             {10, 20, 30, 50, 70, 100}};
@@ -128,7 +130,8 @@ Scenario tower(bool sleeping) {
 
 Scenario pyramid() {
   Scenario s;
-  s.info = {"pyramid", "base boxes",
+  s.info = {"pyramid",
+            "base boxes",
             "S2 pyramid, sleeping off, 10 s: no box moves more than 10 cm",
             {10, 20, 30, 40, 50}};
   s.build = [](double base) {
@@ -153,7 +156,8 @@ Scenario pyramid() {
 
 Scenario fast_thin(double wall) {
   Scenario s;
-  s.info = {format("fast 10 cm cube, wall %g cm", wall * 100), "speed, m/s",
+  s.info = {format("fast 10 cm cube, wall %g cm", wall * 100),
+            "speed, m/s",
             "no gravity, the cube starts 2 m before the wall, 0.5 s: it never ends past the "
             "wall's far side",
             {10, 100, 300, 1000, 3000, 5000}};
@@ -161,7 +165,8 @@ Scenario fast_thin(double wall) {
   s.build = [wall](double speed) {
     BodyDef cube = box(Vec3::Constant(0.1), Vec3(-2, 0, 0), 1);
     cube.linear_velocity = Vec3(speed, 0, 0);
-    SceneDef scene = scene_of("fast-thin", 0.5, {cube, fixed_box(Vec3(wall, 10, 10), Vec3::Zero())});
+    SceneDef scene =
+        scene_of("fast-thin", 0.5, {cube, fixed_box(Vec3(wall, 10, 10), Vec3::Zero())});
     scene.world.gravity = Vec3::Zero();
     return scene;
   };
@@ -178,7 +183,8 @@ Scenario fast_thin(double wall) {
 
 Scenario overlap() {
   Scenario s;
-  s.info = {"initial overlap", "overlap, %",
+  s.info = {"initial overlap",
+            "overlap, %",
             "two unit boxes on the ground spawned overlapping, 3 s: apart by then, both slower "
             "than 0.1 m/s, neither thrown above 1 m",
             {10, 30, 50, 70, 90}};
@@ -208,7 +214,8 @@ Scenario overlap() {
 // Precision, not just rest: a box resting without motion passes in any arithmetic, so it slides.
 Scenario far_from_origin() {
   Scenario s;
-  s.info = {"far from the origin", "distance, m",
+  s.info = {"far from the origin",
+            "distance, m",
             "a unit box sliding at 1 m/s (mu 0.5) on a fixed 8x8x1 m box, both at (d, d, d), "
             "3 s: it stops within 1 cm of v^2/(2 mu g) = 0.102 m and stays on the surface to 1 cm",
             {1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7}};
@@ -236,7 +243,8 @@ Scenario far_from_origin() {
 
 Scenario spin_rate() {
   Scenario s;
-  s.info = {"spin rate", "rad/s",
+  s.info = {"spin rate",
+            "rad/s",
             "a free 1x2x3 box spinning about (0.01, 1, 0.01), no gravity, 5 s: kinetic energy "
             "never above its start by 1e-6, |L| within 1%",
             {1, 10, 100, 1e3, 1e4}};
@@ -277,7 +285,8 @@ Scenario spin_rate() {
 
 Scenario size_ratio(bool equal_density) {
   Scenario s;
-  s.info = {equal_density ? "size ratio, equal density" : "size ratio, equal mass", "size ratio",
+  s.info = {equal_density ? "size ratio, equal density" : "size ratio, equal mass",
+            "size ratio",
             "a small box (edge 1/ratio m) resting on a unit box on the ground, 3 s: it stays "
             "within a tenth of its edge of where it was",
             {1, 10, 100, 1e3, 1e4}};
@@ -294,7 +303,8 @@ Scenario size_ratio(bool equal_density) {
     return [start, edge](const bench::Simulation& sim, double, bool last) -> std::string {
       if (std::string f = common_failure(sim, start); !f.empty()) return f;
       const double moved = (sim.body(1).position - start[1]).norm();
-      if (last && moved > 0.1 * edge) return format("the small box moved %.3g of its edge", moved / edge);
+      if (last && moved > 0.1 * edge)
+        return format("the small box moved %.3g of its edge", moved / edge);
       return "";
     };
   };
@@ -305,7 +315,8 @@ Scenario size_ratio(bool equal_density) {
 // fixed one in that configuration.
 Scenario degenerate() {
   Scenario s;
-  s.info = {"degenerate contacts", "case (1 face-face, 2 edge-edge, 3 vertex-vertex)",
+  s.info = {"degenerate contacts",
+            "case (1 face-face, 2 edge-edge, 3 vertex-vertex)",
             "a unit box exactly touching a fixed unit box, 3 s: no NaN, nothing thrown, energy "
             "(kinetic + potential) never above its start by 1 mJ",
             {1, 2, 3}};
@@ -346,11 +357,10 @@ Scenario degenerate() {
 }
 
 std::vector<Scenario> scenarios(bool quick) {
-  std::vector<Scenario> all = {mass_ratio(true),     mass_ratio(false),      tower(false),
-                               tower(true),          pyramid(),              fast_thin(0.01),
-                               fast_thin(0.1),       overlap(),              far_from_origin(),
-                               spin_rate(),          size_ratio(true),       size_ratio(false),
-                               degenerate()};
+  std::vector<Scenario> all = {
+      mass_ratio(true), mass_ratio(false), tower(false), tower(true),       pyramid(),
+      fast_thin(0.01),  fast_thin(0.1),    overlap(),    far_from_origin(), spin_rate(),
+      size_ratio(true), size_ratio(false), degenerate()};
   if (quick) {
     // Fewer values and shorter runs: the quick report checks the machinery, not the limits.
     for (Scenario& s : all) {

@@ -20,7 +20,7 @@ struct StabilityRow {
   std::string scenario, engine, settings;
   double value = 0;
   bool passed = false;
-  std::string failure;   // the failure mode when not passed
+  std::string failure;  // the failure mode when not passed
   double wall_seconds = 0;
 };
 

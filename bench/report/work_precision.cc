@@ -35,14 +35,6 @@ BodyDef ground() {
   return def;
 }
 
-BodyDef unit_box(const Vec3& position, double mass = 1) {
-  BodyDef def;
-  def.shape = BoxDef{Vec3::Constant(0.5)};
-  def.mass = mass;
-  def.position = position;
-  return def;
-}
-
 // The error of the final value of f(states) against a known one, relative.
 class FinalValue final : public ErrorMeter {
  public:
@@ -62,7 +54,8 @@ Reference slide() {
   const double exact = 25.0 / (2 * 0.5 * 9.81);
   return {{"slide", "stop distance of a box sliding at 5 m/s, mu 0.5, after 3 s",
            "v0^2/(2 mu g) = 2.548 m", "relative"},
-          scene, [exact] {
+          scene,
+          [exact] {
             return std::make_unique<FinalValue>(
                 [](const bench::Simulation& s) { return s.body(0).position.x(); }, exact);
           }};
@@ -91,7 +84,8 @@ Reference bounce() {
   scene.duration = 1.2;  // the apex is at 0.68 s
   return {{"bounce", "height of the first rebound of a box dropped 1 m onto the ground, e = 0.5",
            "e^2 h = 0.25 m", "relative"},
-          scene, [] { return std::make_unique<ReboundHeight>(); }};
+          scene,
+          [] { return std::make_unique<ReboundHeight>(); }};
 }
 
 // S7: a free 1x2x3 box keeps its kinetic energy and world angular momentum.
@@ -136,7 +130,8 @@ Reference spin(bool quick) {
            "spinning near its intermediate axis (Dzhanibekov), over " +
                std::to_string(static_cast<int>(scene.duration)) + " s",
            "both conserved exactly", "relative"},
-          scene, [mass, inertia] { return std::make_unique<Invariants>(mass, inertia); }};
+          scene,
+          [mass, inertia] { return std::make_unique<Invariants>(mass, inertia); }};
 }
 
 // The Dzhanibekov flip: the first time the intermediate axis turns against the angular momentum,
@@ -185,15 +180,13 @@ Reference flip() {
   const Vec3 momentum = peer.inertia[0].cwiseProduct(w0);
   const double exact = exact_first_flip(peer.inertia[0], w0);
   char reference[96];
-  std::snprintf(reference, sizeof reference,
-                "RK4 of Euler's equations, h = 1e-5 s: %.5f s", exact);
+  std::snprintf(reference, sizeof reference, "RK4 of Euler's equations, h = 1e-5 s: %.5f s", exact);
   return {{"flip",
            "time of the first Dzhanibekov flip of the same 1x2x3 box (its intermediate axis "
            "turning against L)",
            reference, "s"},
-          scene, [momentum, exact] {
-            return std::make_unique<FirstFlip>(momentum.normalized(), exact);
-          }};
+          scene,
+          [momentum, exact] { return std::make_unique<FirstFlip>(momentum.normalized(), exact); }};
 }
 
 // A ball rolling without slipping down a 20 degree slope: x = 5/14 g sin(theta) t^2. The slope
@@ -210,12 +203,14 @@ Reference roll() {
   ball.position = Vec3(0, 0, 0.5);
   scene.bodies = {ground(), ball};
   const double exact = 5.0 / 14 * 9.81 * std::sin(theta) * 4;
-  return {{"roll", "distance a ball (r 0.5 m) rolls from rest down a 20 degree slope in 2 s, mu 0.5",
-           "5/14 g sin(theta) t^2 = 4.792 m (rolling without slipping)", "relative"},
-          scene, [exact] {
-            return std::make_unique<FinalValue>(
-                [](const bench::Simulation& s) { return s.body(0).position.x(); }, exact);
-          }};
+  return {
+      {"roll", "distance a ball (r 0.5 m) rolls from rest down a 20 degree slope in 2 s, mu 0.5",
+       "5/14 g sin(theta) t^2 = 4.792 m (rolling without slipping)", "relative"},
+      scene,
+      [exact] {
+        return std::make_unique<FinalValue>(
+            [](const bench::Simulation& s) { return s.body(0).position.x(); }, exact);
+      }};
 }
 
 // Free flight under gravity: p = p0 + v0 t + g t^2 / 2.
@@ -231,7 +226,8 @@ Reference projectile() {
   const Vec3 exact = Vec3(10, 0, 10) * 2 + 0.5 * Vec3(0, 0, -9.81) * 4;
   return {{"projectile", "position of a ball thrown at (10, 0, 10) m/s after 2 s, no ground",
            "p0 + v0 t + g t^2/2", "relative"},
-          scene, [exact] {
+          scene,
+          [exact] {
             return std::make_unique<FinalValue>(
                 [exact](const bench::Simulation& s) {
                   return 1 + (s.body(0).position - exact).norm() / exact.norm();
@@ -296,14 +292,15 @@ Reference converged_reference(SceneDef scene, std::string what, bool quick) {
   scene.world.solver.sleeping = false;
   auto reference = std::make_shared<ConvergedPositions>(converged(scene, quick));
   std::string name = scene.name;
-  return {{name, std::move(what),
-           std::string("Tumble pgs, 200 sweeps, 20 position sweeps, dt 1/") +
-               (quick ? "960" : "1920"),
-           "m (RMS)"},
-          scene, [reference] {
-            return std::make_unique<FinalPositions>(
-                std::shared_ptr<const std::vector<Vec3>>(reference, &reference->positions()));
-          }};
+  return {
+      {name, std::move(what),
+       std::string("Tumble pgs, 200 sweeps, 20 position sweeps, dt 1/") + (quick ? "960" : "1920"),
+       "m (RMS)"},
+      scene,
+      [reference] {
+        return std::make_unique<FinalPositions>(
+            std::shared_ptr<const std::vector<Vec3>>(reference, &reference->positions()));
+      }};
 }
 
 std::vector<Reference> references(bool quick) {
@@ -315,8 +312,8 @@ std::vector<Reference> references(bool quick) {
       quick));
   SceneDef pyramid = pyramid_scene(6);
   pyramid.duration = 2;
-  out.push_back(converged_reference(
-      pyramid, "pyramid of 21 boxes (base 6): positions after 2 s", quick));
+  out.push_back(
+      converged_reference(pyramid, "pyramid of 21 boxes (base 6): positions after 2 s", quick));
   SceneDef tower = tower_scene(10);
   tower.duration = 2;
   out.push_back(converged_reference(tower, "tower of 10 boxes: positions after 2 s", quick));

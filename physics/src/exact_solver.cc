@@ -254,8 +254,7 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
           solve_lcp_lemke(m, refined_q, max_pivots, refined_z, &workspace.lemke);
       result.lemke.pivots += again.pivots;
       if (again.outcome != LemkeOutcome::kSolved || !refined_z.allFinite()) break;
-      const double error =
-          exact_velocity_error(m, workspace.diagonal, q, refined_z, velocity_rows);
+      const double error = exact_velocity_error(m, workspace.diagonal, q, refined_z, velocity_rows);
       if (!(error < result.velocity_error)) break;
       z = refined_z;
       result.velocity_error = error;

@@ -8,6 +8,7 @@
 
 #include "exact_solver.h"
 #include "integrate.h"
+#include "parallel.h"
 #include "physics/world.h"
 #include "step_scratch.h"
 
@@ -306,20 +307,19 @@ void World::prepare_contacts(double /*dt*/) {
   s.dynamic.resize(slots);
   const int threads = team_size(settings_.threads);
   const std::int64_t slot_count = static_cast<std::int64_t>(slots);
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && slots > 256)
-  for (std::int64_t i = 0; i < slot_count; ++i) {
+  for_indices(threads, slots > 256, slot_count, [&](std::int64_t i) {
     const Slot& slot = bodies_[i];
     SolverBody& sb = s.bodies[i];
     sb = SolverBody{};
     s.dynamic[i] = slot.alive && slot.body.is_moving();
-    if (!slot.alive) continue;
+    if (!slot.alive) return;
     s.poses[i] = slot.body.pose();
-    if (!s.dynamic[i]) continue;
+    if (!s.dynamic[i]) return;
     sb.v = slot.body.linear_velocity;
     sb.w = slot.body.angular_velocity;
     sb.inverse_mass = slot.body.inverse_mass;
     sb.inverse_inertia = slot.body.inverse_inertia_world;
-  }
+  });
 
   // Every manifold's rows have a place known in advance, so they are built in parallel.
   const std::size_t manifolds = contacts_.size();
@@ -342,13 +342,12 @@ void World::prepare_contacts(double /*dt*/) {
       s.row_ids[r] = static_cast<std::uint32_t>(r);
   }
   const std::int64_t count = static_cast<std::int64_t>(manifolds);
-#pragma omp parallel for schedule(static) num_threads(threads) if (count > 64 && threads > 1)
-  for (std::int64_t m = 0; m < count; ++m) {
+  for_indices(threads, count > 64, count, [&](std::int64_t m) {
     const Contact& contact = contacts_[m];
     prepare_rows(contact.manifold, contact.a, bodies_[contact.a.index].body, contact.b,
                  bodies_[contact.b.index].body, s.cache, static_cast<std::uint32_t>(m),
                  &s.rows[s.row_begin[m]], &s.blocks[m]);
-  }
+  });
   build_islands(s.dynamic, s.links, &s.islands);
 
   const std::size_t islands = s.islands.count();
@@ -388,9 +387,8 @@ void World::prepare_contacts(double /*dt*/) {
         // solve's cost (8-direction pyramids make 10 unknowns per point). A body touching
         // nothing takes the plain step of dt.
         const bool alone = s.islands.body_begin[i + 1] - s.islands.body_begin[i] == 1;
-        const bool small =
-            points <= static_cast<std::uint32_t>(
-                          std::min(solver.exact_max_points, solver.exact_max_island_points));
+        const bool small = points <= static_cast<std::uint32_t>(std::min(
+                                         solver.exact_max_points, solver.exact_max_island_points));
         kind = points == 0 || (!alone && small) ? IslandSolver::kExact : IslandSolver::kSoft;
         break;
       }
@@ -440,8 +438,7 @@ void World::solve_islands(double dt) {
   // Large islands one after the other with the whole team, then the rest one island per thread:
   // islands share no body and no row, and colours share no moving body, so any thread count gives
   // the same bits.
-#pragma omp parallel num_threads(threads) if (parallel)
-  {
+  run_region(threads, parallel, [&] {
     for (std::uint32_t i : s.team_islands)
       team_advance_island(island_context(s, settings_, i), s.island_colour_begin[i],
                           s.island_colour_begin[i + 1], dt, &s.reports[i]);
@@ -450,7 +447,7 @@ void World::solve_islands(double dt) {
       const std::uint32_t i = s.single_islands[k];
       advance_island(island_context(s, settings_, i), dt, &s.reports[i]);
     }
-  }
+  });
   for (const IslandReport& report : s.reports) {
     if (report.solver == IslandSolver::kExact)
       ++stats_.exact_islands;
@@ -482,8 +479,7 @@ void World::correct_positions() {
   if (!any || solver.position_iterations == 0) return;
   const int threads = team_size(settings_.threads);
   const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
-#pragma omp parallel num_threads(threads) if (threads > 1)
-  {
+  run_region(threads, true, [&] {
     for (std::uint32_t i : s.team_islands) {
       if (!needs_correction(i)) continue;
       for (int k = 0; k < solver.position_iterations; ++k)
@@ -503,7 +499,7 @@ void World::correct_positions() {
       for (int n = 0; n < solver.position_iterations; ++n)
         tumble::correct_positions(s.rows, rows, s.bodies, s.poses, solver);
     }
-  }
+  });
 }
 
 std::uint32_t World::wake_touched() {
@@ -551,8 +547,7 @@ void World::finish_step(double dt) {
   // Impulses for the next step's warm start, sorted by body pair as the contacts are.
   s.cache.resize(s.rows.size());
   impulses_.resize(s.rows.size());
-#pragma omp parallel num_threads(threads) if (threads > 1 && slots > 256)
-  {
+  run_region(threads, slots > 256, [&] {
 #pragma omp for schedule(static) nowait
     for (std::int64_t i = 0; i < slots; ++i) {
       if (!s.dynamic[i]) continue;
@@ -576,7 +571,7 @@ void World::finish_step(double dt) {
         impulses_[r] = row.normal_impulse;
       }
     }
-  }
+  });
   time_ += dt;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "broad_phase.h"
+#include "parallel.h"
 #include "step_scratch.h"
 
 namespace tumble {
@@ -261,15 +262,12 @@ void World::compute_bounds(double dt) {
       settings_.collision.margin + (dt > 0 ? settings_.solver.speculative_distance : 0.0);
   const double gravity = settings_.gravity.norm();
   const SolverSettings& solver = settings_.solver;
-  std::uint32_t fast = 0;
-#pragma omp parallel for schedule(static) num_threads(thread_count(settings_.threads)) \
-    reduction(+ : fast) if (n > 256)
-  for (std::int64_t i = 0; i < n; ++i) {
+  for_indices(thread_count(settings_.threads), n > 256, n, [&](std::int64_t i) {
     const Slot& slot = bodies_[i];
     if (!slot.alive) {
       bounds_[i] = Aabb();
       movable_[i] = 0;
-      continue;
+      return;
     }
     const Body& body = slot.body;
     double motion = 0;
@@ -280,7 +278,6 @@ void World::compute_bounds(double dt) {
       const double swept_beyond = solver.continuous_fraction * body.shape.inner_radius();
       if (solver.continuous && motion > swept_beyond) {
         fast_[i] = 1;
-        ++fast;
       }
       speculative_[i] = fast_[i] ? swept_beyond : motion;
       motion_[i] = motion;
@@ -289,8 +286,8 @@ void World::compute_bounds(double dt) {
         transform_aabb(body.shape.local_bounds(), body.pose()).expanded(base_margin + motion);
     // Sleepers pair only with moving bodies, as statics do.
     movable_[i] = body.is_moving() ? 1 : 0;
-  }
-  fast_count_ = fast;
+  });
+  fast_count_ = static_cast<std::uint32_t>(std::count(fast_.begin(), fast_.end(), 1));
 }
 
 std::span<const BodyPair> World::find_pairs() {
@@ -322,35 +319,35 @@ void World::find_contacts(double dt) {
   // Every pair writes its own slot, then the touching ones are packed in pair order: the same
   // result for any thread count.
   contacts_.resize(pairs_.size());
-  std::uint32_t flags = 0;
-#pragma omp parallel for schedule(dynamic, 32) num_threads(thread_count(settings_.threads)) \
-    reduction(|                                                                             \
-              : flags) if (n > 64)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const Body& a = bodies_[pairs_[i].a].body;
-    const Body& b = bodies_[pairs_[i].b].body;
-    Contact& contact = contacts_[i];
-    contact.a = {pairs_[i].a, bodies_[pairs_[i].a].generation};
-    contact.b = {pairs_[i].b, bodies_[pairs_[i].b].generation};
-    CollisionSettings settings = settings_.collision;
-    if (dt > 0) {
-      settings.margin += settings_.solver.speculative_distance + speculative_[pairs_[i].a] +
-                         speculative_[pairs_[i].b];
-      // A stepping world wants the same manifold from step to step (see CollisionSettings).
-      settings.feature_slack = std::max(settings.feature_slack, settings_.solver.slop);
-      settings.feature_slack_relative = std::max(settings.feature_slack_relative, 0.05);
-      settings.face_angle = std::max(settings.face_angle, 0.02);
-    }
-    flags |= collide(a.shape, a.pose(), b.shape, b.pose(), settings, &contact.manifold);
-    // A fast body already touching something is not swept against it (there is no first
-    // impact to find), so the solver must see every feature that can reach it in the step: the
-    // far edge of a plate falling flat, for one. Its speculative contacts cover the whole motion.
-    if (dt > 0 && contact.manifold.count > 0 && (fast_[pairs_[i].a] || fast_[pairs_[i].b])) {
-      settings.margin = settings_.collision.margin + settings_.solver.speculative_distance +
-                        motion_[pairs_[i].a] + motion_[pairs_[i].b];
-      flags |= collide(a.shape, a.pose(), b.shape, b.pose(), settings, &contact.manifold);
-    }
-  }
+  const std::uint32_t flags = or_over_indices(
+      thread_count(settings_.threads), n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
+        const Body& a = bodies_[pairs_[i].a].body;
+        const Body& b = bodies_[pairs_[i].b].body;
+        Contact& contact = contacts_[i];
+        contact.a = {pairs_[i].a, bodies_[pairs_[i].a].generation};
+        contact.b = {pairs_[i].b, bodies_[pairs_[i].b].generation};
+        CollisionSettings settings = settings_.collision;
+        if (dt > 0) {
+          settings.margin += settings_.solver.speculative_distance + speculative_[pairs_[i].a] +
+                             speculative_[pairs_[i].b];
+          // A stepping world wants the same manifold from step to step (see CollisionSettings).
+          settings.feature_slack = std::max(settings.feature_slack, settings_.solver.slop);
+          settings.feature_slack_relative = std::max(settings.feature_slack_relative, 0.05);
+          settings.face_angle = std::max(settings.face_angle, 0.02);
+        }
+        std::uint32_t pair_flags =
+            collide(a.shape, a.pose(), b.shape, b.pose(), settings, &contact.manifold);
+        // A fast body already touching something is not swept against it (there is no first
+        // impact to find), so the solver must see every feature that can reach it in the step: the
+        // far edge of a plate falling flat, for one. Its speculative contacts cover the whole
+        // motion.
+        if (dt > 0 && contact.manifold.count > 0 && (fast_[pairs_[i].a] || fast_[pairs_[i].b])) {
+          settings.margin = settings_.collision.margin + settings_.solver.speculative_distance +
+                            motion_[pairs_[i].a] + motion_[pairs_[i].b];
+          pair_flags |= collide(a.shape, a.pose(), b.shape, b.pose(), settings, &contact.manifold);
+        }
+        return pair_flags;
+      });
   std::size_t kept = 0;
   for (std::size_t i = 0; i < contacts_.size(); ++i)
     if (contacts_[i].manifold.count > 0) contacts_[kept++] = contacts_[i];
