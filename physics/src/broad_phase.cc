@@ -6,6 +6,8 @@
 #include <bit>
 #include <cmath>
 
+#include "parallel.h"
+
 namespace tumble {
 namespace {
 
@@ -102,11 +104,11 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   std::uint64_t occupied = 0;  // bit per level
 
   // (1) Cells of each body on its own level.
-#pragma omp parallel num_threads(threads) reduction(| : occupied)
-  {
+  run_region(threads, true, [&] {
     const int t = omp_get_thread_num();
     auto& out = thread_entries_[t];
     out.clear();
+    std::uint64_t mine = 0;
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
       const Aabb& box = bounds[i];
@@ -119,7 +121,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
         ++level;
       }
       level_[i] = static_cast<std::int8_t>(level);
-      occupied |= 1ull << level;
+      mine |= 1ull << level;
       const Eigen::Array3d lo = (box.min / cell).array().floor();
       const Eigen::Array3d hi = (box.max / cell).array().floor();
       for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
@@ -129,8 +131,10 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
                ++z)
             out.emplace_back(cell_key(level, x, y, z), static_cast<std::uint32_t>(i));
     }
+#pragma omp atomic update
+    occupied |= mine;
     sort_by_high_half(&out, &thread_scratch_[t]);
-  }
+  });
   // (2) One sorted array: the threads' sorted runs merged in thread order.
   merge_sorted(thread_entries_, threads, &entries_, &merge_buffer_);
 
@@ -142,8 +146,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
 
   // (3) Candidate pairs.
   const std::int64_t entry_count = static_cast<std::int64_t>(entries_.size());
-#pragma omp parallel num_threads(threads)
-  {
+  run_region(threads, true, [&] {
     auto& out = thread_pairs_[omp_get_thread_num()];
     out.clear();
     // Same cell: each run of equal keys, visited from its first entry.
@@ -189,7 +192,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
-  }
+  });
   // (4) Reduction: merge the threads' sorted lists, then drop pairs found by several threads.
   merge_sorted(thread_pairs_, threads, pairs, &pair_buffer_);
   pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());

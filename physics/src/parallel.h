@@ -25,6 +25,21 @@ void run_region(int threads, bool parallel, Region&& region) {
   }
 }
 
+// Inside run_region: body(i) for i in [0, n) handed out one at a time over the team, or in order
+// on a lone thread. An orphaned dynamic loop outside any team would still ask libgomp for a work
+// share, which it allocates.
+template <class Body>
+void team_for_dynamic(std::int64_t n, Body&& body) {
+  if (omp_in_parallel()) {
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t i = 0; i < n; ++i)
+      body(i);
+  } else {
+    for (std::int64_t i = 0; i < n; ++i)
+      body(i);
+  }
+}
+
 // body(i) for i in [0, n): statically split over a team when `parallel`, else in order here.
 template <class Body>
 void for_indices(int threads, bool parallel, std::int64_t n, Body&& body) {

@@ -442,11 +442,10 @@ void World::solve_islands(double dt) {
     for (std::uint32_t i : s.team_islands)
       team_advance_island(island_context(s, settings_, i), s.island_colour_begin[i],
                           s.island_colour_begin[i + 1], dt, &s.reports[i]);
-#pragma omp for schedule(dynamic, 1)
-    for (std::int64_t k = 0; k < singles; ++k) {
+    team_for_dynamic(singles, [&](std::int64_t k) {
       const std::uint32_t i = s.single_islands[k];
       advance_island(island_context(s, settings_, i), dt, &s.reports[i]);
-    }
+    });
   });
   for (const IslandReport& report : s.reports) {
     if (report.solver == IslandSolver::kExact)
@@ -491,14 +490,13 @@ void World::correct_positions() {
             },
             false);
     }
-#pragma omp for schedule(dynamic, 1)
-    for (std::int64_t k = 0; k < singles; ++k) {
+    team_for_dynamic(singles, [&](std::int64_t k) {
       const std::uint32_t i = s.single_islands[k];
-      if (!needs_correction(i)) continue;
+      if (!needs_correction(i)) return;
       const auto rows = island_context(s, settings_, i).rows;
       for (int n = 0; n < solver.position_iterations; ++n)
         tumble::correct_positions(s.rows, rows, s.bodies, s.poses, solver);
-    }
+    });
   });
 }
 

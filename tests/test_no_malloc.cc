@@ -1,0 +1,88 @@
+// A warmed-up step on one thread calls no allocator at all, C's included: every C allocation
+// function of the program is replaced here by a counting one over glibc's own (__libc_*), so that
+// allocations made inside libraries count too. libgomp once made and freed a team of one for each
+// of a step's six OpenMP regions whose `if` clause was false (parallel.h).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstddef>
+
+#include "scene_runner.h"
+
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void __libc_free(void*);
+}
+
+namespace {
+std::atomic<bool> counting{false};
+std::atomic<long> calls{0};
+void count() {
+  if (counting.load(std::memory_order_relaxed)) calls.fetch_add(1, std::memory_order_relaxed);
+}
+}  // namespace
+
+extern "C" {
+void* malloc(std::size_t size) {
+  count();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  count();
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  count();
+  return __libc_realloc(p, size);
+}
+void* memalign(std::size_t align, std::size_t size) {
+  count();
+  return __libc_memalign(align, size);
+}
+void* aligned_alloc(std::size_t align, std::size_t size) {
+  count();
+  return __libc_memalign(align, size);
+}
+int posix_memalign(void** out, std::size_t align, std::size_t size) {
+  count();
+  *out = __libc_memalign(align, size);
+  return *out != nullptr ? 0 : ENOMEM;
+}
+void free(void* p) {
+  __libc_free(p);
+}
+}
+
+namespace tumble::testing {
+namespace {
+
+long allocations_in_steps(SceneDef scene, int steps) {
+  scene.world.threads = 1;
+  World world = build(scene);
+  run(world, scene.dt, 30);  // warm up: scratch memory grows to its size
+  calls = 0;
+  counting = true;
+  for (int s = 0; s < steps; ++s)
+    EXPECT_TRUE(world.step(scene.dt).is_ok());
+  counting = false;
+  return calls.load();
+}
+
+TEST(NoMalloc, OneThreadStepsCallNoAllocator) {
+  EXPECT_EQ(allocations_in_steps(slide_scene(), 100), 0);
+  EXPECT_EQ(allocations_in_steps(spin_scene(), 100), 0);
+  SceneDef tower = tower_scene(5);
+  tower.world.solver.sleeping = false;
+  EXPECT_EQ(allocations_in_steps(tower, 100), 0);
+  // Islands large enough to be coloured and swept by the (one-thread) team path.
+  SceneDef pyramid = pyramid_scene(12);
+  pyramid.world.solver.sleeping = false;
+  EXPECT_EQ(allocations_in_steps(pyramid, 20), 0);
+}
+
+}  // namespace
+}  // namespace tumble::testing
