@@ -40,10 +40,15 @@ void team_for_dynamic(std::int64_t n, Body&& body) {
   }
 }
 
-// body(i) for i in [0, n): statically split over a team when `parallel`, else in order here.
+// body(i) for i in [0, n): split over a team when `parallel` (statically, or handed out
+// `dynamic_chunk` at a time when that is > 0), else in order here.
 template <class Body>
-void for_indices(int threads, bool parallel, std::int64_t n, Body&& body) {
-  if (parallel && threads > 1) {
+void for_indices(int threads, bool parallel, std::int64_t n, Body&& body, int dynamic_chunk = 0) {
+  if (parallel && threads > 1 && dynamic_chunk > 0) {
+#pragma omp parallel for schedule(dynamic, dynamic_chunk) num_threads(threads)
+    for (std::int64_t i = 0; i < n; ++i)
+      body(i);
+  } else if (parallel && threads > 1) {
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (std::int64_t i = 0; i < n; ++i)
       body(i);

@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "continuous.h"
+#include "parallel.h"
 #include "physics/world.h"
 #include "step_scratch.h"
 
@@ -37,13 +38,16 @@ void World::sweep_fast_bodies(double /*dt*/) {
   const double target = std::max({0.5 * solver.speculative_distance, solver.slop, 1e-6});
   const std::int64_t count = static_cast<std::int64_t>(s.swept_pairs.size());
   const int threads = settings_.threads > 0 ? settings_.threads : omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) if (threads > 1 && count > 8)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const BodyPair& pair = pairs_[s.swept_pairs[k]];
-    s.impacts[k] =
-        time_of_impact(bodies_[pair.a].body.shape, motion_of(pair.a), bodies_[pair.b].body.shape,
-                       motion_of(pair.b), target, 0.25 * target, solver.continuous_iterations);
-  }
+  // Sweeps differ in cost (a few to 32 advancement steps): handed out four at a time.
+  for_indices(
+      threads, count > 8, count,
+      [&](std::int64_t k) {
+        const BodyPair& pair = pairs_[s.swept_pairs[k]];
+        s.impacts[k] = time_of_impact(bodies_[pair.a].body.shape, motion_of(pair.a),
+                                      bodies_[pair.b].body.shape, motion_of(pair.b), target,
+                                      0.25 * target, solver.continuous_iterations);
+      },
+      4);
 
   s.first_impact.assign(bodies_.size(), 1.0);
   for (std::size_t k = 0; k < s.impacts.size(); ++k) {
