@@ -98,7 +98,7 @@ Status WorldHost::set_real_time_factor(double factor) {
 
 bool WorldHost::wait_idle(std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
-  return idle_.wait_for(lock, timeout, [&] { return !running_ && steps_left_ == 0; });
+  return idle_.wait_for(lock, timeout, [&] { return !running_ && steps_left_ == 0 && !in_step_; });
 }
 
 std::shared_ptr<FrameMailbox> WorldHost::subscribe() {
@@ -118,7 +118,7 @@ void WorldHost::unsubscribe(const std::shared_ptr<FrameMailbox>& mailbox) {
 HostStatus WorldHost::status() const {
   std::lock_guard lock(mutex_);
   HostStatus status = status_;
-  status.running = running_ || steps_left_ > 0;
+  status.running = running_ || steps_left_ > 0 || in_step_;
   status.dt = hosted_.dt;
   status.real_time_factor = real_time_factor_;
   status.subscribers = subscribers_.size();
@@ -212,10 +212,12 @@ void WorldHost::run() {
     }
     const double dt = hosted_.dt;
     if (steps_left_ > 0) --steps_left_;
+    in_step_ = true;
     lock.unlock();  // the world is this thread's alone; callers may queue meanwhile
     const Status stepped = hosted_.world.step(dt);
     std::shared_ptr<const FrameData> frame = stepped ? make_frame() : nullptr;
     lock.lock();
+    in_step_ = false;
     paced_time += dt;
     status_.step = hosted_.world.step_count();
     status_.time = hosted_.world.time();

@@ -140,6 +140,9 @@ class WorldHost {
   std::deque<Command> commands_;
   bool running_ = false, stopping_ = false;
   std::uint64_t steps_left_ = 0;
+  // A step is being computed (the lock is released meanwhile): the world is still running, and
+  // neither status() nor wait_idle() may say otherwise until it is done.
+  bool in_step_ = false;
   double real_time_factor_;
   HostStatus status_;
   std::vector<std::shared_ptr<FrameMailbox>> subscribers_;
