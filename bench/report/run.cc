@@ -41,6 +41,13 @@ RunOutcome run_scene(const Engine& engine, const SceneDef& scene, const bench::P
   return out;
 }
 
+BodyDef ground() {
+  BodyDef def;
+  def.shape = HalfSpaceDef{};
+  def.type = BodyType::kStatic;
+  return def;
+}
+
 double kinetic_energy(const bench::BodyState& s, double mass, const Vec3& inertia) {
   const Vec3 w_body = s.orientation.conjugate() * s.angular_velocity;
   return 0.5 * mass * s.linear_velocity.squaredNorm() +

@@ -27,6 +27,9 @@ using Observer = std::function<bool(const bench::Simulation&, double t, bool las
 RunOutcome run_scene(const Engine& engine, const SceneDef& scene, const bench::PeerOptions& options,
                      const Observer& observe, double time_limit);
 
+// The static ground plane z = 0 that the report's own scenes stand on.
+BodyDef ground();
+
 // Kinetic energy of a body from its state and principal inertia (body axes = shape axes).
 double kinetic_energy(const bench::BodyState& s, double mass, const Vec3& inertia);
 // World angular momentum about the centre of mass.

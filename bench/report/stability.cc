@@ -26,13 +26,6 @@ std::string format(const char* pattern, double x) {
   return text;
 }
 
-BodyDef ground() {
-  BodyDef def;
-  def.shape = HalfSpaceDef{};
-  def.type = BodyType::kStatic;
-  return def;
-}
-
 BodyDef box(const Vec3& size, const Vec3& position, double mass) {
   BodyDef def;
   def.shape = BoxDef{0.5 * size};
@@ -343,12 +336,13 @@ Scenario degenerate() {
     std::vector<Vec3> start = start_positions(scene);
     const double g = -scene.world.gravity.z();
     const bench::PeerScene peer = bench::peer_scene(scene);
+    const double mass = peer.mass.back();
     const Vec3 inertia = peer.inertia.back();
-    const double initial = g * start[0].z();
+    const double initial = mass * g * start[0].z();
     return [=](const bench::Simulation& sim, double, bool) -> std::string {
       if (std::string f = common_failure(sim, start); !f.empty()) return f;
       const bench::BodyState b = sim.body(0);
-      const double energy = kinetic_energy(b, 1, inertia) + g * b.position.z();
+      const double energy = kinetic_energy(b, mass, inertia) + mass * g * b.position.z();
       if (energy > initial + 1e-3) return format("energy grew by %.3g J", energy - initial);
       return "";
     };

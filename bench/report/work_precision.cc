@@ -28,13 +28,6 @@ struct Reference {
   std::function<std::unique_ptr<ErrorMeter>()> meter;
 };
 
-BodyDef ground() {
-  BodyDef def;
-  def.shape = HalfSpaceDef{};
-  def.type = BodyType::kStatic;
-  return def;
-}
-
 // The error of the final value of f(states) against a known one, relative.
 class FinalValue final : public ErrorMeter {
  public:
