@@ -7,10 +7,14 @@
 #include <pthread.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "scenes/scene.h"
 #include "scenes/standard.h"
@@ -26,6 +30,30 @@ tumble::Result<std::string> read_pem(const std::string& path, const char* flag) 
   return std::move(text).str();
 }
 
+// Applies "NAME=VALUE" options over the scene's limits.
+tumble::Status override_limits(const std::vector<std::string>& options,
+                               tumble::WorldLimits* limits) {
+  for (const std::string& option : options) {
+    const std::size_t equals = option.find('=');
+    const std::string name = option.substr(0, equals);
+    const auto fields = tumble::limit_fields();
+    const auto field = std::find_if(fields.begin(), fields.end(),
+                                    [&](const tumble::LimitField& f) { return f.name == name; });
+    if (equals == std::string::npos || field == fields.end())
+      return tumble::Status::error(option +
+                                   ": expected NAME=VALUE with NAME one of max_coordinate, "
+                                   "min_size, max_size, min_mass, max_mass, "
+                                   "max_linear_speed, max_angular_speed, max_time_step");
+    char* end = nullptr;
+    const std::string text = option.substr(equals + 1);
+    const double value = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0')
+      return tumble::Status::error(option + ": the value is not a number");
+    limits->*field->value = value;
+  }
+  return tumble::validate(*limits);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -38,6 +66,7 @@ int main(int argc, char** argv) {
   bool paused = false;
   std::string token, tls_cert, tls_key;
   int max_message_mb = 256;
+  std::vector<std::string> limit_options;
   app.add_option("--listen", listen, "address to listen on (loopback by default)")
       ->envname("TUMBLE_LISTEN");
   app.add_option("--scene", scene_file, "a scene file (JSON, docs/SCENES.md)")
@@ -66,6 +95,11 @@ int main(int argc, char** argv) {
                  "ones are refused with RESOURCE_EXHAUSTED")
       ->envname("TUMBLE_MAX_MESSAGE_MB")
       ->check(CLI::Range(1, 2047));
+  app.add_option("--limit", limit_options,
+                 "NAME=VALUE: a limit of the world (docs/SCENES.md), imposed on every scene and "
+                 "snapshot loaded; repeatable, e.g. --limit max_size=100 --limit max_mass=1e6")
+      ->envname("TUMBLE_LIMITS")
+      ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   if (tls_cert.empty() != tls_key.empty()) {
     std::fprintf(stderr, "tumble-server: --tls-cert and --tls-key go together\n");
@@ -99,6 +133,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   scene.value().world.threads = threads;
+  if (Status s = override_limits(limit_options, &scene.value().world.limits); !s) {
+    std::fprintf(stderr, "tumble-server: --limit %s\n", s.message().c_str());
+    return 2;
+  }
+  if (scene.value().dt > scene.value().world.limits.max_time_step) {
+    std::fprintf(stderr, "tumble-server: the scene's dt is above limits.max_time_step\n");
+    return 2;
+  }
   Result<World> world = make_world(scene.value());
   if (!world) {
     std::fprintf(stderr, "tumble-server: %s\n", world.error().c_str());
@@ -106,7 +148,9 @@ int main(int argc, char** argv) {
   }
 
   server::WorldHost host(std::move(world).value(), scene.value().dt, real_time_factor);
-  server::WorldService service(host, {.max_bodies = max_bodies, .token = token}, scene.value());
+  server::WorldService service(
+      host, {.max_bodies = max_bodies, .token = token, .world = scene.value().world.limits},
+      scene.value());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;

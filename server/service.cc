@@ -58,7 +58,10 @@ grpc::Status WorldService::authorize(const grpc::ServerContext* context) const {
                              "authorization: missing or wrong bearer token");
 }
 
-grpc::Status WorldService::replace_world(const SceneDef& scene, std::vector<std::uint64_t>* ids) {
+grpc::Status WorldService::replace_world(SceneDef scene, std::vector<std::uint64_t>* ids) {
+  scene.world.limits = limits_.world;
+  if (scene.dt > limits_.world.max_time_step)
+    return invalid("scene: dt " + std::to_string(scene.dt) + " s is above limits.max_time_step");
   if (scene.bodies.size() > limits_.max_bodies)
     return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                         "scene: " + std::to_string(scene.bodies.size()) +
@@ -299,6 +302,10 @@ grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::Contr
   // Checked before anything changes, so a refused request changes nothing.
   if (settings.has_dt() && !(settings.dt() > 0 && std::isfinite(settings.dt())))
     return invalid("settings.dt: must be finite and > 0");
+  if (settings.has_dt() && settings.dt() > limits_.world.max_time_step)
+    return invalid("settings.dt: " + std::to_string(settings.dt()) +
+                   " s is above limits.max_time_step (" +
+                   std::to_string(limits_.world.max_time_step) + " s)");
   if (settings.has_real_time_factor() &&
       !(settings.real_time_factor() >= 0 && std::isfinite(settings.real_time_factor())))
     return invalid("settings.real_time_factor: must be finite and >= 0");
@@ -428,6 +435,9 @@ grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::Resto
                         "state: " + std::to_string(live) + " bodies, more than the " +
                             std::to_string(limits_.max_bodies) + " allowed");
   const std::uint64_t step = s.state.step;
+  s.settings.limits = limits_.world;
+  if (!(s.dt > 0) || s.dt > limits_.world.max_time_step)
+    return invalid("state.dt: must be > 0 and at most limits.max_time_step");
   // Checked whole before the running world is touched.
   Result<World> restored = World::from_state(s.settings, std::move(s.state));
   if (!restored) return invalid("state." + restored.error());

@@ -21,6 +21,9 @@ struct ServiceLimits {
   // When set, every call must carry the metadata "authorization: Bearer <token>" or is
   // UNAUTHENTICATED.
   std::string token;
+  // What every world this server holds accepts (docs/SCENES.md, "Limits"): imposed on scenes
+  // loaded and snapshots restored, whatever limits they carry, so a client cannot widen them.
+  WorldLimits world;
 };
 
 class WorldService final : public v1::World::Service {
@@ -59,7 +62,7 @@ class WorldService final : public v1::World::Service {
   WorldHost& host_;
   ServiceLimits limits_;
   // Builds `scene`'s world and swaps it in between two steps; its body ids into `ids`.
-  grpc::Status replace_world(const SceneDef& scene, std::vector<std::uint64_t>* ids);
+  grpc::Status replace_world(SceneDef scene, std::vector<std::uint64_t>* ids);
   std::mutex scene_mutex_;
   SceneDef scene_;  // the last scene loaded
   std::atomic<bool> shutting_down_{false};

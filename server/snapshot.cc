@@ -79,6 +79,28 @@ void put_settings(const WorldSettings& s, pb::WorldSettings* out) {
   o->set_max_push_velocity(v.max_push_velocity);
   o->set_max_correction(v.max_correction);
   o->set_baumgarte(v.baumgarte);
+  const WorldLimits& l = s.limits;
+  pb::WorldLimits* lo = out->mutable_limits();
+  lo->set_max_coordinate(l.max_coordinate);
+  lo->set_min_size(l.min_size);
+  lo->set_max_size(l.max_size);
+  lo->set_min_mass(l.min_mass);
+  lo->set_max_mass(l.max_mass);
+  lo->set_max_linear_speed(l.max_linear_speed);
+  lo->set_max_angular_speed(l.max_angular_speed);
+  lo->set_max_time_step(l.max_time_step);
+}
+
+void take_limits(const pb::WorldLimits& in, WorldLimits* l) {
+  for (const auto& [value, field] : {std::pair{in.max_coordinate(), &l->max_coordinate},
+                                     {in.min_size(), &l->min_size},
+                                     {in.max_size(), &l->max_size},
+                                     {in.min_mass(), &l->min_mass},
+                                     {in.max_mass(), &l->max_mass},
+                                     {in.max_linear_speed(), &l->max_linear_speed},
+                                     {in.max_angular_speed(), &l->max_angular_speed},
+                                     {in.max_time_step(), &l->max_time_step}})
+    if (value != 0) *field = value;
 }
 
 Result<WorldSettings> take_settings(const pb::WorldSettings& in) {
@@ -118,6 +140,7 @@ Result<WorldSettings> take_settings(const pb::WorldSettings& in) {
   v.slop = o.slop();
   v.speculative_distance = o.speculative_distance();
   v.restitution_threshold = o.restitution_threshold();
+  take_limits(in.limits(), &s.limits);
   v.continuous = o.continuous();
   v.continuous_fraction = o.continuous_fraction();
   v.continuous_iterations = o.continuous_iterations();

@@ -85,6 +85,26 @@ TEST_P(BroadPhaseScenes, PairsEqualBruteForce) {
   }
 }
 
+// A box of half extent 1e18 m once made the grid put it on its coarsest level, where it still
+// covered 1e4 cells a side: memory grew without bound. It, and bodies too far out for the cell
+// numbers, must meet every body directly, with the same pairs as brute force.
+TEST(BroadPhase, HugeAndFarBodiesCostNoMemoryInProportionToTheirSize) {
+  Random rng(7);
+  Scene scene = make_scene("uniform", rng, 200);
+  add_box(scene, Vec3::Zero(), Vec3::Constant(1e18), true);
+  add_box(scene, Vec3(10, 10, 10), Vec3(1e18, 0.5, 0.5), false);
+  add_box(scene, Vec3(1e300, 0, 0), Vec3::Constant(1), true);
+  add_box(scene, Vec3(1e300, 0, 0.5), Vec3::Constant(1), true);
+  const std::vector<BodyPair> expected = brute_force(scene);
+  ASSERT_GT(expected.size(), 300u);  // the huge box meets every body
+  for (int threads : {1, 2}) {
+    HashGrid grid;
+    std::vector<BodyPair> pairs;
+    grid.find_pairs({scene.bounds, scene.movable, threads}, &pairs);
+    EXPECT_EQ(pairs, expected) << threads << " threads";
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Scenes, BroadPhaseScenes,
                          ::testing::Values("uniform", "clustered", "wide", "borders", "far"));
 

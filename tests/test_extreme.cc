@@ -111,6 +111,7 @@ TEST(Spin, FastSpinKeepsEnergyAndMomentum) {
 TEST(Spin, BeyondTheBoundTheStepReportsAndGainsNothing) {
   SceneDef scene = spin_scene();
   scene.bodies[0].angular_velocity = Vec3(0.01, 1, 0.01) * 1e6;
+  scene.world.limits.max_angular_speed = 1e7;  // the default limit refuses this spin at the door
   World world = build(scene);
   const double energy = kinetic_energy(*dynamic_bodies(world)[0]);
   run(world, 1.0 / 60, 10);

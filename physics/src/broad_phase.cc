@@ -12,6 +12,11 @@ namespace tumble {
 namespace {
 
 constexpr int kMaxLevels = 48;
+// Cell numbers stay below 2^52 so that floor(coordinate / cell) converts to an integer exactly.
+constexpr double kFarthestCell = 0x1p52;
+// level_ of a body that is not on a grid level.
+constexpr std::int8_t kDeadSlot = -1;
+constexpr std::int8_t kMeetsEveryone = -2;
 // Level 0 cells this many times the median body extent: bodies a little above the median stay on
 // level 0 (with cells exactly the median, half of a uniform scene went a level up and looked up
 // every cell it covers there).
@@ -100,7 +105,22 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     std::nth_element(sizes_.begin(), middle, sizes_.end());
     if (*middle > 0) base = kCellPerMedianExtent * *middle;
   }
-  level_.assign(n, -1);
+  // A body larger than the top level's cells, or so far out that its cell numbers would not fit
+  // an integer, would cover cells without bound (memory in proportion to its size): it joins the
+  // unbounded bodies and meets every body directly.
+  level_.assign(n, kDeadSlot);
+  const double top_cell = base * std::ldexp(1.0, kMaxLevels - 1);
+  const double farthest = base * kFarthestCell;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (is_dead(bounds[i])) continue;
+    const Aabb& box = bounds[i];
+    if (!box.is_bounded() || box.extent().maxCoeff() > top_cell ||
+        box.min.cwiseAbs().maxCoeff() > farthest || box.max.cwiseAbs().maxCoeff() > farthest) {
+      level_[i] = kMeetsEveryone;
+      if (box.is_bounded()) unbounded_.push_back(i);
+    }
+  }
+  std::sort(unbounded_.begin(), unbounded_.end());
   std::uint64_t occupied = 0;  // bit per level
 
   // (1) Cells of each body on its own level.
@@ -112,7 +132,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
       const Aabb& box = bounds[i];
-      if (is_dead(box) || !box.is_bounded()) continue;
+      if (is_dead(box) || level_[i] == kMeetsEveryone) continue;
       const double extent = box.extent().maxCoeff();
       int level = 0;
       double cell = base;
@@ -161,7 +181,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
       const int own = level_[i];
-      if (own < 0) continue;
+      if (own < 0) continue;  // dead, or meets everyone below
       const Aabb& box = bounds[i];
       // Only the occupied coarser levels (most scenes have one or two levels in all).
       for (std::uint64_t above = occupied & ~((2ull << own) - 1); above != 0; above &= above - 1) {
@@ -183,12 +203,12 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
             }
       }
     }
-    // Unbounded bodies meet everyone.
+    // Unbounded and oversized bodies meet everyone (each such pair once).
 #pragma omp for schedule(static) nowait
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-      if (is_dead(bounds[i])) continue;
+      if (level_[i] == kDeadSlot) continue;
       for (std::uint32_t u : unbounded_)
-        if (!bounds[i].is_bounded() ? u < i : true) emit(static_cast<std::uint32_t>(i), u, out);
+        if (level_[i] == kMeetsEveryone ? u < i : true) emit(static_cast<std::uint32_t>(i), u, out);
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());

@@ -4,7 +4,9 @@
 // Mirtich's hierarchical hash tables): the base cell is the median body size and each level
 // doubles it; a body lives on the first level whose cells are at least its size, so it touches at
 // most 8 cells there and sizes from 1 mm to 100 m cost the same per body. Unbounded bodies (the
-// ground half-space) stay out of the grid and are paired with every body directly.
+// ground half-space), and bodies too large for the coarsest level or too far out for its cell
+// numbers, stay out of the grid and are paired with every body directly: no body costs memory in
+// proportion to its size.
 //
 // Steps: (1) level and cells of every body, in parallel, into per-thread buffers of
 // (cell key, body) entries, each sorted by its thread (a radix sort on the key); (2) one sorted

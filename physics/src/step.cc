@@ -10,6 +10,7 @@
 #include "integrate.h"
 #include "parallel.h"
 #include "physics/world.h"
+#include "step_limits.h"
 #include "step_scratch.h"
 
 namespace tumble {
@@ -250,6 +251,9 @@ void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint3
 
 Status World::step(double dt) {
   if (!(dt > 0) || !std::isfinite(dt)) return Status::error("dt: must be finite and > 0");
+  if (dt > settings_.limits.max_time_step)
+    return Status::error("dt: " + std::to_string(dt) + " s is above limits.max_time_step (" +
+                         std::to_string(settings_.limits.max_time_step) + " s)");
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t step_index = stats_.step + 1;
   stats_ = StepStats{};
@@ -545,17 +549,25 @@ void World::finish_step(double dt) {
   // Impulses for the next step's warm start, sorted by body pair as the contacts are.
   s.cache.resize(s.rows.size());
   impulses_.resize(s.rows.size());
+  std::uint32_t non_finite = 0, slowed = 0, stopped = 0;
   run_region(threads, slots > 256, [&] {
+    std::uint32_t my_non_finite = 0, my_slowed = 0, my_stopped = 0;
 #pragma omp for schedule(static) nowait
     for (std::int64_t i = 0; i < slots; ++i) {
       if (!s.dynamic[i]) continue;
       Body& body = bodies_[i].body;
-      body.position = s.poses[i].position;
-      body.orientation = s.poses[i].orientation;
-      body.linear_velocity = s.bodies[i].v;
-      body.angular_velocity = s.bodies[i].w;
-      body.update_world_inertia();
+      const std::uint8_t guard =
+          take_step_result(&body, s.poses[i], s.bodies[i].v, s.bodies[i].w, settings_.limits);
+      my_non_finite += (guard & kStepNonFinite) != 0;
+      my_slowed += (guard & kStepSlowed) != 0;
+      my_stopped += (guard & kStepAtEdge) != 0;
     }
+#pragma omp atomic update
+    non_finite += my_non_finite;
+#pragma omp atomic update
+    slowed += my_slowed;
+#pragma omp atomic update
+    stopped += my_stopped;
 #pragma omp for schedule(static)
     for (std::int64_t m = 0; m < manifolds; ++m) {
       for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r) {
@@ -570,6 +582,9 @@ void World::finish_step(double dt) {
       }
     }
   });
+  stats_.non_finite_bodies = non_finite;
+  stats_.slowed_bodies = slowed;
+  stats_.bodies_at_edge = stopped;
   time_ += dt;
 }
 

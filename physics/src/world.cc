@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "broad_phase.h"
 #include "parallel.h"
@@ -26,6 +28,13 @@ HashGrid& scratch_grid() {
   return grid;
 }
 
+std::pair<Vec3, Vec3> velocities_after_impulse(const Body& body, const Vec3& impulse,
+                                               const Vec3* point) {
+  Vec3 w = body.angular_velocity;
+  if (point != nullptr) w += body.inverse_inertia_world * (*point - body.position).cross(impulse);
+  return {body.linear_velocity + body.inverse_mass * impulse, w};
+}
+
 }  // namespace
 
 World::World(const WorldSettings& settings)
@@ -36,6 +45,12 @@ World& World::operator=(World&&) noexcept = default;
 
 Status validate(const WorldSettings& s) {
   if (!is_finite(s.gravity)) return Status::error("gravity: must be finite");
+  if (Status t = validate(s.limits); !t) return t.within("limits.");
+  // One step of gravity alone may not take a body past the speed limit.
+  if (s.gravity.norm() * s.limits.max_time_step > s.limits.max_linear_speed)
+    return Status::error(
+        "gravity: |gravity| x limits.max_time_step is above "
+        "limits.max_linear_speed");
   if (s.threads < 0) return Status::error("threads: must be >= 0");
   if (!(s.collision.margin >= 0) || !std::isfinite(s.collision.margin))
     return Status::error("collision.margin: must be finite and >= 0");
@@ -92,6 +107,10 @@ Status validate(const WorldSettings& s) {
 
 Status World::set_settings(const WorldSettings& settings) {
   if (Status s = validate(settings); !s) return s;
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_[i].alive)
+      if (Status s = check_limits(bodies_[i].body, settings.limits); !s)
+        return s.within("limits: the body in slot " + std::to_string(i) + " is beyond them: ");
   settings_ = settings;
   return Status::ok();
 }
@@ -112,7 +131,8 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
   made.reserve(defs.size());
   for (std::size_t i = 0; i < defs.size(); ++i) {
     Result<Body> body = make_body(defs[i]);
-    if (!body) return body.status().within("bodies[" + std::to_string(i) + "].");
+    const Status status = body ? check_limits(body.value(), settings_.limits) : body.status();
+    if (!status) return status.within("bodies[" + std::to_string(i) + "].");
     made.push_back(std::move(body).value());
   }
   std::vector<BodyId> ids;
@@ -160,14 +180,22 @@ void World::wake_around(const Body& body) {
 
 Status World::check_motion(BodyId id, const BodyMotion& motion) const {
   if (!contains(id)) return Status::error("body: no body with this id");
+  const Body& body = bodies_[id.index].body;
   if (motion.position && !is_finite(*motion.position))
     return Status::error("position: must be finite");
+  if (motion.position) {
+    Body moved;
+    moved.type = BodyType::kStatic;  // only the position is checked here
+    moved.shape = body.shape;
+    moved.position = *motion.position;
+    if (Status s = check_limits(moved, settings_.limits); !s) return s;
+  }
   if (motion.orientation) {
     const double norm = motion.orientation->norm();
     if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
       return Status::error("orientation: must be a unit quaternion");
   }
-  const bool is_static = bodies_[id.index].body.is_static();
+  const bool is_static = body.is_static();
   for (const auto& [velocity, name] : {std::pair{&motion.linear_velocity, "linear_velocity"},
                                        {&motion.angular_velocity, "angular_velocity"}}) {
     if (!*velocity) continue;
@@ -175,7 +203,9 @@ Status World::check_motion(BodyId id, const BodyMotion& motion) const {
     if (is_static && !(*velocity)->isZero(0))
       return Status::error(std::string(name) + ": a static body does not move");
   }
-  return Status::ok();
+  if (is_static) return Status::ok();
+  return check_speeds(motion.linear_velocity.value_or(body.linear_velocity),
+                      motion.angular_velocity.value_or(body.angular_velocity), settings_.limits);
 }
 
 Status World::set_motion(BodyId id, const BodyMotion& motion) {
@@ -202,6 +232,10 @@ Status World::check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) c
   if (bodies_[id.index].body.is_static()) return Status::error("body: a static body does not move");
   if (!is_finite(impulse)) return Status::error("impulse: must be finite");
   if (point != nullptr && !is_finite(*point)) return Status::error("point: must be finite");
+  const Body& body = bodies_[id.index].body;
+  const auto [v, w] = velocities_after_impulse(body, impulse, point);
+  if (Status s = check_speeds(v, w, settings_.limits); !s)
+    return Status::error("impulse: it would give " + s.message());
   return Status::ok();
 }
 
@@ -210,9 +244,8 @@ Status World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point) {
   Body& body = bodies_[id.index].body;
   if (body.asleep) wake_island(body.sleep_island);
   body.sleep_timer = 0;
-  body.linear_velocity += body.inverse_mass * impulse;
-  if (point != nullptr)
-    body.angular_velocity += body.inverse_inertia_world * (*point - body.position).cross(impulse);
+  std::tie(body.linear_velocity, body.angular_velocity) =
+      velocities_after_impulse(body, impulse, point);
   return Status::ok();
 }
 

@@ -1,4 +1,6 @@
 // Saving a world's state and restoring it.
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -28,6 +30,19 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
       return Status::error("mass: must be finite and > 0 for a dynamic body");
     if (body.shape.type() == ShapeType::kHalfSpace)
       return Status::error("shape: a half-space must be static");
+    // The inverses are stored too (a restored world steps bit for bit), so a crafted state could
+    // pair a mass with any inverse: they must agree, and the inertia must be positive definite.
+    if (std::abs(body.mass * body.inverse_mass - 1) > 1e-9)
+      return Status::error("inverse_mass: must be 1 / mass");
+    if (!body.inverse_inertia_body.isApprox(body.inertia_body.inverse(), 1e-9))
+      return Status::error("inverse_inertia_body: must be the inverse of inertia_body");
+    if (!body.inertia_body.isApprox(body.inertia_body.transpose(), 1e-9) ||
+        body.inertia_body.llt().info() != Eigen::Success)
+      return Status::error("inertia_body: must be symmetric positive definite");
+    const Mat3 r = body.orientation.toRotationMatrix();
+    const Mat3 world_inverse = r * body.inverse_inertia_body * r.transpose();
+    if (!body.inverse_inertia_world.isApprox(world_inverse, 1e-6))
+      return Status::error("inverse_inertia_world: must be the body's inverse inertia, rotated");
   }
   if (!(body.friction >= 0) || !std::isfinite(body.friction))
     return Status::error("friction: must be finite and >= 0");
@@ -65,6 +80,8 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
     if (!slot.alive) continue;
     ++live;
     if (Status s = check_body(slot.body, slot_count); !s)
+      return s.within("slots[" + std::to_string(i) + "].");
+    if (Status s = check_limits(slot.body, settings.limits); !s)
       return s.within("slots[" + std::to_string(i) + "].");
   }
   // Exactly the dead slots are free, each once: creation reuses them in this order.

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "scenes/scene.h"
 
@@ -130,7 +131,22 @@ ShapeDef read_shape(ObjectReader& r) {
   fail(r.child("shape"), "unknown shape '" + type + "' (box, sphere, capsule, hull or plane)");
 }
 
-BodyDef read_body(const Json& json, const std::string& path) {
+void read_limits(const Json& json, WorldLimits* limits) {
+  ObjectReader r(json, "limits");
+  for (const LimitField& field : limit_fields())
+    limits->*field.value = r.number(std::string(field.name), limits->*field.value);
+  r.reject_unknown();
+  if (Status s = validate(*limits); !s) throw FieldError{"limits." + s.message()};
+}
+
+Json limits_json(const WorldLimits& limits) {
+  Json out = Json::object();
+  for (const LimitField& field : limit_fields())
+    out[std::string(field.name)] = limits.*field.value;
+  return out;
+}
+
+BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& limits) {
   ObjectReader r(json, path);
   BodyDef def;
   def.shape = read_shape(r);
@@ -153,7 +169,9 @@ BodyDef read_body(const Json& json, const std::string& path) {
   def.restitution = r.number("restitution", def.restitution);
   r.reject_unknown();
   // The engine's own checks (mass, friction, orientation, hull degeneracy...) with this path.
-  if (Result<Body> body = make_body(def); !body) throw FieldError{path + "." + body.error()};
+  Result<Body> body = make_body(def);
+  if (!body) throw FieldError{path + "." + body.error()};
+  if (Status s = check_limits(body.value(), limits); !s) throw FieldError{path + "." + s.message()};
   return def;
 }
 
@@ -196,13 +214,18 @@ SceneDef read_scene(const Json& json) {
   solver.contact_hertz = r.number("contact_hertz", solver.contact_hertz);
   solver.continuous = r.boolean("continuous", solver.continuous);
   solver.continuous_fraction = r.number("continuous_fraction", solver.continuous_fraction);
+  if (const Json* limits = r.find("limits")) read_limits(*limits, &world.limits);
   if (Status s = validate(world); !s) throw FieldError{s.message()};
+  if (scene.dt > world.limits.max_time_step)
+    fail("dt",
+         "is above limits.max_time_step (" + std::to_string(world.limits.max_time_step) + " s)");
 
   const Json* bodies = r.find("bodies");
   if (bodies != nullptr) {
     if (!bodies->is_array()) fail("bodies", "must be an array");
     for (std::size_t i = 0; i < bodies->size(); ++i)
-      scene.bodies.push_back(read_body((*bodies)[i], "bodies[" + std::to_string(i) + "]"));
+      scene.bodies.push_back(
+          read_body((*bodies)[i], "bodies[" + std::to_string(i) + "]", world.limits));
   }
   r.reject_unknown();
   return scene;
@@ -305,7 +328,8 @@ std::string scene_to_json(const SceneDef& scene) {
               {"restitution_threshold", s.restitution_threshold},
               {"contact_hertz", s.contact_hertz},
               {"continuous", s.continuous},
-              {"continuous_fraction", s.continuous_fraction}};
+              {"continuous_fraction", s.continuous_fraction},
+              {"limits", limits_json(scene.world.limits)}};
   out["bodies"] = Json::array();
   for (const BodyDef& def : scene.bodies)
     out["bodies"].push_back(body_json(def));

@@ -102,6 +102,10 @@ struct StepStats {
   // Bodies whose implicit gyroscopic step hit its Newton iteration bound or spun too fast for
   // kGyroscopicMaxPieces; they kept their body-frame spin for the step.
   std::uint32_t gyroscopic_limit_hits = 0;
+  // The world's limits (WorldLimits) held by the step: bodies whose step produced a non-finite
+  // value (they keep their pose from before the step, at rest), bodies slowed to the speed
+  // limits, and bodies held at the edge of the world (max_coordinate).
+  std::uint32_t non_finite_bodies = 0, slowed_bodies = 0, bodies_at_edge = 0;
   StageTimes time;
 };
 

@@ -9,6 +9,7 @@
 
 #include "physics/body.h"
 #include "physics/collision.h"
+#include "physics/limits.h"
 #include "physics/math.h"
 #include "physics/status.h"
 #include "physics/step.h"
@@ -28,6 +29,7 @@ struct WorldSettings {
   BroadPhaseMethod broad_phase = BroadPhaseMethod::kAuto;
   CollisionSettings collision;
   SolverSettings solver;
+  WorldLimits limits;
 };
 
 // Checks settings without applying them; the message names the field.
@@ -61,7 +63,7 @@ class World {
   World(World&&) noexcept;
   World& operator=(World&&) noexcept;
 
-  // Creates one body, or none and says why.
+  // Creates one body, or none and says why (an invalid definition, or one beyond the limits).
   Result<BodyId> create_body(const BodyDef& def);
   // Creates all bodies or none; a failure names the definition ("bodies[3].mass: must be > 0").
   Result<std::vector<BodyId>> create_bodies(std::span<const BodyDef> defs);
@@ -70,13 +72,14 @@ class World {
   // Wakes a sleeping body and the island it fell asleep with.
   Status wake(BodyId id);
   // Moves a body or changes its velocities (the fields given; a static body takes a pose only).
-  // Refused, changing nothing, for an unknown id, a non-finite value or a quaternion not within
-  // 1e-3 of unit length; check_motion says so without changing anything. The body wakes, and
-  // so do sleepers around a static body that moved.
+  // Refused, changing nothing, for an unknown id, a value beyond the world's limits or a
+  // quaternion not within 1e-3 of unit length; check_motion says so without changing anything. The
+  // body wakes, and so do sleepers around a static body that moved.
   Status check_motion(BodyId id, const BodyMotion& motion) const;
   Status set_motion(BodyId id, const BodyMotion& motion);
   // An impulse (N s, world) at a point (m, world; the centre of mass when null) of a dynamic
-  // body, applied now to its velocities; the body wakes.
+  // body, applied now to its velocities; the body wakes. Refused when the velocities it gives
+  // would be beyond the world's limits.
   Status check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) const;
   Status apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point);
 
@@ -94,12 +97,14 @@ class World {
   std::uint32_t slot_count() const { return static_cast<std::uint32_t>(bodies_.size()); }
 
   const WorldSettings& settings() const { return settings_; }
-  // Applies all settings or none.
+  // Applies all settings or none: new limits are refused while a body lies beyond them.
   Status set_settings(const WorldSettings& settings);
   void set_broad_phase(BroadPhaseMethod method) { settings_.broad_phase = method; }
 
-  // Advances the world by dt seconds (> 0): broad phase, narrow phase, contact preparation,
-  // solve and integrate per island, position correction. See StepStats for what it reports.
+  // Advances the world by dt seconds (> 0, at most limits.max_time_step): broad phase, narrow
+  // phase, contact preparation, solve and integrate per island, position correction. See StepStats
+  // for what it reports; a body the step would take beyond the limits is held within them and
+  // counted there.
   Status step(double dt);
   const StepStats& last_step() const { return stats_; }
   double time() const { return time_; }  // s, simulated

@@ -1,0 +1,50 @@
+// What a world accepts. Every body, change of motion, impulse and restored state is checked
+// against these before anything changes, and the step keeps every body within them, so that the
+// world never holds a value that double precision or the solvers cannot carry (a spin of 1e308
+// rad/s turns into NaN in one step; a sphere of radius 1e18 m needs more grid cells than memory).
+#pragma once
+
+#include <span>
+#include <string_view>
+
+#include "physics/body.h"
+#include "physics/status.h"
+
+namespace tumble {
+
+struct WorldLimits {
+  // m: |x|, |y| and |z| of every body's centre of mass (and of a static plane's origin). At 1e9 m
+  // doubles still resolve 0.1 µm.
+  double max_coordinate = 1e9;
+  // m: a body's smallest dimension (sphere or capsule radius, box half extent, half the thinnest
+  // side of a hull's box) and its largest (the farthest point of the shape from its centre).
+  // Together they bound the size ratio of any two bodies, and the aspect ratio of one, to 1e10.
+  double min_size = 1e-5;
+  double max_size = 1e5;
+  // kg: a dynamic body's mass; the mass ratio of any two bodies is at most max_mass / min_mass.
+  double min_mass = 1e-15;
+  double max_mass = 1e15;
+  double max_linear_speed = 1e5;   // m/s, of the centre of mass
+  double max_angular_speed = 1e6;  // rad/s
+  double max_time_step = 1;        // s, one call of World::step
+};
+
+// Each limit by the name scene files and command lines use ("max_size").
+struct LimitField {
+  std::string_view name;
+  double WorldLimits::*value;
+};
+std::span<const LimitField> limit_fields();
+
+// Checks the limits themselves; the message names the field ("max_size: must be > min_size").
+Status validate(const WorldLimits& limits);
+
+// Checks a built body against the limits; the message names the field and the limit
+// ("shape.radius: 1e+18 m is above limits.max_size (100000 m)").
+Status check_limits(const Body& body, const WorldLimits& limits);
+
+// Checks velocities a body would take ("linear_velocity: ... above limits.max_linear_speed").
+Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,
+                    const WorldLimits& limits);
+
+}  // namespace tumble

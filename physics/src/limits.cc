@@ -1,0 +1,116 @@
+#include "physics/limits.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace tumble {
+namespace {
+
+std::string number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
+}
+
+Status above(const std::string& field, double value, const char* unit, const char* limit,
+             double bound) {
+  return Status::error(field + ": " + number(value) + " " + unit + " is above limits." + limit +
+                       " (" + number(bound) + " " + unit + ")");
+}
+
+Status below(const std::string& field, double value, const char* unit, const char* limit,
+             double bound) {
+  return Status::error(field + ": " + number(value) + " " + unit + " is below limits." + limit +
+                       " (" + number(bound) + " " + unit + ")");
+}
+
+// The field that sets a shape's smallest dimension, its value, and its largest dimension.
+struct ShapeSpan {
+  const char* smallest_field;
+  double smallest;
+  const char* largest_field;
+};
+
+ShapeSpan span_of(const Shape& shape) {
+  switch (shape.type()) {
+    case ShapeType::kSphere:
+      return {"shape.radius", shape.radius(), "shape.radius"};
+    case ShapeType::kCapsule:
+      return {"shape.radius", shape.radius(), "shape.half_height"};
+    case ShapeType::kBox:
+      return {"shape.half_extents", shape.half_extents().minCoeff(), "shape.half_extents"};
+    case ShapeType::kHull:
+      return {"shape.points", shape.local_bounds().extent().minCoeff() / 2, "shape.points"};
+    case ShapeType::kHalfSpace:
+      break;
+  }
+  return {"shape", 0, "shape"};
+}
+
+constexpr LimitField kLimitFields[] = {
+    {"max_coordinate", &WorldLimits::max_coordinate},
+    {"min_size", &WorldLimits::min_size},
+    {"max_size", &WorldLimits::max_size},
+    {"min_mass", &WorldLimits::min_mass},
+    {"max_mass", &WorldLimits::max_mass},
+    {"max_linear_speed", &WorldLimits::max_linear_speed},
+    {"max_angular_speed", &WorldLimits::max_angular_speed},
+    {"max_time_step", &WorldLimits::max_time_step},
+};
+
+}  // namespace
+
+std::span<const LimitField> limit_fields() {
+  return kLimitFields;
+}
+
+Status validate(const WorldLimits& l) {
+  for (const LimitField& field : kLimitFields)
+    if (const double value = l.*field.value; !(value > 0) || !std::isfinite(value))
+      return Status::error(std::string(field.name) + ": must be finite and > 0");
+  if (!(l.min_size <= l.max_size)) return Status::error("max_size: must be >= min_size");
+  if (!(l.min_mass <= l.max_mass)) return Status::error("max_mass: must be >= min_mass");
+  // Beyond these a product of two limits (an impulse, a moment arm times a speed) could overflow.
+  if (l.max_coordinate > 1e15) return Status::error("max_coordinate: must be <= 1e15");
+  if (l.max_size > 1e12) return Status::error("max_size: must be <= 1e12");
+  if (l.max_mass > 1e30 || l.min_mass < 1e-30)
+    return Status::error("min_mass, max_mass: must be within [1e-30, 1e30]");
+  if (l.max_linear_speed > 1e12 || l.max_angular_speed > 1e12)
+    return Status::error("max_linear_speed, max_angular_speed: must be <= 1e12");
+  return Status::ok();
+}
+
+Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,
+                    const WorldLimits& limits) {
+  if (!is_finite(linear_velocity)) return Status::error("linear_velocity: must be finite");
+  if (!is_finite(angular_velocity)) return Status::error("angular_velocity: must be finite");
+  if (const double v = linear_velocity.norm(); v > limits.max_linear_speed)
+    return above("linear_velocity", v, "m/s", "max_linear_speed", limits.max_linear_speed);
+  if (const double w = angular_velocity.norm(); w > limits.max_angular_speed)
+    return above("angular_velocity", w, "rad/s", "max_angular_speed", limits.max_angular_speed);
+  return Status::ok();
+}
+
+Status check_limits(const Body& body, const WorldLimits& limits) {
+  if (!is_finite(body.position)) return Status::error("position: must be finite");
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(body.position[k]) > limits.max_coordinate)
+      return above("position[" + std::to_string(k) + "]", std::abs(body.position[k]), "m",
+                   "max_coordinate", limits.max_coordinate);
+  if (body.shape.type() != ShapeType::kHalfSpace) {
+    const ShapeSpan span = span_of(body.shape);
+    if (!(span.smallest >= limits.min_size))
+      return below(span.smallest_field, span.smallest, "m", "min_size", limits.min_size);
+    if (const double largest = body.shape.outer_radius(); !(largest <= limits.max_size))
+      return above(span.largest_field, largest, "m", "max_size", limits.max_size);
+  }
+  if (body.is_static()) return Status::ok();
+  if (!(body.mass >= limits.min_mass))
+    return below("mass", body.mass, "kg", "min_mass", limits.min_mass);
+  if (!(body.mass <= limits.max_mass))
+    return above("mass", body.mass, "kg", "max_mass", limits.max_mass);
+  return check_speeds(body.linear_velocity, body.angular_velocity, limits);
+}
+
+}  // namespace tumble
