@@ -168,6 +168,9 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
   out->set_residual(s.residual);
   out->set_max_penetration(s.max_penetration);
   out->set_swept_bodies(s.swept_bodies);
+  out->set_non_finite_bodies(s.non_finite_bodies);
+  out->set_slowed_bodies(s.slowed_bodies);
+  out->set_bodies_at_edge(s.bodies_at_edge);
   out->set_broad_phase_seconds(s.time.broad_phase);
   out->set_narrow_phase_seconds(s.time.narrow_phase);
   out->set_prepare_seconds(s.time.prepare);

@@ -17,12 +17,12 @@ grpc::Status invalid(const std::string& message) {
 }
 
 // The bodies named by `wire_ids`, or the first unknown one's position in the list.
-Status find_bodies(const World& world,
+Status find_bodies(const HostedWorld& hosted,
                    const google::protobuf::RepeatedField<std::uint64_t>& wire_ids,
                    std::vector<BodyId>* ids) {
   for (int i = 0; i < wire_ids.size(); ++i) {
-    const BodyId id = body_id(wire_ids[i]);
-    if (!world.contains(id))
+    const BodyId id = hosted.ids.find(wire_ids[i]);
+    if (!hosted.world.contains(id))
       return Status::error("ids[" + std::to_string(i) + "]: no body " +
                            std::to_string(wire_ids[i]));
     ids->push_back(id);
@@ -75,9 +75,10 @@ grpc::Status WorldService::replace_world(SceneDef scene, std::vector<std::uint64
     WorldSettings settings = world.settings();
     settings.threads = hosted.world.settings().threads;  // the server's choice, not the scene's
     if (Status s = world.set_settings(settings); !s) return s;
-    for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
-      if (world.id_at(slot).is_valid()) ids->push_back(wire_id(world.id_at(slot)));
     hosted.replace(std::move(world), scene.dt, {});
+    for (std::uint32_t slot = 0; slot < hosted.world.slot_count(); ++slot)
+      if (const BodyId id = hosted.world.id_at(slot); id.is_valid())
+        ids->push_back(hosted.ids.wire(id));
     return Status::ok();
   });
   if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
@@ -96,7 +97,7 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
     defs.push_back(std::move(def).value());
   }
   bool too_many = false;
-  std::vector<BodyId> ids;
+  std::vector<std::uint64_t> ids;
   const Status applied = host_.apply([&](HostedWorld& hosted) {
     World& world = hosted.world;
     if (world.body_count() + defs.size() > limits_.max_bodies) {
@@ -106,17 +107,19 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
     }
     Result<std::vector<BodyId>> made = world.create_bodies(defs);
     if (!made) return made.status();
-    ids = std::move(made).value();
-    for (std::size_t i = 0; i < ids.size(); ++i)
-      hosted.set_colour(ids[i], request->bodies(static_cast<int>(i)).color());
+    hosted.ids.sync(world);
+    for (std::size_t i = 0; i < made.value().size(); ++i) {
+      hosted.set_colour(made.value()[i], request->bodies(static_cast<int>(i)).color());
+      ids.push_back(hosted.ids.wire(made.value()[i]));
+    }
     return Status::ok();
   });
   if (!applied)
     return grpc::Status(
         too_many ? grpc::StatusCode::RESOURCE_EXHAUSTED : grpc::StatusCode::INVALID_ARGUMENT,
         applied.message());
-  for (BodyId id : ids)
-    response->add_ids(wire_id(id));
+  for (std::uint64_t id : ids)
+    response->add_ids(id);
   return grpc::Status::OK;
 }
 
@@ -133,7 +136,7 @@ grpc::Status WorldService::RemoveBodies(grpc::ServerContext* context,
     World& world = hosted.world;
     // Every id is checked before anything is removed: all or nothing.
     std::vector<BodyId> ids;
-    if (Status found = find_bodies(world, request->ids(), &ids); !found) {
+    if (Status found = find_bodies(hosted, request->ids(), &ids); !found) {
       missing = true;
       return found;
     }
@@ -158,16 +161,17 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
     if (request->ids_size() == 0) {
       for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
         if (world.id_at(slot).is_valid()) ids.push_back(world.id_at(slot));
-    } else if (Status found = find_bodies(world, request->ids(), &ids); !found) {
+    } else if (Status found = find_bodies(hosted, request->ids(), &ids); !found) {
       read = found;
       return;
     }
     response->set_step(world.step_count());
     for (BodyId id : ids) {
       const Body& body = *world.body(id);
-      describe(wire_id(id), look_of(body, hosted.colours[id.index]), response->add_descriptions());
+      describe(hosted.ids.wire(id), look_of(body, hosted.colours[id.index]),
+               response->add_descriptions());
       v1::BodyState* state = response->add_states();
-      state->set_id(wire_id(id));
+      state->set_id(hosted.ids.wire(id));
       auto set = [](const Vec3& v, v1::Vec3* out) {
         out->set_x(v.x());
         out->set_y(v.y());
@@ -202,17 +206,21 @@ grpc::Status apply_batch(WorldHost& host, const char* name, const Entries& entri
   bool missing = false;
   const Status applied = host.apply([&](HostedWorld& hosted) {
     World& world = hosted.world;
+    std::vector<BodyId> ids;
+    ids.reserve(entries.size());
     for (int i = 0; i < entries.size(); ++i) {
-      if (!world.contains(body_id(entries[i].id()))) {
+      const BodyId id = hosted.ids.find(entries[i].id());
+      if (!world.contains(id)) {
         missing = true;
         return Status::error(std::string(name) + "[" + std::to_string(i) + "].id: no body " +
                              std::to_string(entries[i].id()));
       }
-      if (Status s = check(world, entries[i]); !s)
+      if (Status s = check(world, id, entries[i]); !s)
         return s.within(std::string(name) + "[" + std::to_string(i) + "].");
+      ids.push_back(id);
     }
-    for (const auto& entry : entries)
-      apply(world, entry);
+    for (int i = 0; i < entries.size(); ++i)
+      apply(world, ids[i], entries[i]);
     return Status::ok();
   });
   if (!applied)
@@ -241,11 +249,11 @@ grpc::Status WorldService::SetBodyState(grpc::ServerContext* context,
   if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   return apply_batch(
       host_, "updates", request->updates(),
-      [](const World& world, const v1::BodyStateUpdate& u) {
-        return world.check_motion(body_id(u.id()), motion_from_proto(u));
+      [](const World& world, BodyId id, const v1::BodyStateUpdate& u) {
+        return world.check_motion(id, motion_from_proto(u));
       },
-      [](World& world, const v1::BodyStateUpdate& u) {
-        world.set_motion(body_id(u.id()), motion_from_proto(u));
+      [](World& world, BodyId id, const v1::BodyStateUpdate& u) {
+        world.set_motion(id, motion_from_proto(u));
       });
 }
 
@@ -258,13 +266,13 @@ grpc::Status WorldService::ApplyImpulse(grpc::ServerContext* context,
   };
   return apply_batch(
       host_, "impulses", request->impulses(),
-      [&](const World& world, const v1::Impulse& i) {
+      [&](const World& world, BodyId id, const v1::Impulse& i) {
         const std::optional<Vec3> point = point_of(i);
-        return world.check_impulse(body_id(i.id()), vec(i.impulse()), point ? &*point : nullptr);
+        return world.check_impulse(id, vec(i.impulse()), point ? &*point : nullptr);
       },
-      [&](World& world, const v1::Impulse& i) {
+      [&](World& world, BodyId id, const v1::Impulse& i) {
         const std::optional<Vec3> point = point_of(i);
-        world.apply_impulse(body_id(i.id()), vec(i.impulse()), point ? &*point : nullptr);
+        world.apply_impulse(id, vec(i.impulse()), point ? &*point : nullptr);
       });
 }
 
@@ -413,7 +421,9 @@ grpc::Status WorldService::Snapshot(grpc::ServerContext* context, const v1::Snap
   if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   SavedWorld saved;
   host_.inspect([&](const HostedWorld& hosted) {
-    saved = {hosted.world.settings(), hosted.world.save_state(), hosted.dt, hosted.colours};
+    saved = {hosted.world.settings(), hosted.world.save_state(), hosted.dt,
+             hosted.colours,          hosted.ids.by_slot(),      hosted.ids.next(),
+             hosted.server_instance};
   });
   // Encoded off the stepping thread: the copy above is all the world waits for.
   response->set_step(saved.state.step);
@@ -446,7 +456,16 @@ grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::Resto
     WorldSettings settings = world.settings();
     settings.threads = hosted.world.settings().threads;  // the server's choice
     if (Status t = world.set_settings(settings); !t) return t;
+    if (s.server_instance == hosted.server_instance) {
+      // Ids this server gave to these very bodies: they keep them.
+      hosted.restore(std::move(world), s.dt, std::move(s.colours), s.ids, s.next_id);
+      return Status::ok();
+    }
+    // Another server's ids could name bodies of ours: every body gets a new one.
     hosted.replace(std::move(world), s.dt, std::move(s.colours));
+    for (std::uint32_t slot = 0; slot < s.ids.size(); ++slot)
+      if (const BodyId id = hosted.world.id_at(slot); id.is_valid() && s.ids[slot] != 0)
+        (*response->mutable_new_ids())[s.ids[slot]] = hosted.ids.wire(id);
     return Status::ok();
   });
   if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());

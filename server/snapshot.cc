@@ -1,6 +1,7 @@
 #include "snapshot.h"
 
 #include <cmath>
+#include <unordered_set>
 
 #include "tumble/v1/snapshot.pb.h"
 
@@ -276,11 +277,16 @@ std::string encode_snapshot(const SavedWorld& saved) {
   put_settings(saved.settings, out.mutable_settings());
   out.set_dt(saved.dt);
   const WorldStateData& state = saved.state;
-  for (std::size_t i = 0; i < state.slots.size(); ++i)
-    put_body(state.slots[i], i < saved.colours.size() ? saved.colours[i] : 0, out.add_slots());
+  for (std::size_t i = 0; i < state.slots.size(); ++i) {
+    pb::Body* body = out.add_slots();
+    put_body(state.slots[i], i < saved.colours.size() ? saved.colours[i] : 0, body);
+    if (state.slots[i].alive && i < saved.ids.size()) body->set_id(saved.ids[i]);
+  }
   out.mutable_free_slots()->Add(state.free_slots.begin(), state.free_slots.end());
   out.set_time(state.time);
   out.set_step(state.step);
+  out.set_server_instance(saved.server_instance);
+  out.set_next_id(saved.next_id);
   pb::WarmStart* w = out.mutable_warm_start();
   for (const WarmStartImpulse& c : state.warm_start) {
     w->add_body_a(c.a.index);
@@ -312,11 +318,22 @@ Result<SavedWorld> decode_snapshot(std::string_view bytes) {
   WorldStateData& state = saved.state;
   state.slots.resize(in.slots_size());
   saved.colours.resize(in.slots_size(), 0);
+  saved.ids.resize(in.slots_size(), 0);
+  std::unordered_set<std::uint64_t> ids;
   for (int i = 0; i < in.slots_size(); ++i) {
-    if (Status s = take_body(in.slots(i), &state.slots[i]); !s)
-      return s.within("slots[" + std::to_string(i) + "].");
+    const std::string slot = "slots[" + std::to_string(i) + "].";
+    if (Status s = take_body(in.slots(i), &state.slots[i]); !s) return s.within(slot);
     saved.colours[i] = in.slots(i).color();
+    const std::uint64_t id = in.slots(i).id();
+    if (id == 0) continue;
+    if (!state.slots[i].alive) return Status::error(slot + "id: a free slot has no id");
+    if (id >= kMaxBodyId) return Status::error(slot + "id: must be below 2^53");
+    if (!ids.insert(id).second) return Status::error(slot + "id: used by another slot too");
+    saved.ids[i] = id;
   }
+  if (in.next_id() >= kMaxBodyId) return Status::error("next_id: must be below 2^53");
+  saved.next_id = in.next_id();
+  saved.server_instance = in.server_instance();
   state.free_slots.assign(in.free_slots().begin(), in.free_slots().end());
   state.time = in.time();
   state.step = in.step();

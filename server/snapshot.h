@@ -15,7 +15,15 @@ struct SavedWorld {
   WorldStateData state;
   double dt = 0;                       // s per step
   std::vector<std::uint32_t> colours;  // by slot
+  // Body ids as clients know them, by slot (0 where none), the next id the server would have
+  // given, and the server process that gave them (0: unknown).
+  std::vector<std::uint64_t> ids;
+  std::uint64_t next_id = 0;
+  std::uint64_t server_instance = 0;
 };
+
+// Ids stay below 2^53 so that JSON tools (doubles) read them exactly.
+constexpr std::uint64_t kMaxBodyId = std::uint64_t{1} << 53;
 
 std::string encode_snapshot(const SavedWorld& saved);
 // Refusals name the field ("slots[3].shape.polyhedron.edges[2]: out of range").

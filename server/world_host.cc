@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 namespace tumble::server {
 
@@ -9,6 +10,10 @@ WorldHost::WorldHost(World world, double dt, double real_time_factor)
     : real_time_factor_(real_time_factor) {
   hosted_.world = std::move(world);
   hosted_.dt = dt;
+  hosted_.ids.sync(hosted_.world);
+  std::random_device entropy;
+  while (hosted_.server_instance == 0)
+    hosted_.server_instance = static_cast<std::uint64_t>(entropy()) << 32 | entropy();
   refresh_catalogue();
   status_.bodies = hosted_.world.body_count();
   status_.dt = dt;
@@ -142,6 +147,7 @@ void WorldHost::apply_pending() {
     const Status result = command.change(hosted_);
     if (result && !command.read_only) {
       changed = true;
+      hosted_.ids.sync(hosted_.world);
       refresh_catalogue();
     }
     status_.bodies = hosted_.world.body_count();
@@ -159,7 +165,7 @@ void WorldHost::refresh_catalogue() {
   bool same = catalogue_epoch_ == hosted_.epoch && catalogue_->size() == world.body_count();
   for (std::uint32_t slot = 0; same && slot < world.slot_count(); ++slot) {
     const BodyId id = world.id_at(slot);
-    same = !id.is_valid() || catalogue_->contains(wire_id(id));
+    same = !id.is_valid() || catalogue_->contains(hosted_.ids.wire(id));
   }
   if (same) return;
   auto fresh = std::make_shared<Catalogue>();
@@ -171,7 +177,7 @@ void WorldHost::refresh_catalogue() {
       hosted_.colours[slot] = 0;  // a later body in this slot starts with the viewer's choice
       continue;
     }
-    fresh->emplace(wire_id(id),
+    fresh->emplace(hosted_.ids.wire(id),
                    BodyLook{body->shape, body->type, body->is_static() ? 0 : body->mass,
                             hosted_.colours[slot]});
   }
@@ -248,7 +254,7 @@ std::shared_ptr<const FrameData> WorldHost::make_frame() const {
     const BodyId id = world.id_at(slot);
     const Body* body = world.body(id);
     if (body == nullptr) continue;
-    frame->ids.push_back(wire_id(id));
+    frame->ids.push_back(hosted_.ids.wire(id));
     frame->positions.insert(frame->positions.end(), body->position.data(),
                             body->position.data() + 3);
     const Quat& q = body->orientation;
@@ -263,8 +269,8 @@ std::shared_ptr<const FrameData> WorldHost::make_frame() const {
   for (const Contact& contact : world.contacts()) {
     for (int i = 0; i < contact.manifold.count; ++i, ++row) {
       const ContactPoint& point = contact.manifold.points[i];
-      frame->contact_a.push_back(wire_id(contact.a));
-      frame->contact_b.push_back(wire_id(contact.b));
+      frame->contact_a.push_back(hosted_.ids.wire(contact.a));
+      frame->contact_b.push_back(hosted_.ids.wire(contact.b));
       frame->contact_points.insert(frame->contact_points.end(), point.point_b.data(),
                                    point.point_b.data() + 3);
       frame->contact_normals.insert(frame->contact_normals.end(), contact.manifold.normal.data(),

@@ -15,18 +15,11 @@
 #include <unordered_map>
 #include <vector>
 
+#include "body_ids.h"
 #include "mailbox.h"
 #include "physics/world.h"
 
 namespace tumble::server {
-
-// Ids on the wire: the slot index in the low 32 bits, its generation above.
-inline std::uint64_t wire_id(BodyId id) {
-  return static_cast<std::uint64_t>(id.generation) << 32 | id.index;
-}
-inline BodyId body_id(std::uint64_t wire) {
-  return {static_cast<std::uint32_t>(wire & 0xFFFFFFFFu), static_cast<std::uint32_t>(wire >> 32)};
-}
 
 // What a viewer needs to draw a body, kept while the body lives.
 struct BodyLook {
@@ -44,14 +37,34 @@ struct HostedWorld {
   World world;
   double dt = 1.0 / 60;                // s per step
   std::vector<std::uint32_t> colours;  // by slot, 0xRRGGBBAA
-  // Counts wholesale replacements (a scene loaded, a snapshot restored): ids start over, so a
-  // subscriber must forget the bodies it knew.
+  // The ids clients see. The host follows every command's changes (a body created gets a new
+  // id, a removed one loses its id for good); a command that needs a new body's id at once
+  // calls ids.sync(world) itself.
+  BodyIds ids;
+  // Chosen at random when the server starts, and written into snapshots: a snapshot made here
+  // gives its bodies back their ids; one from elsewhere gets new ones, which cannot collide with
+  // ids this server has handed out.
+  std::uint64_t server_instance = 0;
+  // Counts wholesale replacements (a scene loaded, a snapshot restored), so that a subscriber
+  // forgets every body it knew.
   std::uint64_t epoch = 0;
 
+  // A new world whose bodies all get new ids.
   void replace(World replacement, double new_dt, std::vector<std::uint32_t> new_colours) {
     world = std::move(replacement);
     dt = new_dt;
     colours = std::move(new_colours);
+    ids.clear();
+    ids.sync(world);
+    ++epoch;
+  }
+  // A restored world whose bodies keep the ids they had (by slot; see BodyIds::adopt).
+  void restore(World replacement, double new_dt, std::vector<std::uint32_t> new_colours,
+               std::span<const std::uint64_t> wire_ids, std::uint64_t next_id) {
+    world = std::move(replacement);
+    dt = new_dt;
+    colours = std::move(new_colours);
+    ids.adopt(world, wire_ids, next_id);
     ++epoch;
   }
   void set_colour(BodyId id, std::uint32_t colour) {

@@ -4,6 +4,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include <set>
 #include <thread>
 
 #include "scene_runner.h"
@@ -35,6 +36,17 @@ class ServiceTest : public ::testing::Test {
     v1::GetInfoResponse info;
     EXPECT_TRUE(stub_->GetInfo(&context, {}, &info).ok());
     return info.body_count();
+  }
+
+  // Every body's id, in the order GetBodies lists them (the world's slots).
+  std::vector<std::uint64_t> ids() {
+    grpc::ClientContext context;
+    v1::GetBodiesResponse bodies;
+    EXPECT_TRUE(stub_->GetBodies(&context, {}, &bodies).ok());
+    std::vector<std::uint64_t> out;
+    for (const v1::BodyState& state : bodies.states())
+      out.push_back(state.id());
+    return out;
   }
 
   static v1::BodySpec ball(double z) {
@@ -104,8 +116,8 @@ TEST_F(ServiceTest, BadInputIsRefusedByFieldAndChangesNothing) {
   }
   {  // one unknown id refuses the whole removal
     v1::RemoveBodiesRequest request;
-    request.add_ids(wire_id(host_.status().bodies > 0 ? BodyId{1, 0} : BodyId{}));
-    request.add_ids(wire_id(BodyId{999, 0}));
+    request.add_ids(ids()[1]);
+    request.add_ids(999999);
     grpc::ClientContext context;
     v1::RemoveBodiesResponse response;
     const grpc::Status status = stub_->RemoveBodies(&context, request, &response);
@@ -134,7 +146,7 @@ TEST_F(ServiceTest, SetStateAndImpulsesApplyWholeBatchesOnly) {
     EXPECT_TRUE(stub_->GetBodies(&context, get, &bodies).ok());
     return bodies.states(0);
   };
-  const std::uint64_t a = wire_id(BodyId{1, 0}), b = wire_id(BodyId{2, 0});
+  const std::uint64_t a = ids()[1], b = ids()[2];
   {
     v1::SetBodyStateRequest request;
     auto* first = request.add_updates();
@@ -164,11 +176,11 @@ TEST_F(ServiceTest, SetStateAndImpulsesApplyWholeBatchesOnly) {
     v1::ApplyImpulseResponse response;
     ASSERT_TRUE(stub_->ApplyImpulse(&context, request, &response).ok());
     EXPECT_EQ(state_of(b).linear_velocity().x(), 3);
-    push->set_id(wire_id(BodyId{0, 0}));  // the ground
+    push->set_id(ids()[0]);  // the ground
     grpc::ClientContext ground;
     EXPECT_EQ(stub_->ApplyImpulse(&ground, request, &response).error_code(),
               grpc::StatusCode::INVALID_ARGUMENT);
-    push->set_id(wire_id(BodyId{77, 3}));
+    push->set_id(77777);
     grpc::ClientContext unknown;
     EXPECT_EQ(stub_->ApplyImpulse(&unknown, request, &response).error_code(),
               grpc::StatusCode::NOT_FOUND);
@@ -239,6 +251,30 @@ TEST_F(ServiceTest, LoadSceneReplacesTheWorldOrNothing) {
   }
 }
 
+// A client cannot widen the server's limits with the limits of a scene it loads.
+TEST_F(ServiceTest, TheServersLimitsHoldForEveryLoadedScene) {
+  const std::vector<std::uint64_t> before = ids();
+  v1::LoadSceneRequest request;
+  request.set_scene_json(R"({"limits": {"max_size": 1e9},
+                             "bodies": [{"shape": "sphere", "radius": 1e6, "mass": 1}]})");
+  grpc::ClientContext context;
+  v1::LoadSceneResponse response;
+  const grpc::Status status = stub_->LoadScene(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("bodies[0].shape.radius"), std::string::npos)
+      << status.error_message();
+  EXPECT_NE(status.error_message().find("max_size"), std::string::npos);
+  EXPECT_EQ(ids(), before);
+
+  v1::ControlRequest slow;
+  slow.mutable_settings()->set_dt(5);
+  grpc::ClientContext control_context;
+  v1::ControlResponse control_response;
+  const grpc::Status refused = stub_->Control(&control_context, slow, &control_response);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(refused.error_message().find("max_time_step"), std::string::npos);
+}
+
 TEST_F(ServiceTest, StreamDescribesBodiesThenSendsPoses) {
   v1::StreamFramesRequest request;
   request.set_stats(true);
@@ -293,14 +329,84 @@ class SnapshotTest : public ServiceTest {
     EXPECT_TRUE(stub_->Snapshot(&context, {}, &response).ok());
     return response;
   }
-  grpc::Status restore(const std::string& state) {
+  grpc::Status restore(const std::string& state, v1::RestoreResponse* answer = nullptr) {
     v1::RestoreRequest request;
     request.set_state(state);
     grpc::ClientContext context;
     v1::RestoreResponse response;
-    return stub_->Restore(&context, request, &response);
+    const grpc::Status status = stub_->Restore(&context, request, &response);
+    if (answer != nullptr) *answer = response;
+    return status;
+  }
+  std::vector<std::uint64_t> spawn_balls(int n) {
+    v1::SpawnBodiesRequest request;
+    for (int i = 0; i < n; ++i)
+      *request.add_bodies() = ball(5 + i);
+    grpc::ClientContext context;
+    v1::SpawnBodiesResponse response;
+    EXPECT_TRUE(stub_->SpawnBodies(&context, request, &response).ok());
+    return {response.ids().begin(), response.ids().end()};
+  }
+  void control(const v1::ControlRequest& request) {
+    grpc::ClientContext context;
+    v1::ControlResponse response;
+    ASSERT_TRUE(stub_->Control(&context, request, &response).ok());
   }
 };
+
+// Issue 17, defect 3: after a reset, a scene load or a restore, new bodies once took the ids of
+// old ones, so a client's remove of "its" box deleted somebody else's sphere.
+TEST_F(SnapshotTest, IdsNeverNameAnotherBodyAcrossResetLoadAndRestore) {
+  std::set<std::uint64_t> seen;
+  // Every id handed out must be new, except a restored body's own.
+  auto all_new = [&](const std::vector<std::uint64_t>& ids) {
+    for (std::uint64_t id : ids)
+      EXPECT_TRUE(seen.insert(id).second) << "id " << id << " was given before";
+  };
+  all_new(ids());
+  const std::vector<std::uint64_t> mine = spawn_balls(2);
+  all_new(mine);
+  v1::ControlRequest reset;
+  reset.set_reset(true);
+  control(reset);
+  all_new(ids());
+  all_new(spawn_balls(2));
+  {  // the balls spawned before the reset are gone: removing one is refused, nothing removed
+    const std::size_t count = body_count();
+    v1::RemoveBodiesRequest request;
+    request.add_ids(mine[0]);
+    grpc::ClientContext context;
+    v1::RemoveBodiesResponse response;
+    EXPECT_EQ(stub_->RemoveBodies(&context, request, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+    EXPECT_EQ(body_count(), count);
+  }
+  v1::LoadSceneRequest load;
+  load.set_builtin("pyramid:3");
+  grpc::ClientContext load_context;
+  v1::LoadSceneResponse loaded;
+  ASSERT_TRUE(stub_->LoadScene(&load_context, load, &loaded).ok());
+  all_new({loaded.ids().begin(), loaded.ids().end()});
+
+  const std::vector<std::uint64_t> saved_ids = ids();
+  const std::string saved = snapshot().state();
+  all_new(spawn_balls(3));
+  v1::RestoreResponse restored;
+  ASSERT_TRUE(restore(saved, &restored).ok());
+  EXPECT_EQ(ids(), saved_ids);  // a snapshot of this server: the same bodies, the same ids
+  EXPECT_TRUE(restored.new_ids().empty());
+  all_new(spawn_balls(2));  // not the ids of the three spawned after the snapshot
+
+  // A snapshot from another server: its ids could be ours for other bodies, so all are new.
+  v1::snapshot::WorldSnapshot foreign;
+  ASSERT_TRUE(foreign.ParseFromString(saved));
+  foreign.set_server_instance(foreign.server_instance() + 1);
+  ASSERT_TRUE(restore(foreign.SerializeAsString(), &restored).ok());
+  all_new(ids());
+  ASSERT_EQ(restored.new_ids().size(), saved_ids.size());
+  for (std::uint64_t old_id : saved_ids)
+    EXPECT_TRUE(restored.new_ids().contains(old_id)) << old_id;
+}
 
 TEST_F(SnapshotTest, RestoreContinuesTheRunBitForBit) {
   v1::SpawnBodiesRequest spawn;
@@ -404,7 +510,7 @@ TEST(ServiceAuth, EveryCallNeedsTheBearerToken) {
   {
     grpc::ClientContext context;
     v1::RemoveBodiesRequest remove;
-    remove.add_ids(wire_id(BodyId{1, 0}));
+    remove.add_ids(2);
     v1::RemoveBodiesResponse removed;
     EXPECT_EQ(stub->RemoveBodies(&context, remove, &removed).error_code(),
               grpc::StatusCode::UNAUTHENTICATED);
