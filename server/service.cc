@@ -284,7 +284,7 @@ grpc::Status WorldService::LoadScene(grpc::ServerContext* context,
   if (request->has_scene_json())
     scene = parse_scene(request->scene_json());
   else if (request->has_builtin())
-    scene = standard_scene(request->builtin());
+    scene = standard_scene(request->builtin(), limits_.max_bodies);
   if (!scene) {
     const char* field = request->has_scene_json() ? "scene_json: "
                         : request->has_builtin()  ? "builtin: "

@@ -55,6 +55,10 @@ Result<Shape> Shape::create(const ShapeDef& def) {
     shape.half_extents_ = box->half_extents;
     shape.polyhedron_ = std::make_shared<ConvexPolyhedron>(make_box_polyhedron(box->half_extents));
   } else if (const auto* hull = std::get_if<HullDef>(&def)) {
+    if (hull->points.size() > kMaxHullPoints)
+      return Status::error("points: " + std::to_string(hull->points.size()) +
+                           " points, more than the " + std::to_string(kMaxHullPoints) +
+                           " a hull may have");
     Result<ConvexPolyhedron> built = build_convex_hull(hull->points);
     if (!built) return built.status();
     shape.type_ = ShapeType::kHull;

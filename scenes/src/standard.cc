@@ -118,7 +118,7 @@ SceneDef bounce_scene(double height, double restitution) {
   return scene;
 }
 
-Result<SceneDef> standard_scene(std::string_view spec) {
+Result<SceneDef> standard_scene(std::string_view spec, std::size_t max_bodies) {
   std::string_view name = spec;
   std::optional<int> size;
   if (const std::size_t colon = spec.find(':'); colon != std::string_view::npos) {
@@ -132,6 +132,12 @@ Result<SceneDef> standard_scene(std::string_view spec) {
                            "': the size after ':' must be an integer in [1, 1000000]");
     size = value;
   }
+  // Counted before anything is built, so a request for a huge scene costs nothing.
+  const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(0));
+  const std::uint64_t bodies = name == "pyramid" ? n * (n + 1) / 2 : n;
+  if (bodies > max_bodies)
+    return Status::error("scene '" + std::string(spec) + "': " + std::to_string(bodies) +
+                         " bodies, more than the " + std::to_string(max_bodies) + " allowed");
   auto sized = [&](const char* what) -> Status {
     if (size) return Status::error("scene '" + std::string(spec) + "': " + what + " takes no size");
     return Status::ok();

@@ -26,8 +26,10 @@ struct CapsuleDef {
 struct BoxDef {
   Vec3 half_extents = Vec3::Constant(0.5);
 };
-// The convex hull of `points` (m, in the body frame). At least 4 points spanning a volume;
-// duplicates, interior and coplanar points are fine.
+// The convex hull of `points` (m, in the body frame). At least 4 points spanning a volume, at
+// most kMaxHullPoints (every contact query walks the hull's vertices, so their number bounds the
+// time a step can take); duplicates, interior and coplanar points are fine.
+inline constexpr std::size_t kMaxHullPoints = 1024;
 struct HullDef {
   std::vector<Vec3> points;
 };

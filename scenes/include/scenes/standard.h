@@ -2,6 +2,7 @@
 // and the peer engines' compare like for like. Tests, benchmarks and the server share them.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -39,8 +40,9 @@ SceneDef bounce_scene(double height = 1,
                                                   // (bottom face above ground), 3 s
 
 // A standard scene by name, with an optional size: "pile", "pile:250", "pyramid:10", "tower:5",
-// "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "default".
-Result<SceneDef> standard_scene(std::string_view name);
+// "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "default". A size whose
+// scene would have more than `max_bodies` bodies is refused before anything is built.
+Result<SceneDef> standard_scene(std::string_view name, std::size_t max_bodies = 1000000);
 
 // What a program was asked to run: the scene file when given, else the standard scene when
 // named, else the built-in default scene.
