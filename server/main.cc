@@ -137,6 +137,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tumble-server: --limit %s\n", s.message().c_str());
     return 2;
   }
+  if (tumble::Status s = server::check_real_time_factor(real_time_factor); !s) {
+    std::fprintf(stderr, "tumble-server: --real-time-factor: %s\n", s.message().c_str());
+    return 2;
+  }
   if (scene.value().dt > scene.value().world.limits.max_time_step) {
     std::fprintf(stderr, "tumble-server: the scene's dt is above limits.max_time_step\n");
     return 2;

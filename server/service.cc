@@ -314,9 +314,9 @@ grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::Contr
     return invalid("settings.dt: " + std::to_string(settings.dt()) +
                    " s is above limits.max_time_step (" +
                    std::to_string(limits_.world.max_time_step) + " s)");
-  if (settings.has_real_time_factor() &&
-      !(settings.real_time_factor() >= 0 && std::isfinite(settings.real_time_factor())))
-    return invalid("settings.real_time_factor: must be finite and >= 0");
+  if (settings.has_real_time_factor())
+    if (Status s = check_real_time_factor(settings.real_time_factor()); !s)
+      return invalid("settings." + s.message());
   if (settings.has_gravity()) {
     const v1::Vec3& g = settings.gravity();
     if (!std::isfinite(g.x()) || !std::isfinite(g.y()) || !std::isfinite(g.z()))

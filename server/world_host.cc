@@ -90,9 +90,17 @@ Status WorldHost::set_dt(double dt) {
   return Status::ok();
 }
 
+Status check_real_time_factor(double factor) {
+  // A tiny factor would put the next step beyond what the clock's integer nanoseconds can hold.
+  if (factor == 0 || (factor >= kMinRealTimeFactor && factor <= kMaxRealTimeFactor))
+    return Status::ok();
+  return Status::error("real_time_factor: must be 0 (as fast as possible) or within [" +
+                       std::to_string(kMinRealTimeFactor) + ", " +
+                       std::to_string(kMaxRealTimeFactor) + "]");
+}
+
 Status WorldHost::set_real_time_factor(double factor) {
-  if (!(factor >= 0) || !std::isfinite(factor))
-    return Status::error("real_time_factor: must be finite and >= 0");
+  if (Status s = check_real_time_factor(factor); !s) return s;
   {
     std::lock_guard lock(mutex_);
     real_time_factor_ = factor;

@@ -102,6 +102,10 @@ struct HostStatus {
   std::size_t subscribers = 0;
 };
 
+// Simulated seconds per wall-clock second when paced; 0 runs flat out.
+inline constexpr double kMinRealTimeFactor = 1e-3, kMaxRealTimeFactor = 1e3;
+Status check_real_time_factor(double factor);
+
 class WorldHost {
  public:
   // `dt`: s per step; `real_time_factor`: 1 paces simulated time to wall time, 0 runs flat out.

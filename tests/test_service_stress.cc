@@ -3,12 +3,6 @@
 // that never reads holds up neither the world nor memory.
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
-#include <malloc.h>
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-// The sanitizer runtimes' own count (declared in clang's sanitizer/allocator_interface.h, which
-// GCC does not ship).
-extern "C" std::size_t __sanitizer_get_current_allocated_bytes();
-#endif
 
 #include <atomic>
 #include <condition_variable>
@@ -18,6 +12,7 @@ extern "C" std::size_t __sanitizer_get_current_allocated_bytes();
 #include <thread>
 #include <unordered_map>
 
+#include "heap_in_use.h"
 #include "scene_runner.h"
 #include "service.h"
 
@@ -25,6 +20,7 @@ namespace tumble::server {
 namespace {
 
 using namespace std::chrono_literals;
+using testing::heap_in_use;
 
 class LoopbackServer {
  public:
@@ -157,17 +153,6 @@ TEST(ServiceStress, SpawnersAndStreamersTogether) {
   EXPECT_EQ(torn_frames, 0);                          // no frame showed part of a batch
   EXPECT_GT(frames_read, kStreamers);
   EXPECT_EQ(server.host().status().bodies, 9u + 1u);  // all batches removed; the scene and poke
-}
-
-// Bytes the program holds on the heap now (sanitizers keep their own heap, and freed memory in
-// quarantine, so they are asked directly).
-std::size_t heap_in_use() {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  return __sanitizer_get_current_allocated_bytes();
-#else
-  const struct mallinfo2 info = mallinfo2();
-  return info.uordblks + info.hblkhd;
-#endif
 }
 
 // A streamer asking for velocities and contacts of 1000 bodies (about 100 kB a frame) that never

@@ -1,0 +1,282 @@
+// Issue 17: hostile files. Scene JSON, snapshots and recordings, damaged at the byte level and
+// crafted at the field level (hostile numbers, wrong types, huge counts). Each is refused with a
+// message, or accepted and then steps to a finite world within its limits; none crashes or hangs.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "fuzz_support.h"
+#include "recording.h"
+#include "scene_runner.h"
+#include "snapshot.h"
+#include "tumble/v1/snapshot.pb.h"
+
+namespace tumble {
+namespace {
+
+using Json = nlohmann::json;
+using testing::FuzzTally;
+using testing::Hostile;
+
+void print(const char* what, const FuzzTally& t) {
+  std::printf("fuzz %s: %llu inputs, %llu accepted, %llu refused, %llu poisoned\n", what,
+              static_cast<unsigned long long>(t.tried), static_cast<unsigned long long>(t.accepted),
+              static_cast<unsigned long long>(t.refused),
+              static_cast<unsigned long long>(t.poisoned));
+}
+
+// Every body finite and within the world's limits.
+bool sound(const World& world) {
+  for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
+    const Body* body = world.body(world.id_at(slot));
+    if (body != nullptr && !check_limits(*body, world.settings().limits)) return false;
+  }
+  return true;
+}
+
+// A world that was accepted must step and stay sound.
+bool steps_soundly(World& world, double dt) {
+  for (int k = 0; k < 3; ++k)
+    if (!world.step(dt) || !sound(world)) return false;
+  return true;
+}
+
+// Somewhere in `json`, one value replaced by a hostile one, a key removed or added, or an array
+// made long.
+void craft(Hostile& h, Json* json) {
+  Json* node = json;
+  for (int depth = 0; depth < 6 && (node->is_object() || node->is_array()) && !node->empty();
+       ++depth) {
+    if (h.chance(0.25)) break;
+    auto it = node->begin();
+    std::advance(it, static_cast<long>(h.rng().uniform() * node->size()));
+    node = &*it;
+  }
+  switch (h.integer(0, 7)) {
+    case 0:
+    case 1: {
+      const double v = h.special();
+      *node = std::isfinite(v) ? Json(v) : Json(h.chance(0.5) ? 1e308 : -1e308);
+      break;
+    }
+    case 2:
+      *node = h.chance(0.5) ? Json("text") : Json(nullptr);
+      break;
+    case 3:
+      *node = Json::array({1, 2});
+      break;
+    case 4:
+      if (node->is_object() && !node->empty()) node->erase(node->begin());
+      break;
+    case 5:
+      if (node->is_object()) (*node)["unknown_field"] = 1;
+      break;
+    case 6:
+      if (node->is_array() && !node->empty())
+        for (int k = h.integer(1, 200); k > 0; --k)
+          node->push_back(node->front());
+      break;
+    default:
+      *node = h.chance(0.5) ? Json(-1) : Json(static_cast<std::int64_t>(1) << 62);
+  }
+}
+
+TEST(FuzzFiles, SceneJson) {
+  Hostile h(17);
+  const std::string base(default_scene_json());
+  const Json parsed = Json::parse(base);
+  FuzzTally tally;
+  for (int i = 0; i < 3000; ++i) {
+    std::string text;
+    if (h.chance(0.5)) {
+      text = h.mutate(base);
+    } else {
+      Json json = parsed;
+      for (int k = h.integer(1, 3); k > 0; --k)
+        craft(h, &json);
+      text = json.dump();
+    }
+    ++tally.tried;
+    Result<SceneDef> scene = parse_scene(text);
+    if (!scene) {
+      ++tally.refused;
+      EXPECT_FALSE(scene.error().empty());
+      continue;
+    }
+    Result<World> world = make_world(scene.value());
+    if (!world) {
+      ++tally.refused;
+      continue;
+    }
+    ++tally.accepted;
+    if (!steps_soundly(world.value(), scene.value().dt)) {
+      ++tally.poisoned;
+      ADD_FAILURE() << "scene " << i << " was accepted but stepped into an unsound world:\n"
+                    << text;
+    }
+  }
+  // Nesting deep enough to overflow a recursive parser's stack.
+  const std::string deep = std::string(200000, '[') + std::string(200000, ']');
+  EXPECT_FALSE(parse_scene(deep).ok());
+  ++tally.tried;
+  ++tally.refused;
+  print("scene json", tally);
+  EXPECT_EQ(tally.poisoned, 0u);
+  EXPECT_GT(tally.accepted, 200u);
+  EXPECT_GT(tally.refused, 300u);
+}
+
+std::string landed_pile_snapshot() {
+  World world = make_world(pile_scene(20)).value();
+  for (int k = 0; k < 40; ++k)
+    EXPECT_TRUE(world.step(1.0 / 60).is_ok());
+  server::SavedWorld saved{world.settings(), world.save_state(), 1.0 / 60, {}, {}, 0, 0};
+  for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
+    saved.ids.push_back(world.id_at(slot).is_valid() ? slot + 1 : 0);
+  saved.next_id = world.slot_count() + 1;
+  return server::encode_snapshot(saved);
+}
+
+TEST(FuzzFiles, Snapshots) {
+  Hostile h(18);
+  const std::string good = landed_pile_snapshot();
+  v1::snapshot::WorldSnapshot parsed;
+  ASSERT_TRUE(parsed.ParseFromString(good));
+  ASSERT_GT(parsed.warm_start().normal_size(), 0);
+  FuzzTally tally;
+  for (int i = 0; i < 3000; ++i) {
+    std::string bytes;
+    if (h.chance(0.4)) {
+      bytes = h.mutate(good);
+    } else {
+      v1::snapshot::WorldSnapshot s = parsed;
+      v1::snapshot::Body* b = s.mutable_slots(h.integer(0, s.slots_size() - 1));
+      switch (h.integer(0, 11)) {
+        case 0:
+          b->set_mass(h.special());
+          break;
+        case 1:
+          b->set_inverse_mass(h.special());
+          break;
+        case 2:
+          b->set_position(h.integer(0, 2), h.special());
+          break;
+        case 3:
+          b->set_linear_velocity(h.integer(0, 2), h.special());
+          break;
+        case 4:
+          b->set_inertia_body(h.integer(0, 8), h.special());
+          break;
+        case 5:
+          b->mutable_shape()->set_type(static_cast<std::uint32_t>(h.integer(0, 9)));
+          break;
+        case 6:
+          b->mutable_shape()->set_half_extents(h.integer(0, 2), h.special());
+          break;
+        case 7:
+          s.mutable_warm_start()->set_body_a(0, static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
+          break;
+        case 8:
+          s.mutable_warm_start()->set_normal(0, h.special());
+          break;
+        case 9:
+          for (int k = h.integer(1, 1000); k > 0; --k)
+            *s.add_slots() = v1::snapshot::Body();
+          break;
+        case 10:
+          s.mutable_settings()->mutable_solver()->set_iterations(h.integer(-5, 5000));
+          break;
+        default:
+          s.mutable_settings()->mutable_limits()->set_max_size(h.special());
+      }
+      bytes = s.SerializeAsString();
+    }
+    ++tally.tried;
+    Result<server::SavedWorld> saved = server::decode_snapshot(bytes);
+    Result<World> world = saved ? World::from_state(saved.value().settings, saved.value().state)
+                                : Result<World>(saved.status());
+    if (!world) {
+      ++tally.refused;
+      EXPECT_FALSE(world.error().empty());
+      continue;
+    }
+    ++tally.accepted;
+    if (!steps_soundly(world.value(), saved.value().dt)) {
+      ++tally.poisoned;
+      ADD_FAILURE() << "snapshot " << i << " was accepted but stepped into an unsound world";
+    }
+  }
+  print("snapshots", tally);
+  EXPECT_EQ(tally.poisoned, 0u);
+  EXPECT_GT(tally.accepted, 100u);
+  EXPECT_GT(tally.refused, 1000u);
+}
+
+TEST(FuzzFiles, Recordings) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("tumble-fuzz-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string good_path = (dir / "good.rec").string();
+  {
+    Result<client::RecordingWriter> writer = client::RecordingWriter::create(good_path);
+    ASSERT_TRUE(writer.ok()) << writer.error();
+    for (int k = 0; k < 20; ++k) {
+      v1::Frame frame;
+      frame.set_step(k);
+      frame.set_time(k / 60.0);
+      for (int b = 0; b < 5; ++b) {
+        frame.add_ids(b + 1);
+        for (int c = 0; c < 3; ++c)
+          frame.add_positions(b + c + k);
+      }
+      ASSERT_TRUE(writer.value().write(frame).is_ok());
+    }
+  }
+  std::string good;
+  {
+    std::FILE* file = std::fopen(good_path.c_str(), "rb");
+    ASSERT_NE(file, nullptr);
+    char buffer[4096];
+    for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, file)) > 0;)
+      good.append(buffer, n);
+    std::fclose(file);
+  }
+  Hostile h(19);
+  FuzzTally tally;
+  const std::string path = (dir / "damaged.rec").string();
+  for (int i = 0; i < 1000; ++i) {
+    std::string bytes = h.mutate(good);
+    if (h.chance(0.2)) {  // a frame length that claims far more than the file holds
+      const std::size_t header = std::string("tumble-recording 1\n").size();
+      if (bytes.size() > header) bytes.replace(header, 1, "\xff\xff\xff\xff\x0f");
+    }
+    {
+      std::FILE* file = std::fopen(path.c_str(), "wb");
+      ASSERT_NE(file, nullptr);
+      std::fwrite(bytes.data(), 1, bytes.size(), file);
+      std::fclose(file);
+    }
+    ++tally.tried;
+    Result<client::RecordingReader> reader = client::RecordingReader::open(path);
+    if (!reader) {
+      ++tally.refused;
+      continue;
+    }
+    v1::Frame frame;
+    int frames = 0;
+    while (reader.value().next(&frame))
+      ASSERT_LE(++frames, static_cast<int>(bytes.size())) << "more frames than the file holds";
+    (reader.value().truncated() ? tally.refused : tally.accepted)++;
+  }
+  std::filesystem::remove_all(dir);
+  print("recordings", tally);
+  EXPECT_GT(tally.accepted, 10u);
+  EXPECT_GT(tally.refused, 100u);
+}
+
+}  // namespace
+}  // namespace tumble

@@ -1,0 +1,372 @@
+// Issue 17: random and hostile requests for every RPC of the service, through an in-process
+// channel. After each one the server answers, its own snapshot of the world restores (so nothing
+// non-finite or beyond the limits got in), and a refused or read-only request left the world
+// byte for byte as it was (the snapshot before and after).
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "fuzz_support.h"
+#include "scene_runner.h"
+#include "service.h"
+#include "snapshot.h"
+#include "tumble/v1/snapshot.pb.h"
+
+namespace tumble::server {
+namespace {
+
+using testing::FuzzTally;
+using testing::Hostile;
+
+constexpr std::size_t kMaxBodies = 300;
+
+class FuzzService {
+ public:
+  FuzzService()
+      : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0),
+        service_(host_, {.max_bodies = kMaxBodies, .token = "", .world = {}}, pile_scene(8)) {
+    grpc::ServerBuilder builder;
+    builder.RegisterService(&service_);
+    server_ = builder.BuildAndStart();
+    stub_ = v1::World::NewStub(server_->InProcessChannel(grpc::ChannelArguments()));
+  }
+  ~FuzzService() {
+    service_.shut_down();
+    server_->Shutdown();
+  }
+
+  // Runs `count` random requests; the tally counts them and what went wrong.
+  FuzzTally run(std::uint64_t seed, int count) {
+    Hostile h(seed);
+    FuzzTally tally;
+    std::string before = snapshot();
+    refresh_ids();
+    for (int i = 0; i < count; ++i) {
+      bool read_only = false;
+      const int rpc = h.integer(0, 9);
+      const grpc::Status status = send(h, rpc, &read_only);
+      ++tally.tried;
+      (status.ok() ? tally.accepted : tally.refused)++;
+      EXPECT_NE(status.error_code(), grpc::StatusCode::INTERNAL)
+          << "request " << i << " (rpc " << rpc << "): " << status.error_message();
+      EXPECT_NE(status.error_code(), grpc::StatusCode::UNKNOWN) << status.error_message();
+      host_.wait_idle(std::chrono::seconds(30));
+      grpc::ClientContext alive;
+      v1::GetInfoResponse info;
+      if (!stub_->GetInfo(&alive, {}, &info).ok()) {
+        ADD_FAILURE() << "the server stopped answering after request " << i;
+        return tally;
+      }
+      const std::string after = snapshot();
+      if ((!status.ok() || read_only) && after != before) {
+        ++tally.half_applied;
+        ADD_FAILURE() << "request " << i << " (rpc " << rpc << ", "
+                      << (status.ok() ? "read only" : status.error_message())
+                      << ") changed the world";
+      }
+      // The server's own snapshot must always restore: every value in the world is one the world
+      // would accept (defect 1: a NaN made the server's own snapshot unrestorable).
+      Result<SavedWorld> saved = decode_snapshot(after);
+      Result<World> world = saved ? World::from_state(saved.value().settings, saved.value().state)
+                                  : Result<World>(saved.status());
+      if (!world) {
+        ++tally.poisoned;
+        ADD_FAILURE() << "after request " << i << " (rpc " << rpc
+                      << ") the world's snapshot is refused: " << world.error();
+        return tally;
+      }
+      before = after;
+      if (status.ok() && !read_only) refresh_ids();
+    }
+    return tally;
+  }
+
+ private:
+  std::string snapshot() {
+    grpc::ClientContext context;
+    v1::SnapshotResponse response;
+    EXPECT_TRUE(stub_->Snapshot(&context, {}, &response).ok());
+    return response.state();
+  }
+  void refresh_ids() {
+    grpc::ClientContext context;
+    v1::GetBodiesResponse bodies;
+    EXPECT_TRUE(stub_->GetBodies(&context, {}, &bodies).ok());
+    known_.clear();
+    for (const auto& state : bodies.states())
+      known_.push_back(state.id());
+  }
+  // A live id most of the time; else one that names nothing (0, stale, huge).
+  std::uint64_t id(Hostile& h) {
+    if (!known_.empty() && h.chance(0.8))
+      return known_[static_cast<std::size_t>(h.rng().uniform() * known_.size())];
+    const std::uint64_t odd[] = {
+        0, 1, 999999, UINT64_MAX, std::uint64_t{1} << 53, known_.empty() ? 7 : known_.back() + 1};
+    return odd[h.integer(0, 5)];
+  }
+  static void set(const Vec3& v, v1::Vec3* out) {
+    out->set_x(v.x());
+    out->set_y(v.y());
+    out->set_z(v.z());
+  }
+  static void set(Hostile& h, v1::Quat* q) {
+    if (h.chance(0.5)) {
+      const Quat r = h.rng().rotation();
+      q->set_w(r.w());
+      q->set_x(r.x());
+      q->set_y(r.y());
+      q->set_z(r.z());
+    } else {
+      q->set_w(h.number(-1, 1));
+      q->set_x(h.number(-1, 1));
+      q->set_y(h.number(-1, 1));
+      q->set_z(h.number(-1, 1));
+    }
+  }
+
+  v1::BodySpec body(Hostile& h) {
+    v1::BodySpec spec;
+    v1::Shape* shape = spec.mutable_shape();
+    switch (h.integer(0, 6)) {
+      case 0:
+        set(h.vector(0.05, 2), shape->mutable_box()->mutable_size());
+        break;
+      case 1:
+        shape->mutable_sphere()->set_radius(h.number(0.05, 1));
+        break;
+      case 2:
+        shape->mutable_capsule()->set_radius(h.number(0.05, 0.5));
+        shape->mutable_capsule()->set_half_height(h.number(0.05, 1));
+        break;
+      case 3: {
+        const int counts[] = {0, 2, 4, 4, 8, 12, 1025};
+        const int n = counts[h.integer(0, 6)];
+        const bool flat = h.chance(0.2);
+        for (int p = 0; p < n; ++p) {
+          Vec3 v = h.chance(0.9) ? h.rng().vector(-0.5, 0.5) : h.vector(-0.5, 0.5);
+          if (flat) v.z() = 0;
+          shape->mutable_hull()->add_points(v.x());
+          shape->mutable_hull()->add_points(v.y());
+          shape->mutable_hull()->add_points(v.z());
+        }
+        if (h.chance(0.1)) shape->mutable_hull()->add_points(1);  // not a whole triple
+        break;
+      }
+      case 4:
+        shape->mutable_plane();
+        break;
+      default:
+        if (h.chance(0.5)) shape->mutable_sphere()->set_radius(0.2);
+        break;  // or no shape at all
+    }
+    if (h.chance(0.15)) spec.set_type(v1::BODY_TYPE_STATIC);
+    if (h.chance(0.05)) spec.set_type(static_cast<v1::BodyType>(h.integer(2, 9)));
+    if (h.chance(0.7)) set(h.vector(-5, 5), spec.mutable_position());
+    if (h.chance(0.3)) set(h, spec.mutable_orientation());
+    if (h.chance(0.4)) set(h.vector(-10, 10), spec.mutable_linear_velocity());
+    if (h.chance(0.4)) set(h.vector(-10, 10), spec.mutable_angular_velocity());
+    if (h.chance(0.3)) spec.set_mass(h.number(0.1, 10));
+    if (h.chance(0.2)) spec.set_density(h.number(100, 5000));
+    if (h.chance(0.2)) spec.set_friction(h.number(0, 1));
+    if (h.chance(0.2)) spec.set_restitution(h.number(0, 1));
+    spec.set_color(static_cast<std::uint32_t>(h.rng().uniform() * 4294967295.0));
+    return spec;
+  }
+
+  // Sends one random request of kind `rpc`; `read_only` says it may not change the world.
+  grpc::Status send(Hostile& h, int rpc, bool* read_only) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    switch (rpc) {
+      case 0: {
+        v1::SpawnBodiesRequest request;
+        const int sizes[] = {0, 1, 1, 2, 3, 5, 40, 400};
+        for (int n = sizes[h.integer(0, 7)]; n > 0; --n)
+          *request.add_bodies() = body(h);
+        v1::SpawnBodiesResponse response;
+        return stub_->SpawnBodies(&context, request, &response);
+      }
+      case 1: {
+        v1::RemoveBodiesRequest request;
+        for (int n = h.chance(0.02) ? 5000 : h.integer(0, 3); n > 0; --n)
+          request.add_ids(id(h));
+        v1::RemoveBodiesResponse response;
+        return stub_->RemoveBodies(&context, request, &response);
+      }
+      case 2: {
+        v1::SetBodyStateRequest request;
+        for (int n = h.integer(0, 4); n > 0; --n) {
+          v1::BodyStateUpdate* u = request.add_updates();
+          u->set_id(id(h));
+          if (h.chance(0.5)) set(h.vector(-5, 5), u->mutable_position());
+          if (h.chance(0.3)) set(h, u->mutable_orientation());
+          if (h.chance(0.4)) set(h.vector(-10, 10), u->mutable_linear_velocity());
+          if (h.chance(0.4)) set(h.vector(-10, 10), u->mutable_angular_velocity());
+        }
+        v1::SetBodyStateResponse response;
+        return stub_->SetBodyState(&context, request, &response);
+      }
+      case 3: {
+        v1::ApplyImpulseRequest request;
+        for (int n = h.integer(0, 3); n > 0; --n) {
+          v1::Impulse* i = request.add_impulses();
+          i->set_id(id(h));
+          set(h.vector(-10, 10), i->mutable_impulse());
+          if (h.chance(0.5)) set(h.vector(-5, 5), i->mutable_point());
+        }
+        v1::ApplyImpulseResponse response;
+        return stub_->ApplyImpulse(&context, request, &response);
+      }
+      case 4: {
+        *read_only = true;
+        v1::GetBodiesRequest request;
+        for (int n = h.integer(0, 3); n > 0; --n)
+          request.add_ids(id(h));
+        v1::GetBodiesResponse response;
+        return stub_->GetBodies(&context, request, &response);
+      }
+      case 5: {
+        v1::LoadSceneRequest request;
+        if (h.chance(0.5)) {
+          const char* builtins[] = {"pile:6", "pyramid:3", "tower:4",          "pyramid:100000",
+                                    "pile:0", "pile:-3",   "pile:99999999999", "tower:x",
+                                    "",       "bogus",     "spin:3",           "default"};
+          request.set_builtin(builtins[h.integer(0, 11)]);
+        } else if (h.chance(0.9)) {
+          request.set_scene_json(h.mutate(std::string(default_scene_json())));
+        }
+        v1::LoadSceneResponse response;
+        return stub_->LoadScene(&context, request, &response);
+      }
+      case 6: {
+        v1::ControlRequest request;
+        v1::RunSettings* s = request.mutable_settings();
+        if (h.chance(0.2)) s->set_dt(h.number(1e-3, 0.05));
+        if (h.chance(0.1)) s->set_substeps(h.chance(0.8) ? h.integer(-2, 12) : 1000000);
+        if (h.chance(0.2)) s->set_solver(static_cast<v1::SolverKind>(h.integer(0, 6)));
+        if (h.chance(0.2)) set(h.vector(-20, 20), s->mutable_gravity());
+        if (h.chance(0.1)) s->set_real_time_factor(h.number(0, 2));
+        switch (h.integer(0, 3)) {
+          case 0:
+            request.set_step(static_cast<std::uint32_t>(h.integer(1, 3)));
+            break;
+          case 1:
+            request.set_pause(true);
+            break;
+          case 2:
+            request.set_reset(h.chance(0.3));
+            break;
+          default:
+            break;
+        }
+        v1::ControlResponse response;
+        return stub_->Control(&context, request, &response);
+      }
+      case 7: {
+        *read_only = true;
+        v1::SnapshotResponse response;
+        return stub_->Snapshot(&context, {}, &response);
+      }
+      case 8: {
+        v1::RestoreRequest request;
+        request.set_state(damaged_snapshot(h));
+        v1::RestoreResponse response;
+        return stub_->Restore(&context, request, &response);
+      }
+      default: {
+        *read_only = true;
+        v1::StreamFramesRequest request;
+        request.set_max_rate(h.number(0, 100));
+        request.set_velocities(h.chance(0.5));
+        request.set_contacts(h.chance(0.5));
+        request.set_stats(h.chance(0.5));
+        for (int n = h.integer(0, 2); n > 0; --n)
+          request.add_ids(id(h));
+        context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(15));
+        auto reader = stub_->StreamFrames(&context, request);
+        v1::Frame frame;
+        while (reader->Read(&frame)) {
+        }
+        const grpc::Status status = reader->Finish();
+        // A stream cut by its deadline is how this client ends it, not a refusal.
+        return status.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED ? grpc::Status::OK
+                                                                          : status;
+      }
+    }
+  }
+
+  // This server's snapshot, damaged: bytes mutated, or a field set to a hostile value.
+  std::string damaged_snapshot(Hostile& h) {
+    const std::string good = snapshot();
+    if (h.chance(0.1)) return good;  // an undamaged one restores
+    if (h.chance(0.5)) return h.mutate(good);
+    v1::snapshot::WorldSnapshot s;
+    s.ParseFromString(good);
+    if (s.slots_size() == 0) return good;
+    v1::snapshot::Body* b = s.mutable_slots(h.integer(0, s.slots_size() - 1));
+    switch (h.integer(0, 9)) {
+      case 0:
+        b->set_mass(h.special());
+        break;
+      case 1:
+        b->set_inverse_mass(h.special());
+        break;
+      case 2:
+        if (b->position_size() == 3) b->set_position(h.integer(0, 2), h.special());
+        break;
+      case 3:
+        if (b->angular_velocity_size() == 3) b->set_angular_velocity(h.integer(0, 2), h.special());
+        break;
+      case 4:
+        if (b->inverse_inertia_body_size() == 9)
+          b->set_inverse_inertia_body(h.integer(0, 8), h.special());
+        break;
+      case 5:
+        b->set_sleep_island(static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
+        break;
+      case 6:
+        s.add_free_slots(static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
+        break;
+      case 7:
+        b->set_id(s.slots(0).id());  // two slots with one id
+        break;
+      case 8:
+        s.set_next_id(UINT64_MAX);
+        break;
+      default:
+        s.set_dt(h.special());
+    }
+    return s.SerializeAsString();
+  }
+
+  WorldHost host_;
+  WorldService service_;
+  std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<v1::World::Stub> stub_;
+  std::vector<std::uint64_t> known_;
+};
+
+TEST(FuzzService, EveryRpcSurvivesHostileRequestsAndRefusalsChangeNothing) {
+  FuzzService fuzz;
+  const FuzzTally tally = fuzz.run(20261123, 2500);
+  std::printf(
+      "fuzz service: %llu requests, %llu accepted, %llu refused, %llu half-applied, %llu "
+      "poisoned the world\n",
+      static_cast<unsigned long long>(tally.tried), static_cast<unsigned long long>(tally.accepted),
+      static_cast<unsigned long long>(tally.refused),
+      static_cast<unsigned long long>(tally.half_applied),
+      static_cast<unsigned long long>(tally.poisoned));
+  EXPECT_EQ(tally.tried, 2500u);
+  EXPECT_EQ(tally.half_applied, 0u);
+  EXPECT_EQ(tally.poisoned, 0u);
+  // Both kinds must be common, or the suite tests little.
+  EXPECT_GT(tally.accepted, 500u);
+  EXPECT_GT(tally.refused, 500u);
+}
+
+}  // namespace
+}  // namespace tumble::server
