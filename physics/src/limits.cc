@@ -85,9 +85,9 @@ Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,
                     const WorldLimits& limits) {
   if (!is_finite(linear_velocity)) return Status::error("linear_velocity: must be finite");
   if (!is_finite(angular_velocity)) return Status::error("angular_velocity: must be finite");
-  if (const double v = linear_velocity.norm(); v > limits.max_linear_speed)
+  if (const double v = linear_velocity.stableNorm(); v > limits.max_linear_speed)
     return above("linear_velocity", v, "m/s", "max_linear_speed", limits.max_linear_speed);
-  if (const double w = angular_velocity.norm(); w > limits.max_angular_speed)
+  if (const double w = angular_velocity.stableNorm(); w > limits.max_angular_speed)
     return above("angular_velocity", w, "rad/s", "max_angular_speed", limits.max_angular_speed);
   return Status::ok();
 }
