@@ -19,6 +19,9 @@
 #include "scenes/scene.h"
 #include "scenes/standard.h"
 #include "service.h"
+#ifdef TUMBLE_WITH_DDS
+#include "dds_publisher.h"
+#endif
 
 namespace {
 
@@ -67,6 +70,9 @@ int main(int argc, char** argv) {
   std::string token, tls_cert, tls_key;
   int max_message_mb = 256;
   std::vector<std::string> limit_options;
+  bool dds = false;
+  std::uint32_t dds_domain = 0;
+  double dds_rate = 0;
   app.add_option("--listen", listen, "address to listen on (loopback by default)")
       ->envname("TUMBLE_LISTEN");
   app.add_option("--scene", scene_file, "a scene file (JSON, docs/SCENES.md)")
@@ -100,6 +106,14 @@ int main(int argc, char** argv) {
                  "snapshot loaded; repeatable, e.g. --limit max_size=100 --limit max_mass=1e6")
       ->envname("TUMBLE_LIMITS")
       ->delimiter(',');
+  app.add_flag("--dds", dds, "publish states on DDS (topics in proto/dds/tumble_states.idl)")
+      ->envname("TUMBLE_DDS");
+  app.add_option("--dds-domain", dds_domain, "the DDS domain to publish on")
+      ->envname("TUMBLE_DDS_DOMAIN")
+      ->check(CLI::Range(0, 232));
+  app.add_option("--dds-rate", dds_rate, "DDS samples per second at most (0: every step)")
+      ->envname("TUMBLE_DDS_RATE")
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   if (tls_cert.empty() != tls_key.empty()) {
     std::fprintf(stderr, "tumble-server: --tls-cert and --tls-key go together\n");
@@ -152,6 +166,24 @@ int main(int argc, char** argv) {
   }
 
   server::WorldHost host(std::move(world).value(), scene.value().dt, real_time_factor);
+#ifdef TUMBLE_WITH_DDS
+  std::unique_ptr<server::DdsPublisher> dds_publisher;
+  if (dds) {
+    auto started = server::DdsPublisher::start(host, {.domain = dds_domain, .rate = dds_rate});
+    if (!started) {
+      std::fprintf(stderr, "tumble-server: --dds: %s\n", started.error().c_str());
+      return 1;
+    }
+    dds_publisher = std::move(started).value();
+  }
+#else
+  if (dds) {
+    std::fprintf(stderr,
+                 "tumble-server: --dds: this build has no DDS (install Cyclone DDS: "
+                 "scripts/install-deps dds, and rebuild)\n");
+    return 2;
+  }
+#endif
   server::WorldService service(
       host, {.max_bodies = max_bodies, .token = token, .world = scene.value().world.limits},
       scene.value());
@@ -172,6 +204,7 @@ int main(int argc, char** argv) {
   std::printf("tumble-server: scene %s, %zu bodies, listening on %s%s\n",
               scene.value().name.c_str(), host.status().bodies, bound.c_str(),
               tls_cert.empty() ? "" : " (TLS)");
+  if (dds) std::printf("tumble-server: publishing on DDS domain %u\n", dds_domain);
   std::fflush(stdout);
   if (!paused) host.play();
 

@@ -1,0 +1,210 @@
+// tumble-dds-echo: reads what tumble-server --dds publishes and prints it as JSON lines, one
+// sample a line, so other programs (and tests) can read Tumble's states without gRPC. It is also
+// the smallest example of a DDS program reading them: Cyclone DDS's C API and the types that
+// idlc generates from proto/dds/tumble_states.idl, nothing of Tumble's.
+#include <dds/dds.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tumble_states.h"
+
+namespace {
+
+using Json = nlohmann::json;
+
+Json stamp(const std_msgs_msg_dds__Header_& header) {
+  return header.stamp.sec + header.stamp.nanosec * 1e-9;
+}
+
+template <class Sequence>
+Json numbers(const Sequence& s) {
+  Json out = Json::array();
+  for (std::uint32_t i = 0; i < s._length; ++i)
+    out.push_back(s._buffer[i]);
+  return out;
+}
+
+template <class Sequence>
+Json points(const Sequence& s) {
+  Json out = Json::array();
+  for (std::uint32_t i = 0; i < s._length; ++i)
+    out.push_back({s._buffer[i].x, s._buffer[i].y, s._buffer[i].z});
+  return out;
+}
+
+Json poses_json(const geometry_msgs_msg_dds__PoseArray_& m) {
+  Json poses = Json::array();
+  for (std::uint32_t i = 0; i < m.poses._length; ++i) {
+    const auto& p = m.poses._buffer[i];
+    poses.push_back({{"p", {p.position.x, p.position.y, p.position.z}},
+                     {"q", {p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z}}});
+  }
+  return {{"topic", "poses"}, {"time", stamp(m.header)}, {"poses", poses}};
+}
+
+Json ids_json(const tumble_msg_dds__BodyIds_& m) {
+  return {
+      {"topic", "pose_ids"}, {"step", m.step}, {"time", stamp(m.header)}, {"ids", numbers(m.ids)}};
+}
+
+Json contacts_json(const tumble_msg_dds__Contacts_& m) {
+  return {{"topic", "contacts"},
+          {"step", m.step},
+          {"time", stamp(m.header)},
+          {"body_a", numbers(m.body_a)},
+          {"body_b", numbers(m.body_b)},
+          {"points", points(m.points)},
+          {"normals", points(m.normals)},
+          {"depths", numbers(m.depths)},
+          {"impulses", numbers(m.impulses)}};
+}
+
+Json stats_json(const tumble_msg_dds__StepStats_& m) {
+  return {{"topic", "stats"},
+          {"step", m.step},
+          {"time", stamp(m.header)},
+          {"bodies", m.bodies},
+          {"pairs", m.pairs},
+          {"contact_points", m.contact_points},
+          {"islands", m.islands},
+          {"sleeping_bodies", m.sleeping_bodies},
+          {"max_penetration", m.max_penetration},
+          {"step_seconds", m.step_seconds}};
+}
+
+Json body_json(const tumble_msg_dds__Body_& m) {
+  const char* shapes[] = {"sphere", "capsule", "box", "hull", "plane"};
+  Json out = {{"topic", "bodies"},
+              {"id", m.id},
+              {"shape", m.shape < 5 ? shapes[m.shape] : "unknown"},
+              {"static", m.is_static},
+              {"mass", m.mass},
+              {"color", m.color}};
+  if (m.shape == 0 || m.shape == 1) out["radius"] = m.radius;
+  if (m.shape == 1) out["half_height"] = m.half_height;
+  if (m.shape == 2) out["half_extents"] = {m.half_extents[0], m.half_extents[1], m.half_extents[2]};
+  if (m.shape == 3) out["hull_vertices"] = points(m.hull_vertices);
+  return out;
+}
+
+struct Subscription {
+  std::string name;
+  dds_entity_t reader = 0;
+  Json (*to_json)(const void* sample);
+};
+
+template <class T, Json (*Convert)(const T&)>
+Json convert(const void* sample) {
+  return Convert(*static_cast<const T*>(sample));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Prints what tumble-server --dds publishes, as JSON lines."};
+  std::uint32_t domain = 0;
+  std::vector<std::string> topics = {"poses", "pose_ids", "contacts", "stats", "bodies"};
+  long count = 0;
+  double timeout = 0;
+  app.add_option("--domain", domain, "the DDS domain")->envname("TUMBLE_DDS_DOMAIN");
+  app.add_option("--topics", topics, "which of poses, pose_ids, contacts, stats, bodies")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"poses", "pose_ids", "contacts", "stats", "bodies"}));
+  app.add_option("--count", count, "stop after this many samples (0: never)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--timeout", timeout,
+                 "stop after this many seconds (0: never); exit 1 if --count was not reached")
+      ->check(CLI::NonNegativeNumber);
+  CLI11_PARSE(app, argc, argv);
+
+  const dds_entity_t participant = dds_create_participant(domain, nullptr, nullptr);
+  if (participant < 0) {
+    std::fprintf(stderr, "tumble-dds-echo: cannot join domain %u: %s\n", domain,
+                 dds_strretcode(participant));
+    return 1;
+  }
+  dds_qos_t* states = dds_create_qos();
+  dds_qset_reliability(states, DDS_RELIABILITY_BEST_EFFORT, 0);
+  dds_qset_history(states, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qos_t* catalogue = dds_create_qos();
+  dds_qset_reliability(catalogue, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_durability(catalogue, DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(catalogue, DDS_HISTORY_KEEP_LAST, 1);
+
+  const std::set<std::string> wanted(topics.begin(), topics.end());
+  const dds_entity_t waitset = dds_create_waitset(participant);
+  std::vector<Subscription> subscriptions;
+  auto subscribe = [&](const char* name, const char* topic_name, const dds_topic_descriptor_t* type,
+                       const dds_qos_t* qos, Json (*to_json)(const void*)) {
+    if (!wanted.contains(name)) return true;
+    const dds_entity_t topic = dds_create_topic(participant, type, topic_name, qos, nullptr);
+    const dds_entity_t reader =
+        topic < 0 ? topic : dds_create_reader(participant, topic, qos, nullptr);
+    if (reader < 0) {
+      std::fprintf(stderr, "tumble-dds-echo: %s: %s\n", topic_name, dds_strretcode(reader));
+      return false;
+    }
+    dds_set_status_mask(reader, DDS_DATA_AVAILABLE_STATUS);
+    dds_waitset_attach(waitset, reader, static_cast<dds_attach_t>(subscriptions.size()));
+    subscriptions.push_back({name, reader, to_json});
+    return true;
+  };
+  using geometry_msgs_msg_dds__PoseArray = geometry_msgs_msg_dds__PoseArray_;
+  const bool ok = subscribe("poses", "rt/tumble/poses", &geometry_msgs_msg_dds__PoseArray__desc,
+                            states, convert<geometry_msgs_msg_dds__PoseArray, poses_json>) &&
+                  subscribe("pose_ids", "rt/tumble/pose_ids", &tumble_msg_dds__BodyIds__desc,
+                            states, convert<tumble_msg_dds__BodyIds_, ids_json>) &&
+                  subscribe("contacts", "rt/tumble/contacts", &tumble_msg_dds__Contacts__desc,
+                            states, convert<tumble_msg_dds__Contacts_, contacts_json>) &&
+                  subscribe("stats", "rt/tumble/stats", &tumble_msg_dds__StepStats__desc, states,
+                            convert<tumble_msg_dds__StepStats_, stats_json>) &&
+                  subscribe("bodies", "rt/tumble/bodies", &tumble_msg_dds__Body__desc, catalogue,
+                            convert<tumble_msg_dds__Body_, body_json>);
+  dds_delete_qos(states);
+  dds_delete_qos(catalogue);
+  if (!ok) {
+    dds_delete(participant);
+    return 1;
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  long printed = 0;
+  while (count == 0 || printed < count) {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (timeout > 0 && elapsed >= timeout) break;
+    const dds_duration_t wait = timeout > 0 ? DDS_SECS(1) * (timeout - elapsed) : DDS_INFINITY;
+    dds_attach_t triggered[8];
+    const dds_return_t n = dds_waitset_wait(waitset, triggered, 8, wait);
+    for (dds_return_t t = 0; t < n; ++t) {
+      const Subscription& s = subscriptions[static_cast<std::size_t>(triggered[t])];
+      void* samples[16] = {};
+      dds_sample_info_t infos[16];
+      const dds_return_t taken = dds_take(s.reader, samples, infos, 16, 16);
+      for (dds_return_t i = 0; i < taken && (count == 0 || printed < count); ++i) {
+        Json line;
+        if (infos[i].valid_data) {
+          line = s.to_json(samples[i]);
+        } else if (infos[i].instance_state != DDS_IST_ALIVE && s.name == "bodies") {
+          tumble_msg_dds__Body_ key{};
+          dds_instance_get_key(s.reader, infos[i].instance_handle, &key);
+          line = {{"topic", "bodies"}, {"id", key.id}, {"removed", true}};
+        } else {
+          continue;
+        }
+        std::printf("%s\n", line.dump().c_str());
+        ++printed;
+      }
+      std::fflush(stdout);
+      if (taken > 0) dds_return_loan(s.reader, samples, taken);
+    }
+  }
+  dds_delete(participant);
+  return count > 0 && printed < count ? 1 : 0;
+}

@@ -1,0 +1,192 @@
+// The server's DDS publishing, on loopback only: what tumble-dds-echo receives for a step equals
+// the gRPC frame of the same step, bit for bit, and a subscriber that joins late still learns
+// every live body (the catalogue is transient local) and none of the removed ones.
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "process_support.h"
+#include "tumble/v1/world.grpc.pb.h"
+
+namespace tumble::testing {
+namespace {
+
+using Json = nlohmann::json;
+using namespace std::chrono_literals;
+
+// Cyclone DDS on the loopback interface only, unicast discovery to 127.0.0.1.
+constexpr char kLoopback[] =
+    "<CycloneDDS><Domain><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
+    "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto"
+    "</ParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain>"
+    "</CycloneDDS>";
+
+// A domain of this process's own, so that suites running side by side do not hear each other.
+std::string own_domain() {
+  return std::to_string(1 + getpid() % 200);
+}
+
+// Runs tumble-dds-echo with `args` in the background and collects its lines.
+class Echo {
+ public:
+  explicit Echo(const std::string& args) {
+    pipe_ = popen(
+        (std::string(TUMBLE_DDS_ECHO_BINARY) + " --domain " + own_domain() + " " + args).c_str(),
+        "r");
+    reader_ = std::thread([this] {
+      char line[1 << 16];
+      std::string partial;
+      while (pipe_ != nullptr && fgets(line, sizeof line, pipe_) != nullptr) {
+        partial += line;
+        if (partial.empty() || partial.back() != '\n') continue;
+        std::lock_guard lock(mutex_);
+        lines_.push_back(Json::parse(partial));
+        partial.clear();
+      }
+    });
+  }
+  // Waits for the echo to exit and returns what it printed.
+  std::vector<Json> finish() {
+    reader_.join();
+    if (pipe_ != nullptr) pclose(pipe_);
+    pipe_ = nullptr;
+    std::lock_guard lock(mutex_);
+    return lines_;
+  }
+  ~Echo() {
+    if (reader_.joinable()) finish();
+  }
+
+ private:
+  FILE* pipe_ = nullptr;
+  std::thread reader_;
+  std::mutex mutex_;
+  std::vector<Json> lines_;
+};
+
+class DdsTest : public ::testing::Test {
+ protected:
+  void SetUp() override { setenv("CYCLONEDDS_URI", kLoopback, 1); }
+  std::unique_ptr<v1::World::Stub> connect(const Server& server) {
+    return v1::World::NewStub(
+        grpc::CreateChannel(server.address, grpc::InsecureChannelCredentials()));
+  }
+};
+
+TEST_F(DdsTest, PosesEqualTheGrpcFrameOfTheSameStep) {
+  Server server;
+  server.start({"--paused", "--dds", "--dds-domain", own_domain()});
+  auto stub = connect(server);
+
+  // The gRPC frames of every step, as a subscriber receives them.
+  std::mutex mutex;
+  std::map<std::uint64_t, v1::Frame> frames;
+  grpc::ClientContext stream_context;
+  auto reader = stub->StreamFrames(&stream_context, {});
+  std::thread streaming([&] {
+    v1::Frame frame;
+    while (reader->Read(&frame)) {
+      std::lock_guard lock(mutex);
+      frames[frame.step()] = frame;
+    }
+  });
+
+  Echo echo("--topics poses,pose_ids --timeout 6");
+  std::this_thread::sleep_for(1500ms);  // discovery
+  for (int k = 0; k < 30; ++k) {        // one step at a time, each left time to arrive
+    grpc::ClientContext context;
+    v1::ControlRequest step;
+    step.set_step(1);
+    v1::ControlResponse response;
+    ASSERT_TRUE(stub->Control(&context, step, &response).ok());
+    std::this_thread::sleep_for(100ms);
+  }
+  const std::vector<Json> lines = echo.finish();
+  stream_context.TryCancel();
+  streaming.join();
+
+  // Pair each step's ids with its poses (the same stamp), then compare with the gRPC frame.
+  std::map<double, Json> ids_at;
+  for (const Json& line : lines)
+    if (line["topic"] == "pose_ids") ids_at[line["time"].get<double>()] = line;
+  int compared = 0;
+  for (const Json& line : lines) {
+    if (line["topic"] != "poses" || !ids_at.contains(line["time"].get<double>())) continue;
+    const Json& ids = ids_at[line["time"].get<double>()];
+    const std::uint64_t step = ids["step"];
+    std::lock_guard lock(mutex);
+    if (step == 0 || !frames.contains(step)) continue;
+    const v1::Frame& frame = frames[step];
+    ASSERT_EQ(ids["ids"].size(), static_cast<std::size_t>(frame.ids_size()));
+    ASSERT_EQ(line["poses"].size(), static_cast<std::size_t>(frame.ids_size()));
+    for (int i = 0; i < frame.ids_size(); ++i) {
+      EXPECT_EQ(ids["ids"][i].get<std::uint64_t>(), frame.ids(i));
+      const Json& pose = line["poses"][i];
+      for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(pose["p"][k].get<double>(), frame.positions(3 * i + k)) << "step " << step;
+      for (int k = 0; k < 4; ++k)
+        EXPECT_EQ(pose["q"][k].get<double>(), frame.orientations(4 * i + k)) << "step " << step;
+    }
+    ++compared;
+  }
+  // Best effort on loopback loses little; most steps must have come through whole.
+  EXPECT_GE(compared, 20) << lines.size() << " lines received";
+}
+
+TEST_F(DdsTest, ALateSubscriberLearnsEveryLiveBodyAndNoRemovedOne) {
+  Server server;
+  server.start({"--dds", "--dds-domain", own_domain(), "--standard", "pyramid:3"});
+  auto stub = connect(server);
+  v1::SpawnBodiesRequest spawn;
+  for (int i = 0; i < 3; ++i) {
+    v1::BodySpec* ball = spawn.add_bodies();
+    ball->mutable_shape()->mutable_sphere()->set_radius(0.3);
+    ball->mutable_position()->set_z(5 + i);
+  }
+  v1::SpawnBodiesResponse spawned;
+  {
+    grpc::ClientContext context;
+    ASSERT_TRUE(stub->SpawnBodies(&context, spawn, &spawned).ok());
+  }
+  {
+    grpc::ClientContext context;
+    v1::RemoveBodiesRequest remove;
+    remove.add_ids(spawned.ids(1));
+    v1::RemoveBodiesResponse removed;
+    ASSERT_TRUE(stub->RemoveBodies(&context, remove, &removed).ok());
+  }
+  std::this_thread::sleep_for(500ms);  // the world has stepped on since
+
+  std::set<std::uint64_t> live;
+  {
+    grpc::ClientContext context;
+    v1::GetBodiesResponse bodies;
+    ASSERT_TRUE(stub->GetBodies(&context, {}, &bodies).ok());
+    for (const auto& state : bodies.states())
+      live.insert(state.id());
+  }
+  ASSERT_EQ(live.size(), 6u + 1 + 2);  // the pyramid, its ground, two of the three balls
+
+  Echo echo("--topics bodies --timeout 4");
+  const std::vector<Json> lines = echo.finish();
+  std::set<std::uint64_t> described;
+  for (const Json& line : lines)
+    if (!line.contains("removed")) {
+      described.insert(line["id"].get<std::uint64_t>());
+      if (line["id"] == spawned.ids(0)) {
+        EXPECT_EQ(line["shape"], "sphere");
+        EXPECT_EQ(line["radius"], 0.3);
+      }
+    }
+  EXPECT_EQ(described, live);
+  EXPECT_FALSE(described.contains(spawned.ids(1)));
+}
+
+}  // namespace
+}  // namespace tumble::testing
