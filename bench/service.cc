@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "drifting_spheres.h"
 #include "scenes/scene.h"
 #include "service.h"
 
@@ -23,31 +24,8 @@ namespace {
 
 using namespace tumble;
 using Clock = std::chrono::steady_clock;
-
-// 1000 spheres drifting apart without gravity: cheap steps, so the table shows the service's
-// cost, not the solver's; frames are the full 1000 poses (64 kB).
-SceneDef drifting_spheres(int threads) {
-  SceneDef scene;
-  scene.world.threads = threads;
-  scene.name = "drift-1000";
-  scene.dt = 0.001;
-  scene.world.gravity = Vec3::Zero();
-  scene.world.solver.sleeping = false;
-  for (int i = 0; i < 1000; ++i) {
-    BodyDef ball;
-    ball.shape = SphereDef{0.2};
-    ball.position = Vec3(i % 10, (i / 10) % 10, i / 100);
-    ball.linear_velocity = Vec3(0.01 * (i % 3), 0.01 * (i % 5), 0.01);
-    scene.bodies.push_back(ball);
-  }
-  return scene;
-}
-
-std::uint64_t unix_ns() {
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                        std::chrono::system_clock::now().time_since_epoch())
-                                        .count());
-}
+using bench::drifting_spheres;
+using bench::unix_ns;
 
 struct Row {
   double step_rate = 0;       // steps per second of wall time

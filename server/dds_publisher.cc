@@ -154,7 +154,7 @@ void DdsPublisher::publish(const FrameData& frame) {
   const auto header = header_at(frame.time);
 
   PoseArray poses{header, view<dds_sequence_geometry_msgs_msg_dds__Pose_>(w.pose_buffer)};
-  PoseIds ids{header, frame.step, view<dds_sequence_uint64>(w.id_buffer)};
+  PoseIds ids{header, frame.step, frame.stepped_at_unix_ns, view<dds_sequence_uint64>(w.id_buffer)};
   // The ids first: a subscriber that has a step's poses can then find their ids.
   dds_write(w.ids, &ids);
   dds_write(w.poses, &poses);

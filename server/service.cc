@@ -12,8 +12,31 @@
 namespace tumble::server {
 namespace {
 
+// The one mapping from the engine's and the host's failures to gRPC's codes.
+grpc::Status to_grpc(const Status& status) {
+  switch (status.code()) {
+    case StatusCode::kOk:
+      return grpc::Status::OK;
+    case StatusCode::kInvalidArgument:
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, status.message());
+    case StatusCode::kNotFound:
+      return grpc::Status(grpc::StatusCode::NOT_FOUND, status.message());
+    case StatusCode::kResourceExhausted:
+      return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, status.message());
+    case StatusCode::kUnavailable:
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE, status.message());
+    case StatusCode::kInternal:
+      break;
+  }
+  return grpc::Status(grpc::StatusCode::INTERNAL, status.message());
+}
+
 grpc::Status invalid(const std::string& message) {
-  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message);
+  return to_grpc(Status::error(message));
+}
+
+grpc::Status too_many(const std::string& message) {
+  return to_grpc(Status::error(message, StatusCode::kResourceExhausted));
 }
 
 // The bodies named by `wire_ids`, or the first unknown one's position in the list.
@@ -23,8 +46,8 @@ Status find_bodies(const HostedWorld& hosted,
   for (int i = 0; i < wire_ids.size(); ++i) {
     const BodyId id = hosted.ids.find(wire_ids[i]);
     if (!hosted.world.contains(id))
-      return Status::error("ids[" + std::to_string(i) + "]: no body " +
-                           std::to_string(wire_ids[i]));
+      return Status::not_found("ids[" + std::to_string(i) + "]: no body " +
+                               std::to_string(wire_ids[i]));
     ids->push_back(id);
   }
   return Status::ok();
@@ -63,10 +86,8 @@ grpc::Status WorldService::replace_world(SceneDef scene, std::vector<std::uint64
   if (scene.dt > limits_.world.max_time_step)
     return invalid("scene: dt " + std::to_string(scene.dt) + " s is above limits.max_time_step");
   if (scene.bodies.size() > limits_.max_bodies)
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        "scene: " + std::to_string(scene.bodies.size()) +
-                            " bodies, more than the " + std::to_string(limits_.max_bodies) +
-                            " allowed");
+    return too_many("scene: " + std::to_string(scene.bodies.size()) + " bodies, more than the " +
+                    std::to_string(limits_.max_bodies) + " allowed");
   // Built before the world is touched: a scene that cannot be made changes nothing.
   Result<World> made = make_world(scene);
   if (!made) return invalid("scene: " + made.error());
@@ -81,8 +102,7 @@ grpc::Status WorldService::replace_world(SceneDef scene, std::vector<std::uint64
         ids->push_back(hosted.ids.wire(id));
     return Status::ok();
   });
-  if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
-  return grpc::Status::OK;
+  return to_grpc(replaced);
 }
 
 grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
@@ -96,15 +116,13 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
     if (!def) return invalid("bodies[" + std::to_string(i) + "]." + def.error());
     defs.push_back(std::move(def).value());
   }
-  bool too_many = false;
   std::vector<std::uint64_t> ids;
   const Status applied = host_.apply([&](HostedWorld& hosted) {
     World& world = hosted.world;
-    if (world.body_count() + defs.size() > limits_.max_bodies) {
-      too_many = true;
+    if (world.body_count() + defs.size() > limits_.max_bodies)
       return Status::error("bodies: " + std::to_string(defs.size()) + " more would exceed the " +
-                           std::to_string(limits_.max_bodies) + " bodies allowed");
-    }
+                               std::to_string(limits_.max_bodies) + " bodies allowed",
+                           StatusCode::kResourceExhausted);
     Result<std::vector<BodyId>> made = world.create_bodies(defs);
     if (!made) return made.status();
     hosted.ids.sync(world);
@@ -114,10 +132,7 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
     }
     return Status::ok();
   });
-  if (!applied)
-    return grpc::Status(
-        too_many ? grpc::StatusCode::RESOURCE_EXHAUSTED : grpc::StatusCode::INVALID_ARGUMENT,
-        applied.message());
+  if (!applied) return to_grpc(applied);
   for (std::uint64_t id : ids)
     response->add_ids(id);
   return grpc::Status::OK;
@@ -131,23 +146,14 @@ grpc::Status WorldService::RemoveBodies(grpc::ServerContext* context,
   for (int i = 0; i < request->ids_size(); ++i)
     if (!seen.insert(request->ids(i)).second)
       return invalid("ids[" + std::to_string(i) + "]: listed twice");
-  bool missing = false;
-  const Status applied = host_.apply([&](HostedWorld& hosted) {
-    World& world = hosted.world;
+  return to_grpc(host_.apply([&](HostedWorld& hosted) {
     // Every id is checked before anything is removed: all or nothing.
     std::vector<BodyId> ids;
-    if (Status found = find_bodies(hosted, request->ids(), &ids); !found) {
-      missing = true;
-      return found;
-    }
+    if (Status found = find_bodies(hosted, request->ids(), &ids); !found) return found;
     for (BodyId id : ids)
-      world.remove_body(id);
+      hosted.world.remove_body(id);
     return Status::ok();
-  });
-  if (!applied)
-    return grpc::Status(missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INVALID_ARGUMENT,
-                        applied.message());
-  return grpc::Status::OK;
+  }));
 }
 
 grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
@@ -187,8 +193,7 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
       state->set_asleep(body.asleep);
     }
   });
-  if (!read) return grpc::Status(grpc::StatusCode::NOT_FOUND, read.message());
-  return grpc::Status::OK;
+  return to_grpc(read);
 }
 
 namespace {
@@ -203,18 +208,15 @@ Vec3 vec(const v1::Vec3& v) {
 template <class Entries, class Check, class Apply>
 grpc::Status apply_batch(WorldHost& host, const char* name, const Entries& entries, Check check,
                          Apply apply) {
-  bool missing = false;
-  const Status applied = host.apply([&](HostedWorld& hosted) {
+  return to_grpc(host.apply([&](HostedWorld& hosted) {
     World& world = hosted.world;
     std::vector<BodyId> ids;
     ids.reserve(entries.size());
     for (int i = 0; i < entries.size(); ++i) {
       const BodyId id = hosted.ids.find(entries[i].id());
-      if (!world.contains(id)) {
-        missing = true;
-        return Status::error(std::string(name) + "[" + std::to_string(i) + "].id: no body " +
-                             std::to_string(entries[i].id()));
-      }
+      if (!world.contains(id))
+        return Status::not_found(std::string(name) + "[" + std::to_string(i) + "].id: no body " +
+                                 std::to_string(entries[i].id()));
       if (Status s = check(world, id, entries[i]); !s)
         return s.within(std::string(name) + "[" + std::to_string(i) + "].");
       ids.push_back(id);
@@ -222,11 +224,7 @@ grpc::Status apply_batch(WorldHost& host, const char* name, const Entries& entri
     for (int i = 0; i < entries.size(); ++i)
       apply(world, ids[i], entries[i]);
     return Status::ok();
-  });
-  if (!applied)
-    return grpc::Status(missing ? grpc::StatusCode::NOT_FOUND : grpc::StatusCode::INVALID_ARGUMENT,
-                        applied.message());
-  return grpc::Status::OK;
+  }));
 }
 
 BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
@@ -441,9 +439,8 @@ grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::Resto
   for (const BodySlotState& slot : s.state.slots)
     live += slot.alive ? 1 : 0;
   if (live > limits_.max_bodies)
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        "state: " + std::to_string(live) + " bodies, more than the " +
-                            std::to_string(limits_.max_bodies) + " allowed");
+    return too_many("state: " + std::to_string(live) + " bodies, more than the " +
+                    std::to_string(limits_.max_bodies) + " allowed");
   const std::uint64_t step = s.state.step;
   s.settings.limits = limits_.world;
   if (!(s.dt > 0) || s.dt > limits_.world.max_time_step)
@@ -468,7 +465,7 @@ grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::Resto
         (*response->mutable_new_ids())[s.ids[slot]] = hosted.ids.wire(id);
     return Status::ok();
   });
-  if (!replaced) return grpc::Status(grpc::StatusCode::INTERNAL, replaced.message());
+  if (!replaced) return to_grpc(replaced);
   response->set_step(step);
   return grpc::Status::OK;
 }

@@ -30,7 +30,7 @@ WorldHost::~WorldHost() {
   wake_.notify_all();
   thread_.join();
   for (Command& command : commands_)
-    command.done.set_value(Status::error("server: shutting down"));
+    command.done.set_value(Status::error("server: shutting down", StatusCode::kUnavailable));
   for (const auto& mailbox : subscribers_)
     mailbox->close();
 }
@@ -39,7 +39,7 @@ Status WorldHost::submit(Command command) {
   std::future<Status> done;
   {
     std::lock_guard lock(mutex_);
-    if (stopping_) return Status::error("server: shutting down");
+    if (stopping_) return Status::error("server: shutting down", StatusCode::kUnavailable);
     commands_.push_back(std::move(command));
     done = commands_.back().done.get_future();
   }

@@ -120,7 +120,7 @@ Result<BodyId> World::create_body(const BodyDef& def) {
   if (!ids) {
     // A single definition needs no "bodies[0]." prefix.
     const std::string& message = ids.error();
-    return Status::error(message.substr(message.find('.') + 1));
+    return Status::error(message.substr(message.find('.') + 1), ids.status().code());
   }
   return ids.value()[0];
 }
@@ -156,7 +156,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
 }
 
 Status World::remove_body(BodyId id) {
-  if (!contains(id)) return Status::error("body: no body with this id");
+  if (!contains(id)) return Status::not_found("body: no body with this id");
   Slot& slot = bodies_[id.index];
   wake_around(slot.body);  // whatever rested on it must fall
   slot.alive = false;
@@ -179,7 +179,7 @@ void World::wake_around(const Body& body) {
 }
 
 Status World::check_motion(BodyId id, const BodyMotion& motion) const {
-  if (!contains(id)) return Status::error("body: no body with this id");
+  if (!contains(id)) return Status::not_found("body: no body with this id");
   const Body& body = bodies_[id.index].body;
   if (motion.position && !is_finite(*motion.position))
     return Status::error("position: must be finite");
@@ -228,7 +228,7 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
 }
 
 Status World::check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) const {
-  if (!contains(id)) return Status::error("body: no body with this id");
+  if (!contains(id)) return Status::not_found("body: no body with this id");
   if (bodies_[id.index].body.is_static()) return Status::error("body: a static body does not move");
   if (!is_finite(impulse)) return Status::error("impulse: must be finite");
   if (point != nullptr && !is_finite(*point)) return Status::error("point: must be finite");
@@ -261,7 +261,7 @@ std::uint32_t World::wake_island(std::uint32_t island) {
 }
 
 Status World::wake(BodyId id) {
-  if (!contains(id)) return Status::error("body: no body with this id");
+  if (!contains(id)) return Status::not_found("body: no body with this id");
   const Body& body = bodies_[id.index].body;
   if (body.asleep) wake_island(body.sleep_island);
   return Status::ok();

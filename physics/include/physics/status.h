@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cassert>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -11,24 +12,43 @@
 
 namespace tumble {
 
+// What kind of failure, so that a caller (the server's one mapping to gRPC codes) can answer
+// without reading the message.
+enum class StatusCode : std::uint8_t {
+  kOk,
+  kInvalidArgument,    // a value is wrong: the message names the field
+  kNotFound,           // an id that names nothing
+  kResourceExhausted,  // more than a configured capacity allows
+  kUnavailable,        // shutting down
+  kInternal,           // a broken invariant: a bug of ours
+};
+
 class Status {
  public:
   static Status ok() { return Status(); }
-  static Status error(std::string message) { return Status(std::move(message)); }
+  static Status error(std::string message, StatusCode code = StatusCode::kInvalidArgument) {
+    return Status(std::move(message), code);
+  }
+  static Status not_found(std::string message) {
+    return Status(std::move(message), StatusCode::kNotFound);
+  }
 
-  bool is_ok() const { return !failed_; }
+  bool is_ok() const { return code_ == StatusCode::kOk; }
   explicit operator bool() const { return is_ok(); }
+  StatusCode code() const { return code_; }
   const std::string& message() const { return message_; }
 
   // Prefixes the message with the path of the field that failed, e.g. "bodies[3]." + "size".
   Status within(const std::string& prefix) const {
-    return is_ok() ? *this : Status(prefix + message_);
+    return is_ok() ? *this : Status(prefix + message_, code_);
   }
 
  private:
   Status() = default;
-  explicit Status(std::string message) : failed_(true), message_(std::move(message)) {}
-  bool failed_ = false;
+  Status(std::string message, StatusCode code) : code_(code), message_(std::move(message)) {
+    TUMBLE_ASSERT(code != StatusCode::kOk);
+  }
+  StatusCode code_ = StatusCode::kOk;
   std::string message_;
 };
 
