@@ -12,6 +12,13 @@
 
 namespace tumble::server {
 
+// Told when a frame arrives, so that a reader need not wait on the mailbox (the callback streams).
+class MailboxListener {
+ public:
+  virtual ~MailboxListener() = default;
+  virtual void frame_arrived() = 0;
+};
+
 template <class Frame>
 class Mailbox {
  public:
@@ -20,15 +27,24 @@ class Mailbox {
     std::uint64_t dropped = 0;  // frames replaced unread since the previous delivery
   };
 
-  // Never blocks on a reader (the lock guards a pointer swap only).
+  // Never blocks on a reader (the lock guards a pointer swap only). The listener, if any, is told
+  // outside the lock.
   void put(std::shared_ptr<const Frame> frame) {
+    std::shared_ptr<MailboxListener> listener;
     {
       std::lock_guard lock(mutex_);
       if (closed_) return;
       if (frame_ != nullptr) ++dropped_;
       frame_ = std::move(frame);
+      listener = listener_;
     }
     ready_.notify_one();
+    if (listener != nullptr) listener->frame_arrived();
+  }
+
+  void set_listener(std::shared_ptr<MailboxListener> listener) {
+    std::lock_guard lock(mutex_);
+    listener_ = std::move(listener);
   }
 
   // The newest frame, waiting up to `timeout` for one; nothing when the time runs out or the
@@ -61,6 +77,7 @@ class Mailbox {
   mutable std::mutex mutex_;
   std::condition_variable ready_;
   std::shared_ptr<const Frame> frame_;
+  std::shared_ptr<MailboxListener> listener_;
   std::uint64_t dropped_ = 0;
   bool closed_ = false;
 };

@@ -63,7 +63,7 @@ void settings_to_proto(const HostStatus& status, v1::RunSettings* out) {
 WorldService::WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene)
     : host_(host), limits_(limits), scene_(std::move(scene)) {}
 
-grpc::Status WorldService::authorize(const grpc::ServerContext* context) const {
+grpc::Status WorldService::authorize(const grpc::ServerContextBase* context) const {
   if (limits_.token.empty()) return grpc::Status::OK;
   const std::string expected = "Bearer " + limits_.token;
   const auto& metadata = context->client_metadata();
@@ -470,71 +470,27 @@ grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::Resto
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::StreamFrames(grpc::ServerContext* context,
-                                        const v1::StreamFramesRequest* request,
-                                        grpc::ServerWriter<v1::Frame>* writer) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
-  if (!(request->max_rate() >= 0) || !std::isfinite(request->max_rate()))
-    return invalid("max_rate: must be finite and >= 0");
+grpc::ServerWriteReactor<grpc::ByteBuffer>* WorldService::StreamFrames(
+    grpc::CallbackServerContext* context, const grpc::ByteBuffer* request_bytes) {
+  if (grpc::Status denied = authorize(context); !denied.ok()) return new RefusedStream(denied);
+  std::vector<grpc::Slice> slices;
+  v1::StreamFramesRequest request;
+  std::string bytes;
+  if (request_bytes->Dump(&slices).ok())
+    for (const grpc::Slice& slice : slices)
+      bytes.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+  if (!request.ParseFromString(bytes))
+    return new RefusedStream(invalid("request: not a StreamFramesRequest"));
+  if (!(request.max_rate() >= 0) || !std::isfinite(request.max_rate()))
+    return new RefusedStream(invalid("max_rate: must be finite and >= 0"));
+  if (shutting_down_) return new RefusedStream(grpc::Status::OK);
   FrameOptions options;
-  options.velocities = request->velocities();
-  options.contacts = request->contacts();
-  options.stats = request->stats();
-  options.ids.assign(request->ids().begin(), request->ids().end());
+  options.velocities = request.velocities();
+  options.contacts = request.contacts();
+  options.stats = request.stats();
+  options.ids.assign(request.ids().begin(), request.ids().end());
   std::sort(options.ids.begin(), options.ids.end());
-  const auto min_interval =
-      std::chrono::duration<double>(request->max_rate() > 0 ? 1 / request->max_rate() : 0.0);
-
-  std::shared_ptr<FrameMailbox> mailbox = host_.subscribe();
-  std::vector<std::uint64_t> known;  // ids this subscriber has descriptions of, sorted
-  std::uint64_t dropped = 0, epoch = 0;
-  std::shared_ptr<const Catalogue> known_catalogue;  // held, so its address cannot be reused
-  auto last_sent = std::chrono::steady_clock::time_point{};
-  while (!context->IsCancelled() && !shutting_down_) {
-    auto delivery = mailbox->take(std::chrono::milliseconds(100));
-    if (!delivery) continue;
-    dropped += delivery->dropped;
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_sent < min_interval) {
-      ++dropped;  // over this subscriber's rate
-      continue;
-    }
-    const FrameData& data = *delivery->frame;
-    v1::Frame frame;
-    frame_to_proto(data, options, &frame);
-    frame.set_dropped(dropped);
-    // Bodies new to this subscriber get their descriptions; vanished ones are listed. The host
-    // makes a new catalogue (and a new world a new epoch) whenever the set of bodies changes, so
-    // a frame sharing the last one's catalogue has nothing to diff.
-    if (data.catalogue != known_catalogue) {
-      std::vector<std::uint64_t> current(frame.ids().begin(), frame.ids().end());
-      std::sort(current.begin(), current.end());
-      if (data.epoch != epoch) {  // a new world: every body it had before is gone
-        for (std::uint64_t wire : known)
-          frame.add_removed(wire);
-        known.clear();
-        epoch = data.epoch;
-      }
-      std::vector<std::uint64_t> added, removed;
-      std::set_difference(current.begin(), current.end(), known.begin(), known.end(),
-                          std::back_inserter(added));
-      std::set_difference(known.begin(), known.end(), current.begin(), current.end(),
-                          std::back_inserter(removed));
-      for (std::uint64_t wire : added) {
-        const auto look = data.catalogue->find(wire);
-        if (look != data.catalogue->end()) describe(wire, look->second, frame.add_added());
-      }
-      for (std::uint64_t wire : removed)
-        frame.add_removed(wire);
-      known = std::move(current);
-      known_catalogue = data.catalogue;
-    }
-    if (!writer->Write(frame)) break;  // the client went away
-    dropped = 0;
-    last_sent = now;
-  }
-  host_.unsubscribe(mailbox);
-  return grpc::Status::OK;
+  return new FrameStream(streams_, host_, std::move(options), request.max_rate());
 }
 
 }  // namespace tumble::server

@@ -10,6 +10,7 @@
 
 #include <mutex>
 
+#include "frame_stream.h"
 #include "scenes/scene.h"
 #include "tumble/v1/world.grpc.pb.h"
 #include "world_host.h"
@@ -26,7 +27,9 @@ struct ServiceLimits {
   WorldLimits world;
 };
 
-class WorldService final : public v1::World::Service {
+// StreamFrames uses gRPC's callback API on raw bytes (frame_stream.h); the rest is synchronous.
+class WorldService final
+    : public v1::World::WithRawCallbackMethod_StreamFrames<v1::World::Service> {
  public:
   // `scene`: what the host's world was made from, and what Control's reset goes back to.
   WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene);
@@ -51,14 +54,18 @@ class WorldService final : public v1::World::Service {
                         v1::SnapshotResponse*) override;
   grpc::Status Restore(grpc::ServerContext*, const v1::RestoreRequest*,
                        v1::RestoreResponse*) override;
-  grpc::Status StreamFrames(grpc::ServerContext*, const v1::StreamFramesRequest*,
-                            grpc::ServerWriter<v1::Frame>*) override;
+  grpc::ServerWriteReactor<grpc::ByteBuffer>* StreamFrames(grpc::CallbackServerContext*,
+                                                           const grpc::ByteBuffer*) override;
 
-  // Ends every stream (they return CANCELLED-free OK after their last frame).
-  void shut_down() { shutting_down_ = true; }
+  // Ends every stream (they end with OK after the frame in flight).
+  void shut_down() {
+    shutting_down_ = true;
+    streams_.end_all();
+  }
 
  private:
-  grpc::Status authorize(const grpc::ServerContext* context) const;
+  grpc::Status authorize(const grpc::ServerContextBase* context) const;
+  StreamHub streams_;
   WorldHost& host_;
   ServiceLimits limits_;
   // Builds `scene`'s world and swaps it in between two steps; its body ids into `ids`.

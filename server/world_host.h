@@ -11,8 +11,10 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "body_ids.h"
@@ -75,6 +77,14 @@ struct HostedWorld {
 
 // One step of the world, shared read-only by every subscriber.
 struct FrameData {
+  // Encodings of this frame made for one subscriber and kept for the others that asked for the
+  // same fields (the gRPC streams fill it; see frame_stream.h).
+  struct Encodings {
+    std::mutex mutex;
+    std::vector<std::pair<std::uint32_t, std::shared_ptr<const std::string>>> by_fields;
+  };
+  mutable Encodings encodings;
+
   std::uint64_t epoch = 0;  // HostedWorld::epoch
   std::uint64_t stepped_at_unix_ns = 0;
   std::shared_ptr<const Catalogue> catalogue;

@@ -1,0 +1,226 @@
+#include "frame_stream.h"
+
+#include <algorithm>
+#include <iterator>
+#include <string>
+
+namespace tumble::server {
+namespace {
+
+// The fields a subscription asks for, as a key of FrameData::Encodings. Subscriptions that name
+// ids encode privately (their bodies differ).
+std::uint32_t fields_key(const FrameOptions& options) {
+  return (options.velocities ? 1u : 0u) | (options.contacts ? 2u : 0u) | (options.stats ? 4u : 0u);
+}
+
+std::shared_ptr<const std::string> shared_encoding(const FrameData& frame,
+                                                   const FrameOptions& options) {
+  const auto encode = [&] {
+    v1::Frame shared;
+    frame_to_proto(frame, options, &shared);
+    return std::make_shared<const std::string>(shared.SerializeAsString());
+  };
+  if (!options.ids.empty()) return encode();
+  const std::uint32_t key = fields_key(options);
+  std::lock_guard lock(frame.encodings.mutex);
+  for (const auto& [fields, bytes] : frame.encodings.by_fields)
+    if (fields == key) return bytes;
+  frame.encodings.by_fields.emplace_back(key, encode());
+  return frame.encodings.by_fields.back().second;
+}
+
+// A slice over shared bytes, without copying them: the slice holds a reference until gRPC is done.
+grpc::Slice slice_of(std::shared_ptr<const std::string> bytes) {
+  auto* holder = new std::shared_ptr<const std::string>(std::move(bytes));
+  return grpc::Slice(
+      const_cast<char*>((*holder)->data()), (*holder)->size(),
+      [](void* user) { delete static_cast<std::shared_ptr<const std::string>*>(user); }, holder);
+}
+
+}  // namespace
+
+void StreamLink::frame_arrived() {
+  {
+    std::lock_guard lock(mutex);
+    if (stream == nullptr || scheduled) return;
+    scheduled = true;
+  }
+  hub->schedule(shared_from_this());
+}
+
+void StreamLink::offer() {
+  std::lock_guard lock(mutex);
+  scheduled = false;
+  if (stream != nullptr) stream->offer();
+}
+
+void StreamLink::end() {
+  std::lock_guard lock(mutex);
+  if (stream != nullptr) stream->end();
+}
+
+StreamHub::StreamHub() {
+  thread_ = std::thread([this] {
+    std::unique_lock lock(mutex_);
+    while (true) {
+      wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping, nothing left
+      auto link = std::move(queue_.front());
+      queue_.pop_front();
+      lock.unlock();
+      link->offer();
+      lock.lock();
+    }
+  });
+}
+
+StreamHub::~StreamHub() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+void StreamHub::schedule(std::shared_ptr<StreamLink> link) {
+  {
+    std::lock_guard lock(mutex_);
+    queue_.push_back(std::move(link));
+  }
+  wake_.notify_one();
+}
+
+void StreamHub::add(const std::shared_ptr<StreamLink>& link) {
+  std::lock_guard lock(mutex_);
+  streams_.insert(link);
+}
+
+void StreamHub::remove(const std::shared_ptr<StreamLink>& link) {
+  std::lock_guard lock(mutex_);
+  streams_.erase(link);
+}
+
+void StreamHub::end_all() {
+  std::vector<std::shared_ptr<StreamLink>> links;
+  {
+    std::lock_guard lock(mutex_);
+    links.assign(streams_.begin(), streams_.end());
+  }
+  for (const auto& link : links)
+    link->end();
+}
+
+FrameStream::FrameStream(StreamHub& hub, WorldHost& host, FrameOptions options, double max_rate)
+    : hub_(hub),
+      host_(host),
+      options_(std::move(options)),
+      min_interval_(max_rate > 0 ? 1 / max_rate : 0.0),
+      mailbox_(host.subscribe()),
+      link_(std::make_shared<StreamLink>()) {
+  link_->hub = &hub;
+  link_->stream = this;
+  hub_.add(link_);
+  mailbox_->set_listener(link_);
+  link_->frame_arrived();  // the host's newest frame is already waiting
+}
+
+void FrameStream::offer() {
+  std::lock_guard lock(mutex_);
+  if (writing_ || finishing_) return;
+  auto delivery = mailbox_->take(std::chrono::milliseconds(0));
+  if (!delivery) return;
+  dropped_ += delivery->dropped;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_sent_ < min_interval_) {
+    ++dropped_;  // over this subscriber's rate; the next step brings a newer frame
+    return;
+  }
+  encode(*delivery->frame, dropped_);
+  dropped_ = 0;
+  last_sent_ = now;
+  writing_ = true;
+  StartWrite(&buffer_);
+}
+
+void FrameStream::encode(const FrameData& data, std::uint64_t dropped) {
+  v1::Frame own;
+  own.set_dropped(dropped);
+  // Bodies new to this subscriber get their descriptions; vanished ones are listed. The host
+  // makes a new catalogue (and a new world a new epoch) whenever the set of bodies changes, so a
+  // frame sharing the last one's catalogue has nothing to diff.
+  if (data.catalogue != known_catalogue_) {
+    std::vector<std::uint64_t> current;
+    if (options_.ids.empty()) {
+      current = data.ids;
+    } else {
+      for (std::uint64_t id : data.ids)
+        if (std::binary_search(options_.ids.begin(), options_.ids.end(), id)) current.push_back(id);
+    }
+    std::sort(current.begin(), current.end());
+    if (data.epoch != epoch_) {  // a new world: every body it had before is gone
+      for (std::uint64_t wire : known_)
+        own.add_removed(wire);
+      known_.clear();
+      epoch_ = data.epoch;
+    }
+    std::vector<std::uint64_t> added, removed;
+    std::set_difference(current.begin(), current.end(), known_.begin(), known_.end(),
+                        std::back_inserter(added));
+    std::set_difference(known_.begin(), known_.end(), current.begin(), current.end(),
+                        std::back_inserter(removed));
+    for (std::uint64_t wire : added) {
+      const auto look = data.catalogue->find(wire);
+      if (look != data.catalogue->end()) describe(wire, look->second, own.add_added());
+    }
+    for (std::uint64_t wire : removed)
+      own.add_removed(wire);
+    known_ = std::move(current);
+    known_catalogue_ = data.catalogue;
+  }
+  grpc::Slice parts[2] = {slice_of(shared_encoding(data, options_)),
+                          grpc::Slice(own.SerializeAsString())};
+  buffer_ = grpc::ByteBuffer(parts, 2);
+}
+
+void FrameStream::OnWriteDone(bool ok) {
+  {
+    std::lock_guard lock(mutex_);
+    writing_ = false;
+    if (!ok) finishing_ = true;  // the client went away
+    if (finishing_) {
+      finish_locked(ok ? final_status_ : grpc::Status::OK);
+      return;
+    }
+  }
+  offer();
+}
+
+void FrameStream::end() {
+  std::lock_guard lock(mutex_);
+  finishing_ = true;
+  final_status_ = grpc::Status::OK;
+  if (!writing_) finish_locked(final_status_);
+}
+
+void FrameStream::OnCancel() {
+  end();
+}
+
+void FrameStream::finish_locked(const grpc::Status& status) {
+  if (finished_) return;
+  finished_ = true;
+  Finish(status);
+}
+
+void FrameStream::OnDone() {
+  {
+    std::lock_guard lock(link_->mutex);
+    link_->stream = nullptr;
+  }
+  host_.unsubscribe(mailbox_);
+  hub_.remove(link_);
+  delete this;
+}
+
+}  // namespace tumble::server
