@@ -123,10 +123,6 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   return def;
 }
 
-BodyLook look_of(const Body& body, std::uint32_t colour) {
-  return {body.shape, body.type, body.is_static() ? 0 : body.mass, colour};
-}
-
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) {
   out->set_id(id);
   out->set_type(look.type == BodyType::kStatic ? v1::BODY_TYPE_STATIC : v1::BODY_TYPE_DYNAMIC);

@@ -2,15 +2,14 @@
 // relative to the message given ("shape.box.size.x: must be > 0").
 #pragma once
 
+#include "frame.h"
 #include "physics/world.h"
 #include "tumble/v1/world.pb.h"
-#include "world_host.h"
 
 namespace tumble::server {
 
 Result<BodyDef> body_from_proto(const v1::BodySpec& spec);
 
-BodyLook look_of(const Body& body, std::uint32_t colour);
 // What a viewer needs to draw the body with wire id `id`.
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
 

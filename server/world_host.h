@@ -17,88 +17,12 @@
 #include <utility>
 #include <vector>
 
-#include "body_ids.h"
+#include "frame.h"
+#include "hosted_world.h"
 #include "mailbox.h"
 #include "physics/world.h"
 
 namespace tumble::server {
-
-// What a viewer needs to draw a body, kept while the body lives.
-struct BodyLook {
-  Shape shape;  // in the body's frame (origin at the centre of mass)
-  BodyType type = BodyType::kDynamic;
-  double mass = 0;           // kg; 0 for static bodies
-  std::uint32_t colour = 0;  // 0xRRGGBBAA; 0 lets the viewer choose
-};
-// Every live body's look by wire id. Shared by frames until the set of bodies changes.
-using Catalogue = std::unordered_map<std::uint64_t, BodyLook>;
-
-// The world and what the server keeps beside it. Only the stepping thread touches it: commands
-// run there.
-struct HostedWorld {
-  World world;
-  double dt = 1.0 / 60;                // s per step
-  std::vector<std::uint32_t> colours;  // by slot, 0xRRGGBBAA
-  // The ids clients see. The host follows every command's changes (a body created gets a new
-  // id, a removed one loses its id for good); a command that needs a new body's id at once
-  // calls ids.sync(world) itself.
-  BodyIds ids;
-  // Chosen at random when the server starts, and written into snapshots: a snapshot made here
-  // gives its bodies back their ids; one from elsewhere gets new ones, which cannot collide with
-  // ids this server has handed out.
-  std::uint64_t server_instance = 0;
-  // Counts wholesale replacements (a scene loaded, a snapshot restored), so that a subscriber
-  // forgets every body it knew.
-  std::uint64_t epoch = 0;
-
-  // A new world whose bodies all get new ids.
-  void replace(World replacement, double new_dt, std::vector<std::uint32_t> new_colours) {
-    world = std::move(replacement);
-    dt = new_dt;
-    colours = std::move(new_colours);
-    ids.clear();
-    ids.sync(world);
-    ++epoch;
-  }
-  // A restored world whose bodies keep the ids they had (by slot; see BodyIds::adopt).
-  void restore(World replacement, double new_dt, std::vector<std::uint32_t> new_colours,
-               std::span<const std::uint64_t> wire_ids, std::uint64_t next_id) {
-    world = std::move(replacement);
-    dt = new_dt;
-    colours = std::move(new_colours);
-    ids.adopt(world, wire_ids, next_id);
-    ++epoch;
-  }
-  void set_colour(BodyId id, std::uint32_t colour) {
-    if (colours.size() <= id.index) colours.resize(id.index + 1, 0);
-    colours[id.index] = colour;
-  }
-};
-
-// One step of the world, shared read-only by every subscriber.
-struct FrameData {
-  // Encodings of this frame made for one subscriber and kept for the others that asked for the
-  // same fields (the gRPC streams fill it; see frame_stream.h).
-  struct Encodings {
-    std::mutex mutex;
-    std::vector<std::pair<std::uint32_t, std::shared_ptr<const std::string>>> by_fields;
-  };
-  mutable Encodings encodings;
-
-  std::uint64_t epoch = 0;  // HostedWorld::epoch
-  std::uint64_t stepped_at_unix_ns = 0;
-  std::shared_ptr<const Catalogue> catalogue;
-  std::uint64_t step = 0;
-  double time = 0;                                            // s, simulated
-  std::vector<std::uint64_t> ids;                             // live bodies, slot order
-  std::vector<double> positions;                              // x y z per body, m
-  std::vector<double> orientations;                           // w x y z per body
-  std::vector<double> linear_velocities, angular_velocities;  // x y z per body
-  // One entry per contact point.
-  std::vector<std::uint64_t> contact_a, contact_b;
-  std::vector<double> contact_points, contact_normals, contact_depths, contact_impulses;
-  StepStats stats;
-};
 
 using FrameMailbox = Mailbox<FrameData>;
 

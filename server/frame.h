@@ -1,0 +1,66 @@
+// The world as the wire sees it: one step's frame (poses, velocities, contacts, statistics) and
+// the catalogue of what each body is, read from the hosted world in this one place. The gRPC
+// streams (convert.h, frame_stream.h) and the DDS publisher (dds_publisher.h) encode the same
+// frame; neither reads the world itself.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "hosted_world.h"
+
+namespace tumble::server {
+
+// What a viewer needs to draw a body, kept while the body lives.
+struct BodyLook {
+  Shape shape;  // in the body's frame (origin at the centre of mass)
+  BodyType type = BodyType::kDynamic;
+  double mass = 0;           // kg; 0 for static bodies
+  std::uint32_t colour = 0;  // 0xRRGGBBAA; 0 lets the viewer choose
+};
+// Every live body's look by wire id. Shared by frames until the set of bodies changes.
+using Catalogue = std::unordered_map<std::uint64_t, BodyLook>;
+
+// One step of the world, shared read-only by every subscriber.
+struct FrameData {
+  // Encodings of this frame made for one subscriber and kept for the others that asked for the
+  // same fields (the gRPC streams fill it; see frame_stream.h).
+  struct Encodings {
+    std::mutex mutex;
+    std::vector<std::pair<std::uint32_t, std::shared_ptr<const std::string>>> by_fields;
+  };
+  mutable Encodings encodings;
+
+  std::uint64_t epoch = 0;  // HostedWorld::epoch
+  std::uint64_t stepped_at_unix_ns = 0;
+  std::shared_ptr<const Catalogue> catalogue;
+  std::uint64_t step = 0;
+  double time = 0;                                            // s, simulated
+  std::vector<std::uint64_t> ids;                             // live bodies, slot order
+  std::vector<double> positions;                              // x y z per body, m
+  std::vector<double> orientations;                           // w x y z per body
+  std::vector<double> linear_velocities, angular_velocities;  // x y z per body
+  // One entry per contact point.
+  std::vector<std::uint64_t> contact_a, contact_b;
+  std::vector<double> contact_points, contact_normals, contact_depths, contact_impulses;
+  StepStats stats;
+};
+
+BodyLook look_of(const Body& body, std::uint32_t colour);
+
+// The catalogue of `hosted`'s bodies: `current` itself while the set of bodies is the same (so a
+// steady world's frames share one), else a new one. Forgets the colours of empty slots.
+std::shared_ptr<const Catalogue> updated_catalogue(HostedWorld& hosted,
+                                                   std::shared_ptr<const Catalogue> current,
+                                                   std::uint64_t current_epoch);
+
+// The frame of `hosted` as it is now.
+std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted,
+                                            std::shared_ptr<const Catalogue> catalogue);
+
+}  // namespace tumble::server
