@@ -176,6 +176,63 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
   out->set_total_seconds(s.time.total);
 }
 
+WorldSettings RunChange::applied_to(WorldSettings settings) const {
+  if (gravity) settings.gravity = *gravity;
+  if (substeps) settings.solver.substeps = *substeps;
+  if (solver) settings.solver.kind = *solver;
+  return settings;
+}
+
+Result<RunChange> run_change_from_proto(const v1::RunSettings& settings, double max_time_step) {
+  RunChange change;
+  if (settings.has_dt()) {
+    if (!(settings.dt() > 0 && std::isfinite(settings.dt())))
+      return Status::error("dt: must be finite and > 0");
+    if (settings.dt() > max_time_step)
+      return Status::error("dt: " + std::to_string(settings.dt()) +
+                           " s is above limits.max_time_step (" + std::to_string(max_time_step) +
+                           " s)");
+    change.dt = settings.dt();
+  }
+  if (settings.has_real_time_factor()) {
+    if (Status s = check_real_time_factor(settings.real_time_factor()); !s) return s;
+    change.real_time_factor = settings.real_time_factor();
+  }
+  if (settings.has_gravity()) {
+    if (Status s = finite(settings.gravity(), "gravity"); !s) return s;
+    change.gravity = vec(settings.gravity());
+  }
+  if (settings.has_substeps()) change.substeps = settings.substeps();
+  switch (settings.solver()) {
+    case v1::SOLVER_KIND_UNSPECIFIED:
+      break;
+    case v1::SOLVER_KIND_EXACT:
+      change.solver = SolverKind::kExact;
+      break;
+    case v1::SOLVER_KIND_PGS:
+      change.solver = SolverKind::kPgs;
+      break;
+    case v1::SOLVER_KIND_SOFT:
+      change.solver = SolverKind::kSoft;
+      break;
+    case v1::SOLVER_KIND_AUTO:
+      change.solver = SolverKind::kAuto;
+      break;
+    default:
+      return Status::error("solver: unknown solver " + std::to_string(settings.solver()));
+  }
+  return change;
+}
+
+void run_settings_to_proto(double dt, double real_time_factor, const WorldSettings& world,
+                           v1::RunSettings* out) {
+  out->set_dt(dt);
+  out->set_real_time_factor(real_time_factor);
+  out->set_substeps(world.solver.substeps);
+  out->set_solver(static_cast<v1::SolverKind>(static_cast<int>(world.solver.kind) + 1));
+  set(world.gravity, out->mutable_gravity());
+}
+
 void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out) {
   out->set_step(frame.step);
   out->set_time(frame.time);

@@ -2,7 +2,10 @@
 // relative to the message given ("shape.box.size.x: must be > 0").
 #pragma once
 
+#include <optional>
 #include "frame.h"
+#include "world_host.h"
+
 #include "physics/world.h"
 #include "tumble/v1/world.pb.h"
 
@@ -22,5 +25,19 @@ struct FrameOptions {
 void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out);
 
 void stats_to_proto(const StepStats& stats, v1::StepStats* out);
+
+// What a Control request changes, checked field by field ("dt: must be finite and > 0").
+struct RunChange {
+  std::optional<double> dt, real_time_factor;
+  std::optional<Vec3> gravity;
+  std::optional<int> substeps;
+  std::optional<SolverKind> solver;
+  // `settings` with this change's world settings applied.
+  WorldSettings applied_to(WorldSettings settings) const;
+};
+Result<RunChange> run_change_from_proto(const v1::RunSettings& settings, double max_time_step);
+// The settings in force: the host's pace and the world's solver and gravity.
+void run_settings_to_proto(double dt, double real_time_factor, const WorldSettings& world,
+                           v1::RunSettings* out);
 
 }  // namespace tumble::server

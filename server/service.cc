@@ -53,11 +53,6 @@ Status find_bodies(const HostedWorld& hosted,
   return Status::ok();
 }
 
-void settings_to_proto(const HostStatus& status, v1::RunSettings* out) {
-  out->set_dt(status.dt);
-  out->set_real_time_factor(status.real_time_factor);
-}
-
 }  // namespace
 
 WorldService::WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene)
@@ -103,6 +98,16 @@ grpc::Status WorldService::replace_world(SceneDef scene, std::vector<std::uint64
     return Status::ok();
   });
   return to_grpc(replaced);
+}
+
+grpc::Status WorldService::reset_world() {
+  SceneDef scene;
+  {
+    std::lock_guard lock(scene_mutex_);
+    scene = scene_;
+  }
+  std::vector<std::uint64_t> ids;
+  return replace_world(scene, &ids);
 }
 
 grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
@@ -304,75 +309,31 @@ grpc::Status WorldService::LoadScene(grpc::ServerContext* context,
 grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::ControlRequest* request,
                                    v1::ControlResponse* response) {
   if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
-  const v1::RunSettings& settings = request->settings();
-  // Checked before anything changes, so a refused request changes nothing.
-  if (settings.has_dt() && !(settings.dt() > 0 && std::isfinite(settings.dt())))
-    return invalid("settings.dt: must be finite and > 0");
-  if (settings.has_dt() && settings.dt() > limits_.world.max_time_step)
-    return invalid("settings.dt: " + std::to_string(settings.dt()) +
-                   " s is above limits.max_time_step (" +
-                   std::to_string(limits_.world.max_time_step) + " s)");
-  if (settings.has_real_time_factor())
-    if (Status s = check_real_time_factor(settings.real_time_factor()); !s)
-      return invalid("settings." + s.message());
-  if (settings.has_gravity()) {
-    const v1::Vec3& g = settings.gravity();
-    if (!std::isfinite(g.x()) || !std::isfinite(g.y()) || !std::isfinite(g.z()))
-      return invalid("settings.gravity: must be finite");
-  }
-  std::optional<SolverKind> solver;
-  switch (settings.solver()) {
-    case v1::SOLVER_KIND_UNSPECIFIED:
-      break;
-    case v1::SOLVER_KIND_EXACT:
-      solver = SolverKind::kExact;
-      break;
-    case v1::SOLVER_KIND_PGS:
-      solver = SolverKind::kPgs;
-      break;
-    case v1::SOLVER_KIND_SOFT:
-      solver = SolverKind::kSoft;
-      break;
-    case v1::SOLVER_KIND_AUTO:
-      solver = SolverKind::kAuto;
-      break;
-    default:
-      return invalid("settings.solver: unknown solver " + std::to_string(settings.solver()));
-  }
-  auto changed_settings = [&](WorldSettings next) {
-    if (settings.has_gravity())
-      next.gravity = Vec3(settings.gravity().x(), settings.gravity().y(), settings.gravity().z());
-    if (settings.has_substeps()) next.solver.substeps = settings.substeps();
-    if (solver) next.solver.kind = *solver;
-    return next;
-  };
-  // Checked against the world as it is before the reset below can change anything.
+  // Checked whole before anything changes, the world's settings against the world as it is.
+  Result<RunChange> change =
+      run_change_from_proto(request->settings(), limits_.world.max_time_step);
+  if (!change) return invalid("settings." + change.error());
   Status acceptable = Status::ok();
   host_.inspect([&](const HostedWorld& hosted) {
-    acceptable = validate(changed_settings(hosted.world.settings()));
+    acceptable = validate(change.value().applied_to(hosted.world.settings()));
   });
   if (!acceptable) return invalid("settings." + acceptable.message());
   if (request->action_case() == v1::ControlRequest::kReset && request->reset()) {
-    SceneDef scene;
-    {
-      std::lock_guard lock(scene_mutex_);
-      scene = scene_;
-    }
-    std::vector<std::uint64_t> ids;
     host_.pause();
-    if (grpc::Status reset = replace_world(scene, &ids); !reset.ok()) return reset;
+    if (grpc::Status reset = reset_world(); !reset.ok()) return reset;
   }
   // The world's own settings change in one command, all or nothing (World::set_settings).
   WorldSettings now;
   const Status changed = host_.apply([&](HostedWorld& hosted) {
-    World& world = hosted.world;
-    if (Status s = world.set_settings(changed_settings(world.settings())); !s) return s;
-    now = world.settings();
+    if (Status s = hosted.world.set_settings(change.value().applied_to(hosted.world.settings()));
+        !s)
+      return s;
+    now = hosted.world.settings();
     return Status::ok();
   });
   if (!changed) return invalid("settings." + changed.message());
-  if (settings.has_dt()) host_.set_dt(settings.dt());
-  if (settings.has_real_time_factor()) host_.set_real_time_factor(settings.real_time_factor());
+  if (change.value().dt) host_.set_dt(*change.value().dt);
+  if (change.value().real_time_factor) host_.set_real_time_factor(*change.value().real_time_factor);
   switch (request->action_case()) {
     case v1::ControlRequest::kPlay:
       if (request->play()) host_.play();
@@ -389,13 +350,7 @@ grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::Contr
   const HostStatus status = host_.status();
   response->set_running(status.running);
   response->set_step(status.step);
-  v1::RunSettings* out = response->mutable_settings();
-  settings_to_proto(status, out);
-  out->set_substeps(now.solver.substeps);
-  out->set_solver(static_cast<v1::SolverKind>(static_cast<int>(now.solver.kind) + 1));
-  out->mutable_gravity()->set_x(now.gravity.x());
-  out->mutable_gravity()->set_y(now.gravity.y());
-  out->mutable_gravity()->set_z(now.gravity.z());
+  run_settings_to_proto(status.dt, status.real_time_factor, now, response->mutable_settings());
   return grpc::Status::OK;
 }
 
@@ -408,7 +363,9 @@ grpc::Status WorldService::GetInfo(grpc::ServerContext* context, const v1::GetIn
   response->set_time(status.time);
   response->set_body_count(static_cast<std::uint32_t>(status.bodies));
   response->set_running(status.running);
-  settings_to_proto(status, response->mutable_settings());
+  WorldSettings world;
+  host_.inspect([&](const HostedWorld& hosted) { world = hosted.world.settings(); });
+  run_settings_to_proto(status.dt, status.real_time_factor, world, response->mutable_settings());
   stats_to_proto(status.last_step, response->mutable_last_step());
   response->set_subscribers(static_cast<std::uint32_t>(status.subscribers));
   return grpc::Status::OK;

@@ -70,6 +70,8 @@ class WorldService final
   ServiceLimits limits_;
   // Builds `scene`'s world and swaps it in between two steps; its body ids into `ids`.
   grpc::Status replace_world(SceneDef scene, std::vector<std::uint64_t>* ids);
+  // Back to the scene last loaded.
+  grpc::Status reset_world();
   std::mutex scene_mutex_;
   SceneDef scene_;  // the last scene loaded
   std::atomic<bool> shutting_down_{false};
