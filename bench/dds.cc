@@ -18,6 +18,7 @@
 
 #include "dds_publisher.h"
 #include "drifting_spheres.h"
+#include "tumble_qos.h"
 #include "tumble_states.h"
 
 namespace {
@@ -36,9 +37,7 @@ constexpr char kLoopback[] =
 // "poses N ids M p50_ms p99_ms".
 int run_reader(double seconds) {
   const dds_entity_t participant = dds_create_participant(kDomain, nullptr, nullptr);
-  dds_qos_t* qos = dds_create_qos();
-  dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qos_t* qos = tumble_states_qos();
   const dds_entity_t poses_topic = dds_create_topic(
       participant, &geometry_msgs_msg_dds__PoseArray__desc, "rt/tumble/poses", qos, nullptr);
   const dds_entity_t ids_topic = dds_create_topic(participant, &tumble_msg_dds__BodyIds__desc,

@@ -1,7 +1,8 @@
 // tumble-dds-echo: reads what tumble-server --dds publishes and prints it as JSON lines, one
 // sample a line, so other programs (and tests) can read Tumble's states without gRPC. It is also
-// the smallest example of a DDS program reading them: Cyclone DDS's C API and the types that
-// idlc generates from proto/dds/tumble_states.idl, nothing of Tumble's.
+// the smallest example of a DDS program reading them: Cyclone DDS's C API, the types that idlc
+// generates from proto/dds/tumble_states.idl and the topics' QoS (proto/dds/tumble_qos.h),
+// nothing of Tumble's.
 #include <dds/dds.h>
 
 #include <CLI/CLI.hpp>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "tumble_qos.h"
 #include "tumble_states.h"
 
 namespace {
@@ -129,13 +131,8 @@ int main(int argc, char** argv) {
                  dds_strretcode(participant));
     return 1;
   }
-  dds_qos_t* states = dds_create_qos();
-  dds_qset_reliability(states, DDS_RELIABILITY_BEST_EFFORT, 0);
-  dds_qset_history(states, DDS_HISTORY_KEEP_LAST, 1);
-  dds_qos_t* catalogue = dds_create_qos();
-  dds_qset_reliability(catalogue, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  dds_qset_durability(catalogue, DDS_DURABILITY_TRANSIENT_LOCAL);
-  dds_qset_history(catalogue, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qos_t* states = tumble_states_qos();
+  dds_qos_t* catalogue = tumble_catalogue_qos(DDS_SECS(1));
 
   const std::set<std::string> wanted(topics.begin(), topics.end());
   const dds_entity_t waitset = dds_create_waitset(participant);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "tumble_qos.h"
 #include "tumble_states.h"
 
 namespace tumble::server {
@@ -73,15 +74,8 @@ Result<std::unique_ptr<DdsPublisher>> DdsPublisher::start(WorldHost& host, DdsOp
   if (writers->participant < 0)
     return Status::error(dds_error("dds: cannot join the domain", writers->participant));
 
-  // States: the newest wins; a subscriber that misses one waits for the next step.
-  dds_qos_t* states = dds_create_qos();
-  dds_qset_reliability(states, DDS_RELIABILITY_BEST_EFFORT, 0);
-  dds_qset_history(states, DDS_HISTORY_KEEP_LAST, 1);
-  // The catalogue: every body's last sample kept for subscribers that join later.
-  dds_qos_t* catalogue = dds_create_qos();
-  dds_qset_reliability(catalogue, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-  dds_qset_durability(catalogue, DDS_DURABILITY_TRANSIENT_LOCAL);
-  dds_qset_history(catalogue, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qos_t* states = tumble_states_qos();
+  dds_qos_t* catalogue = tumble_catalogue_qos(DDS_MSECS(100));
 
   Status failed = Status::ok();
   auto writer = [&](const dds_topic_descriptor_t* type, const char* name, const dds_qos_t* qos) {

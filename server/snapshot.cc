@@ -315,6 +315,8 @@ Result<SavedWorld> decode_snapshot(std::string_view bytes) {
   saved.dt = in.dt();
   if (!(saved.dt > 0) || !std::isfinite(saved.dt))
     return Status::error("dt: must be finite and > 0");
+  if (saved.dt > saved.settings.limits.max_time_step)
+    return Status::error("dt: above settings.limits.max_time_step");
   WorldStateData& state = saved.state;
   state.slots.resize(in.slots_size());
   saved.colours.resize(in.slots_size(), 0);

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fuzz_snapshot.h"
 #include "fuzz_support.h"
 #include "recording.h"
 #include "scene_runner.h"
@@ -29,20 +30,19 @@ void print(const char* what, const FuzzTally& t) {
               static_cast<unsigned long long>(t.poisoned));
 }
 
-// Every body finite and within the world's limits.
-bool sound(const World& world) {
-  for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
-    const Body* body = world.body(world.id_at(slot));
-    if (body != nullptr && !check_limits(*body, world.settings().limits)) return false;
+// A world that was accepted must step and stay sound; says what went wrong.
+std::string steps_soundly(World& world, double dt) {
+  for (int k = 0; k < 3; ++k) {
+    if (Status s = world.step(dt); !s) return "step " + std::to_string(k) + ": " + s.message();
+    for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
+      const Body* body = world.body(world.id_at(slot));
+      if (body == nullptr) continue;
+      if (Status s = check_limits(*body, world.settings().limits); !s)
+        return "after step " + std::to_string(k) + ", slot " + std::to_string(slot) + ": " +
+               s.message();
+    }
   }
-  return true;
-}
-
-// A world that was accepted must step and stay sound.
-bool steps_soundly(World& world, double dt) {
-  for (int k = 0; k < 3; ++k)
-    if (!world.step(dt) || !sound(world)) return false;
-  return true;
+  return "";
 }
 
 // Somewhere in `json`, one value replaced by a hostile one, a key removed or added, or an array
@@ -113,9 +113,10 @@ TEST(FuzzFiles, SceneJson) {
       continue;
     }
     ++tally.accepted;
-    if (!steps_soundly(world.value(), scene.value().dt)) {
+    if (const std::string wrong = steps_soundly(world.value(), scene.value().dt); !wrong.empty()) {
       ++tally.poisoned;
-      ADD_FAILURE() << "scene " << i << " was accepted but stepped into an unsound world:\n"
+      ADD_FAILURE() << "scene " << i << " was accepted but stepped into an unsound world (" << wrong
+                    << "):\n"
                     << text;
     }
   }
@@ -149,52 +150,7 @@ TEST(FuzzFiles, Snapshots) {
   ASSERT_GT(parsed.warm_start().normal_size(), 0);
   FuzzTally tally;
   for (int i = 0; i < 3000; ++i) {
-    std::string bytes;
-    if (h.chance(0.4)) {
-      bytes = h.mutate(good);
-    } else {
-      v1::snapshot::WorldSnapshot s = parsed;
-      v1::snapshot::Body* b = s.mutable_slots(h.integer(0, s.slots_size() - 1));
-      switch (h.integer(0, 11)) {
-        case 0:
-          b->set_mass(h.special());
-          break;
-        case 1:
-          b->set_inverse_mass(h.special());
-          break;
-        case 2:
-          b->set_position(h.integer(0, 2), h.special());
-          break;
-        case 3:
-          b->set_linear_velocity(h.integer(0, 2), h.special());
-          break;
-        case 4:
-          b->set_inertia_body(h.integer(0, 8), h.special());
-          break;
-        case 5:
-          b->mutable_shape()->set_type(static_cast<std::uint32_t>(h.integer(0, 9)));
-          break;
-        case 6:
-          b->mutable_shape()->set_half_extents(h.integer(0, 2), h.special());
-          break;
-        case 7:
-          s.mutable_warm_start()->set_body_a(0, static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
-          break;
-        case 8:
-          s.mutable_warm_start()->set_normal(0, h.special());
-          break;
-        case 9:
-          for (int k = h.integer(1, 1000); k > 0; --k)
-            *s.add_slots() = v1::snapshot::Body();
-          break;
-        case 10:
-          s.mutable_settings()->mutable_solver()->set_iterations(h.integer(-5, 5000));
-          break;
-        default:
-          s.mutable_settings()->mutable_limits()->set_max_size(h.special());
-      }
-      bytes = s.SerializeAsString();
-    }
+    const std::string bytes = testing::damaged_snapshot(h, good);
     ++tally.tried;
     Result<server::SavedWorld> saved = server::decode_snapshot(bytes);
     Result<World> world = saved ? World::from_state(saved.value().settings, saved.value().state)
@@ -205,9 +161,10 @@ TEST(FuzzFiles, Snapshots) {
       continue;
     }
     ++tally.accepted;
-    if (!steps_soundly(world.value(), saved.value().dt)) {
+    if (const std::string wrong = steps_soundly(world.value(), saved.value().dt); !wrong.empty()) {
       ++tally.poisoned;
-      ADD_FAILURE() << "snapshot " << i << " was accepted but stepped into an unsound world";
+      ADD_FAILURE() << "snapshot " << i
+                    << " was accepted but stepped into an unsound world: " << wrong;
     }
   }
   print("snapshots", tally);

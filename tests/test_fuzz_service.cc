@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_snapshot.h"
 #include "fuzz_support.h"
 #include "scene_runner.h"
 #include "service.h"
@@ -299,48 +300,10 @@ class FuzzService {
     }
   }
 
-  // This server's snapshot, damaged: bytes mutated, or a field set to a hostile value.
+  // This server's snapshot, damaged (one in ten left whole, to be restored).
   std::string damaged_snapshot(Hostile& h) {
     const std::string good = snapshot();
-    if (h.chance(0.1)) return good;  // an undamaged one restores
-    if (h.chance(0.5)) return h.mutate(good);
-    v1::snapshot::WorldSnapshot s;
-    s.ParseFromString(good);
-    if (s.slots_size() == 0) return good;
-    v1::snapshot::Body* b = s.mutable_slots(h.integer(0, s.slots_size() - 1));
-    switch (h.integer(0, 9)) {
-      case 0:
-        b->set_mass(h.special());
-        break;
-      case 1:
-        b->set_inverse_mass(h.special());
-        break;
-      case 2:
-        if (b->position_size() == 3) b->set_position(h.integer(0, 2), h.special());
-        break;
-      case 3:
-        if (b->angular_velocity_size() == 3) b->set_angular_velocity(h.integer(0, 2), h.special());
-        break;
-      case 4:
-        if (b->inverse_inertia_body_size() == 9)
-          b->set_inverse_inertia_body(h.integer(0, 8), h.special());
-        break;
-      case 5:
-        b->set_sleep_island(static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
-        break;
-      case 6:
-        s.add_free_slots(static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
-        break;
-      case 7:
-        b->set_id(s.slots(0).id());  // two slots with one id
-        break;
-      case 8:
-        s.set_next_id(UINT64_MAX);
-        break;
-      default:
-        s.set_dt(h.special());
-    }
-    return s.SerializeAsString();
+    return h.chance(0.1) ? good : testing::damaged_snapshot(h, good);
   }
 
   WorldHost host_;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "exact_solver.h"
@@ -251,9 +252,12 @@ void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint3
 
 Status World::step(double dt) {
   if (!(dt > 0) || !std::isfinite(dt)) return Status::error("dt: must be finite and > 0");
-  if (dt > settings_.limits.max_time_step)
-    return Status::error("dt: " + std::to_string(dt) + " s is above limits.max_time_step (" +
-                         std::to_string(settings_.limits.max_time_step) + " s)");
+  if (dt > settings_.limits.max_time_step) {
+    char message[96];
+    std::snprintf(message, sizeof message, "dt: %g s is above limits.max_time_step (%g s)", dt,
+                  settings_.limits.max_time_step);
+    return Status::error(message);
+  }
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t step_index = stats_.step + 1;
   stats_ = StepStats{};
