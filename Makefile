@@ -3,7 +3,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test test-sanitize demo bench report format clean
+.PHONY: all deps configure build test test-sanitize test-container demo bench report format clean
 
 all: build
 
@@ -33,6 +33,12 @@ test-sanitize: deps
 	@cmake -S . -B $(BUILD_DIR)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTUMBLE_SANITIZE=thread -DTUMBLE_BUILD_BENCH=OFF >/dev/null
 	@cmake --build $(BUILD_DIR)-tsan -j $(JOBS) --target test_world_host
 	@cd $(BUILD_DIR)-tsan && OMP_NUM_THREADS=1 TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -j $(JOBS) -R '^(Mailbox|WorldHost)[.]'
+
+# The images of docker/Dockerfile built and run with podman (docker/test says what it checks;
+# about 7 minutes on 2 cores from nothing, most of it compiling inside the image).
+test-container:
+	@scripts/install-deps container
+	@docker/test
 
 bench: CMAKE_FLAGS += -DTUMBLE_BENCH_PEERS=ON
 bench:
