@@ -34,7 +34,7 @@ Status take(const RepeatedField<double>& in, int n, const char* field, double* o
 }
 
 Status take_matrix(const RepeatedField<double>& in, const char* field, Mat3* m) {
-  double values[9];
+  double values[9] = {};
   if (Status s = take(in, 9, field, values); !s) return s;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)

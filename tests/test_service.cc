@@ -20,7 +20,7 @@ class ServiceTest : public ::testing::Test {
  protected:
   ServiceTest()
       : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0),
-        service_(host_, {.max_bodies = 100, .token = ""}, pile_scene(8)) {
+        service_(host_, {.max_bodies = 100, .token = "", .world = {}}, pile_scene(8)) {
     grpc::ServerBuilder builder;
     builder.RegisterService(&service_);
     server_ = builder.BuildAndStart();
@@ -495,7 +495,7 @@ TEST_F(SnapshotTest, StreamForgetsTheOldWorldAfterARestore) {
 
 TEST(ServiceAuth, EveryCallNeedsTheBearerToken) {
   WorldHost host(make_world(pile_scene(8)).value(), 1.0 / 60, 0);
-  WorldService service(host, {.max_bodies = 100, .token = "s3cret"}, pile_scene(8));
+  WorldService service(host, {.max_bodies = 100, .token = "s3cret", .world = {}}, pile_scene(8));
   grpc::ServerBuilder builder;
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();

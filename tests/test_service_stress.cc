@@ -26,7 +26,7 @@ class LoopbackServer {
  public:
   LoopbackServer(SceneDef scene, double real_time_factor)
       : host_(make_world(scene).value(), scene.dt, real_time_factor),
-        service_(host_, {.max_bodies = 100000, .token = ""}, scene) {
+        service_(host_, {.max_bodies = 100000, .token = "", .world = {}}, scene) {
     grpc::ServerBuilder builder;
     builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port_);
     builder.RegisterService(&service_);

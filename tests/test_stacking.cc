@@ -48,6 +48,36 @@ TEST(Pyramid, BaseOfTwentyStandsTwentySeconds) {
   EXPECT_LT(largest, 0.02);
 }
 
+// A settled pyramid's ground contacts carry its weight every step: the impulses the world reports
+// are the whole step's (all substeps of the soft solver), whatever the solver and thread count.
+TEST(ContactImpulses, CarryThePyramidsWeightWithEverySolver) {
+  for (SolverKind kind :
+       {SolverKind::kExact, SolverKind::kPgs, SolverKind::kSoft, SolverKind::kAuto}) {
+    for (int threads : {1, 2}) {  // 78 boxes: one island, coloured for a team of two
+      SceneDef scene = awake(pyramid_scene(12));
+      scene.world.solver.kind = kind;
+      scene.world.threads = threads;
+      World world = build(scene);
+      run(world, 1.0 / 60, 180);
+      double weight = 0;
+      for (const Body* b : dynamic_bodies(world))
+        weight += b->mass * 9.81 / 60;
+      const std::span<const double> impulses = world.contact_impulses();
+      double on_ground = 0;
+      std::size_t row = 0;
+      for (const Contact& contact : world.contacts()) {
+        const bool ground =
+            world.body(contact.a)->is_static() || world.body(contact.b)->is_static();
+        for (int p = 0; p < contact.manifold.count; ++p, ++row)
+          if (ground) on_ground += impulses[row] * std::abs(contact.manifold.normal.z());
+      }
+      ASSERT_EQ(row, impulses.size());
+      SCOPED_TRACE(std::string(solver_name(kind)) + ", " + std::to_string(threads) + " threads");
+      EXPECT_NEAR(on_ground, weight, 0.02 * weight);
+    }
+  }
+}
+
 // S4: 1000 kg on 1 kg on 1 kg. Every peer crushes it; the exact solver holds it.
 TEST(MassRatio, HeavyOnLightHoldsWithTheExactSolver) {
   for (bool inverted : {false, true}) {

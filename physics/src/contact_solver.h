@@ -56,6 +56,10 @@ struct ContactRow {
   double relative_velocity = 0;  // normal velocity at the step start, m/s
   double normal_impulse = 0, tangent_impulse1 = 0, tangent_impulse2 = 0;
   double max_normal_impulse = 0;
+  // Soft solver: the normal impulses of the step's substeps before the last. Each substep starts
+  // from the last one's impulse (warm start) and ends with its own in normal_impulse, so the
+  // step's whole impulse, which is what the world reports, is this sum plus normal_impulse.
+  double earlier_substeps_impulse = 0;
   std::uint64_t feature = 0;
   std::uint32_t manifold = 0;                    // index of its NormalBlock
   std::uint8_t block_index = 0, block_size = 1;  // place among its manifold's rows

@@ -85,6 +85,9 @@ void advance_island(const IslandContext& c, double dt, IslandReport* report) {
                            (s + i) % 2 == 0) <= solver.velocity_tolerance)
           break;
       }
+      if (s + 1 < substeps)
+        for (std::uint32_t r : c.rows)
+          rows[r].earlier_substeps_impulse += rows[r].normal_impulse;
     }
     report->residual = normal_residual(rows, c.rows, bodies, h);
     apply_restitution(rows, c.rows, c.scratch.blocks, bodies, solver);
@@ -208,6 +211,11 @@ void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint3
       return solve_contacts(s.rows, ids, s.blocks, s.bodies, solver, soft, h, false);
     });
   };
+  auto add_substep_impulse = [&](std::span<const std::uint32_t> ids) {
+    for (std::uint32_t r : ids)
+      s.rows[r].earlier_substeps_impulse += s.rows[r].normal_impulse;
+    return 0.0;
+  };
   double h = dt;
   if (report->solver == IslandSolver::kSoft) {
     h = dt / solver.substeps;
@@ -221,6 +229,8 @@ void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint3
       team_integrate_positions(c, h);
       for (int i = 0; i < solver.relax_iterations; ++i)
         if (sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
+      if (sub + 1 < solver.substeps)
+        sweep_colours(s, first, last, false, add_substep_impulse, false);
     }
   } else {
     hits += team_integrate_velocities(c, dt);
@@ -582,7 +592,7 @@ void World::finish_step(double dt) {
                       row.local_a,
                       row.normal_impulse,
                       row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2};
-        impulses_[r] = row.normal_impulse;
+        impulses_[r] = row.earlier_substeps_impulse + row.normal_impulse;
       }
     }
   });

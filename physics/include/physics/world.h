@@ -109,8 +109,8 @@ class World {
   const StepStats& last_step() const { return stats_; }
   double time() const { return time_; }  // s, simulated
   std::uint64_t step_count() const { return stats_.step; }
-  // Normal impulse (N s) of each contact point of the last step, in the order of contacts()'s
-  // manifolds and their points.
+  // Normal impulse (N s) of each contact point over the whole last step (all substeps of the soft
+  // solver), in the order of contacts()'s manifolds and their points.
   std::span<const double> contact_impulses() const { return impulses_; }
   // The manifolds of the last step (or of the last find_contacts()).
   std::span<const Contact> contacts() const { return contacts_; }
