@@ -3,14 +3,14 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test test-sanitize test-container demo bench report format clean
+.PHONY: all deps configure build test test-sanitize test-container demo bench report python format clean
 
 all: build
 
 # The peer engines (bench) are installed for the tests too: the quick report in `make test`
 # measures them beside ours.
 deps:
-	@scripts/install-deps core service viewer dds bench
+	@scripts/install-deps core service viewer dds bench python
 
 configure: deps
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
@@ -40,9 +40,16 @@ test-container:
 	@scripts/install-deps container
 	@docker/test
 
+# The Python client into $(BUILD_DIR)/python (docs/PYTHON.md): PYTHONPATH=$(BUILD_DIR)/python.
+python:
+	@scripts/install-deps core service python
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@cmake --build $(BUILD_DIR) --target tumble_python
+	@echo "python: PYTHONPATH=$(BUILD_DIR)/python /usr/bin/python3 -c 'import tumble'"
+
 bench: CMAKE_FLAGS += -DTUMBLE_BENCH_PEERS=ON
 bench:
-	@scripts/install-deps core service viewer bench
+	@scripts/install-deps core service viewer bench python
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DTUMBLE_BENCH_PEERS=ON >/dev/null
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 	@scripts/run-bench $(BUILD_DIR)

@@ -1,0 +1,22 @@
+"""Tumble's Python client: spawn, step and stream a Tumble server's world.
+
+    import tumble
+    world = tumble.connect("127.0.0.1:50051")
+    box = world.spawn_box(size=(1, 1, 1), mass=2.0, pos=(0, 0, 5))
+    world.step(120)
+    for frame in world.frames(rate=60, count=10): print(frame.step, frame.position(box))
+
+Built from proto/tumble/v1/world.proto by `make python` into build/python (docs/PYTHON.md).
+"""
+
+from tumble.bodies import Body, BodySpec, Description
+from tumble.errors import ArgumentError, Error
+from tumble.frames import Contacts, Frame, FrameStream
+from tumble.shapes import Box, Capsule, Hull, Plane, Sphere
+from tumble.world import Info, LoadedScene, Settings, Snapshot, World, connect
+
+__all__ = [
+    "ArgumentError", "Body", "BodySpec", "Box", "Capsule", "Contacts", "Description", "Error",
+    "Frame", "FrameStream", "Hull", "Info", "LoadedScene", "Plane", "Settings", "Snapshot",
+    "Sphere", "World", "connect",
+]

@@ -1,0 +1,326 @@
+"""A connection to one Tumble server and the world it steps (the tumble.v1.World service)."""
+
+import json
+import os
+import time
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import grpc
+
+from tumble import convert
+from tumble.bodies import Body, BodySpec
+from tumble.errors import ArgumentError, Error, from_rpc
+from tumble.frames import FrameStream, plain
+from tumble.shapes import Box, Capsule, Hull, Plane, Sphere
+from tumble.v1 import world_pb2 as pb
+from tumble.v1 import world_pb2_grpc as pb_grpc
+
+# Frames and snapshots of large worlds exceed gRPC's default 4 MiB (the C++ client's limit too).
+_MAX_MESSAGE_BYTES = 512 << 20
+
+_SOLVERS = {
+    "exact": pb.SOLVER_KIND_EXACT,
+    "pgs": pb.SOLVER_KIND_PGS,
+    "soft": pb.SOLVER_KIND_SOFT,
+    "auto": pb.SOLVER_KIND_AUTO,
+}
+
+
+@dataclass
+class Settings:
+    """The run's settings in force: dt (s), substeps (soft solver), solver, gravity (m/s^2),
+    real_time_factor (1: wall-clock pace, 0: as fast as the machine can)."""
+
+    dt: float
+    substeps: int
+    solver: str
+    gravity: tuple
+    real_time_factor: float
+
+    @staticmethod
+    def from_proto(settings):
+        solver = next((k for k, v in _SOLVERS.items() if v == settings.solver), "unspecified")
+        gravity = (settings.gravity.x, settings.gravity.y, settings.gravity.z)
+        return Settings(settings.dt, settings.substeps, solver, gravity, settings.real_time_factor)
+
+
+@dataclass
+class Info:
+    version: str
+    step: int
+    time: float  # s, simulated
+    body_count: int
+    running: bool
+    settings: Settings
+    last_step: SimpleNamespace  # the last step's statistics (tumble.v1.StepStats)
+    subscribers: int
+
+
+@dataclass
+class Snapshot:
+    """The whole world's state at `step`; World.restore continues the run from it bit for bit.
+    `state` is what `tumble snapshot --out FILE` writes, so files move between the two."""
+
+    step: int
+    state: bytes
+
+
+@dataclass
+class LoadedScene:
+    name: str
+    ids: list  # the scene's bodies, in its order
+
+
+def connect(address="127.0.0.1:50051", token=None, *, tls_ca=None, timeout=5.0):
+    """Connects to a Tumble server and checks that it answers: an unreachable server, or one
+    that refuses the token, raises tumble.Error here (naming the address), not on first use.
+
+    token: sent as "authorization: Bearer TOKEN" (default: $TUMBLE_TOKEN when set).
+    tls_ca: path of the PEM certificate authority that signed the server's certificate; when
+    given, the connection uses TLS. timeout: s to wait for the server's first answer."""
+    if token is None:
+        token = os.environ.get("TUMBLE_TOKEN") or None
+    options = [("grpc.max_receive_message_length", _MAX_MESSAGE_BYTES),
+               ("grpc.max_send_message_length", _MAX_MESSAGE_BYTES)]
+    if tls_ca is not None:
+        try:
+            with open(tls_ca, "rb") as file:
+                authority = file.read()
+        except OSError as error:
+            raise ArgumentError(f"tls_ca: cannot read {tls_ca}: {error.strerror}", "connect") from None
+        channel = grpc.secure_channel(address, grpc.ssl_channel_credentials(authority), options)
+    else:
+        channel = grpc.insecure_channel(address, options)
+    world = World(channel, address, token)
+    try:
+        world._rpc("GetInfo", pb.GetInfoRequest(), timeout=timeout)
+    except Error as error:
+        world.close()
+        raise Error(error.code, f"the Tumble server at {address} did not answer: {error.message}",
+                    "connect") from None
+    return world
+
+
+class World:
+    """The world of one server. Every change is applied between two steps, all at once: a refused
+    call raises tumble.Error and leaves the world exactly as it was."""
+
+    def __init__(self, channel, address, token=None):
+        self.address = address
+        self._channel = channel
+        self._stub = pb_grpc.WorldStub(channel)
+        self._raw_frames = channel.unary_stream(
+            "/tumble.v1.World/StreamFrames",
+            request_serializer=pb.StreamFramesRequest.SerializeToString,
+            response_deserializer=None)
+        self._metadata = (("authorization", f"Bearer {token}"),) if token else ()
+
+    # --- bodies -------------------------------------------------------------------------------
+
+    def spawn(self, shape, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
+        """Spawns one body of `shape` (Box, Sphere, Capsule, Hull or Plane); returns its id.
+        Options are BodySpec's: orientation, angular_velocity, mass, density, friction,
+        restitution, color, static."""
+        return self.spawn_many([BodySpec(shape, pos, vel, **options)])[0]
+
+    def spawn_many(self, specs):
+        """Spawns a batch of BodySpec all or nothing; returns their ids in the order given."""
+        request = pb.SpawnBodiesRequest()
+        for i, spec in enumerate(specs):
+            if not isinstance(spec, BodySpec):
+                raise ArgumentError(f"bodies[{i}]: expected a BodySpec, got {spec!r}", "spawn")
+            request.bodies.append(spec.to_proto(f"bodies[{i}]"))
+        return list(self._rpc("SpawnBodies", request).ids)
+
+    def spawn_box(self, size, mass=None, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
+        """A box of full extents `size` (m); mass in kg (default: from density)."""
+        return self.spawn(Box(tuple(convert.array(size, 3, "size"))), pos, vel, mass=mass, **options)
+
+    def spawn_sphere(self, radius, mass=None, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
+        return self.spawn(Sphere(radius), pos, vel, mass=mass, **options)
+
+    def spawn_capsule(self, radius, half_height, mass=None, pos=(0.0, 0.0, 0.0),
+                      vel=(0.0, 0.0, 0.0), **options):
+        return self.spawn(Capsule(radius, half_height), pos, vel, mass=mass, **options)
+
+    def spawn_hull(self, points, mass=None, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
+        """The convex hull of `points` ((N, 3), body frame, m)."""
+        return self.spawn(Hull(convert.points(points, "points")), pos, vel, mass=mass, **options)
+
+    def spawn_ground(self, height=0.0, **options):
+        """A static ground: the half-space below z = height."""
+        return self.spawn(Plane(), (0.0, 0.0, height), static=True, **options)
+
+    def remove(self, ids):
+        """Removes a body or a list of them, all or nothing (one unknown id: NOT_FOUND)."""
+        self._rpc("RemoveBodies", pb.RemoveBodiesRequest(ids=convert.ids(ids)))
+
+    def set_state(self, body_id, pos=None, orientation=None, vel=None, angular_velocity=None):
+        """Moves a body or sets its velocities; values not given are left as they are."""
+        update = pb.BodyStateUpdate(id=convert.ids(body_id, "id")[0])
+        if pos is not None:
+            convert.set_vec3(update.position, pos, "pos")
+        if orientation is not None:
+            convert.set_quat(update.orientation, orientation, "orientation")
+        if vel is not None:
+            convert.set_vec3(update.linear_velocity, vel, "vel")
+        if angular_velocity is not None:
+            convert.set_vec3(update.angular_velocity, angular_velocity, "angular_velocity")
+        self._rpc("SetBodyState", pb.SetBodyStateRequest(updates=[update]))
+
+    def apply_impulse(self, body_id, impulse, point=None):
+        """An impulse (N s, world) at `point` (m, world; default the centre of mass) before the
+        next step."""
+        entry = pb.Impulse(id=convert.ids(body_id, "id")[0])
+        convert.set_vec3(entry.impulse, impulse, "impulse")
+        if point is not None:
+            convert.set_vec3(entry.point, point, "point")
+        self._rpc("ApplyImpulse", pb.ApplyImpulseRequest(impulses=[entry]))
+
+    def bodies(self, ids=()):
+        """Every body (or those of `ids`) with its state at the current step."""
+        response = self._rpc("GetBodies", pb.GetBodiesRequest(ids=convert.ids(ids)))
+        return [Body.from_proto(d, s, response.step)
+                for d, s in zip(response.descriptions, response.states)]
+
+    def body(self, body_id):
+        return self.bodies([body_id])[0]
+
+    # --- the run ------------------------------------------------------------------------------
+
+    def play(self):
+        """Steps continuously (at the real-time factor's pace)."""
+        self._control(pb.ControlRequest(play=True))
+
+    def pause(self, timeout=60.0):
+        """Stops after the current step; returns the step it stopped at once it has."""
+        response = self._control(pb.ControlRequest(pause=True))
+        return self._wait_until_stopped(response, timeout, "pause")
+
+    def step(self, n=1, timeout=600.0):
+        """Runs n steps, pauses, and returns the step reached once they are computed."""
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n < 2**32:
+            raise ArgumentError(f"n: expected a number of steps in [1, 2^32), got {n!r}", "step")
+        response = self._control(pb.ControlRequest(step=n))
+        return self._wait_until_stopped(response, timeout, "step")
+
+    def reset(self):
+        """Back to the scene as last loaded, at step 0."""
+        self._control(pb.ControlRequest(reset=True))
+
+    def settings(self, dt=None, substeps=None, solver=None, gravity=None, real_time_factor=None):
+        """Changes the settings given (none: reads them); returns the settings in force."""
+        request = pb.ControlRequest()
+        settings = request.settings
+        if dt is not None:
+            settings.dt = convert.number(dt, "dt")
+        if substeps is not None:
+            if isinstance(substeps, bool) or not isinstance(substeps, int):
+                raise ArgumentError(f"substeps: expected an integer, got {substeps!r}", "settings")
+            settings.substeps = substeps
+        if solver is not None:
+            if solver not in _SOLVERS:
+                raise ArgumentError(
+                    f"solver: expected one of {', '.join(_SOLVERS)}, got {solver!r}", "settings")
+            settings.solver = _SOLVERS[solver]
+        if gravity is not None:
+            convert.set_vec3(settings.gravity, gravity, "gravity")
+        if real_time_factor is not None:
+            settings.real_time_factor = convert.number(real_time_factor, "real_time_factor")
+        return Settings.from_proto(self._rpc("Control", request).settings)
+
+    def load_scene(self, scene):
+        """Replaces the world with a scene: a dict or JSON text in the format of docs/SCENES.md,
+        or a path (os.PathLike) to such a file."""
+        if isinstance(scene, os.PathLike):
+            with open(scene, "rb") as file:
+                text = file.read()
+        elif isinstance(scene, dict):
+            text = json.dumps(scene).encode()
+        elif isinstance(scene, (str, bytes)):
+            text = scene.encode() if isinstance(scene, str) else scene
+        else:
+            raise ArgumentError(f"scene: expected a dict, JSON text or a path, got {scene!r}",
+                                "load_scene")
+        return self._loaded(self._rpc("LoadScene", pb.LoadSceneRequest(scene_json=text)))
+
+    def load_builtin(self, name):
+        """Replaces the world with a built-in scene: "default", "pile:1000", "pyramid:20", ..."""
+        request = pb.LoadSceneRequest(builtin=str(name).encode())
+        return self._loaded(self._rpc("LoadScene", request))
+
+    def info(self):
+        response = self._rpc("GetInfo", pb.GetInfoRequest())
+        return Info(response.version, response.step, response.time, response.body_count,
+                    response.running, Settings.from_proto(response.settings),
+                    plain(response.last_step), response.subscribers)
+
+    # --- frames, snapshots --------------------------------------------------------------------
+
+    def frames(self, rate=0.0, velocities=False, contacts=False, stats=False, ids=(), count=None,
+               duration=None):
+        """Subscribes to the world's frames: every step's, or at most `rate` per second. A slow
+        reader loses frames (Frame.dropped counts them), never slows the world. Frames come only
+        while the world steps. The subscription ends after `count` frames or `duration` seconds,
+        whichever comes first (default: when closed or when the server stops)."""
+        request = pb.StreamFramesRequest(max_rate=convert.number(rate, "rate"),
+                                         velocities=bool(velocities), contacts=bool(contacts),
+                                         stats=bool(stats), ids=convert.ids(ids))
+        if count is not None and (isinstance(count, bool) or not isinstance(count, int)
+                                  or count < 0):
+            raise ArgumentError(f"count: expected an integer >= 0, got {count!r}", "frames")
+        if duration is not None:
+            duration = convert.number(duration, "duration")
+        # Undecoded: FrameStream reads the arrays from the bytes (tumble.wire).
+        call = self._raw_frames(request, metadata=self._metadata, timeout=duration)
+        return FrameStream(call, request, count, duration is not None, "frames")
+
+    def snapshot(self):
+        response = self._rpc("Snapshot", pb.SnapshotRequest())
+        return Snapshot(response.step, response.state)
+
+    def restore(self, snapshot):
+        """Restores a Snapshot (or its bytes). Returns {old id: new id} for bodies that got new
+        ids (a snapshot made by another server process); empty when every id was kept."""
+        state = snapshot.state if isinstance(snapshot, Snapshot) else snapshot
+        if not isinstance(state, (bytes, bytearray)):
+            raise ArgumentError(f"snapshot: expected a Snapshot or bytes, got {type(state)!r}",
+                                "restore")
+        return dict(self._rpc("Restore", pb.RestoreRequest(state=bytes(state))).new_ids)
+
+    # --- the connection -----------------------------------------------------------------------
+
+    def close(self):
+        self._channel.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _control(self, request):
+        return self._rpc("Control", request)
+
+    def _wait_until_stopped(self, response, timeout, call):
+        # The server answers at once; the steps asked for (or the one under way) end later.
+        deadline = time.monotonic() + timeout
+        step, running = response.step, response.running
+        while running:
+            if time.monotonic() > deadline:
+                raise Error(grpc.StatusCode.DEADLINE_EXCEEDED,
+                            f"the world did not stop within {timeout} s (at step {step})", call)
+            time.sleep(0.002)
+            info = self._rpc("GetInfo", pb.GetInfoRequest())
+            step, running = info.step, info.running
+        return step
+
+    def _loaded(self, response):
+        return LoadedScene(response.name, list(response.ids))
+
+    def _rpc(self, method, request, timeout=None):
+        try:
+            return getattr(self._stub, method)(request, metadata=self._metadata, timeout=timeout)
+        except grpc.RpcError as error:
+            raise from_rpc(error, method) from None
