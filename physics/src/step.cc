@@ -34,85 +34,108 @@ struct IslandContext {
   std::span<const Body* const> body_of_slot;
 };
 
-void integrate_velocities(const IslandContext& c, double h, IslandReport* report) {
-  for (std::uint32_t slot : c.bodies) {
-    if (!integrate_velocity(*c.body_of_slot[slot], c.scratch.poses[slot].orientation,
-                            c.settings.gravity, h, &c.scratch.bodies[slot]))
-      ++report->gyroscopic_limit_hits;
-  }
-}
-
-void integrate_positions(const IslandContext& c, double h) {
-  for (std::uint32_t slot : c.bodies)
-    integrate_position(h, &c.scratch.bodies[slot], &c.scratch.poses[slot]);
-}
-
-void solve_pgs(const IslandContext& c, double h, IslandReport* report) {
-  warm_start(c.scratch.rows, c.rows, c.scratch.bodies);
-  const SolverSettings& solver = c.settings.solver;
-  for (int i = 0; i < solver.iterations; ++i) {
-    ++report->velocity_iterations;
-    if (solve_contacts(c.scratch.rows, c.rows, c.scratch.blocks, c.scratch.bodies, solver, nullptr,
-                       h, i % 2 == 1) <= solver.velocity_tolerance)
-      break;
-  }
-}
-
-// One step of dt for an island with the solver chosen for it.
-void advance_island(const IslandContext& c, double dt, IslandReport* report) {
-  const SolverSettings& solver = c.settings.solver;
-  std::span<ContactRow> rows = c.scratch.rows;
-  std::span<SolverBody> bodies = c.scratch.bodies;
+// The velocity recipe of one island, written once for every solver and thread count. `run`
+// carries each part out: over the island's rows in order on one thread (SerialIsland, which alone
+// has the exact solver's LCP: exact islands are small), or colour by colour over the whole team
+// (TeamIsland), which differs only in the order in which Gauss-Seidel visits the rows.
+//   soft: per substep, gravity, warm start, iterations with the soft bias, move, relaxation
+//         iterations without it (Catto's "Solver2D" soft step, 2024);
+//   exact: gravity, one LCP (pgs when its answer is refused);
+//   pgs:  gravity, warm start, iterations (then position correction, a later stage);
+//   then the normal residual, the move (soft moved in its substeps) and restitution.
+template <class Runner>
+void advance_with(Runner& run, IslandReport* report, const SolverSettings& solver, double dt) {
   if (report->solver == IslandSolver::kSoft) {
     const int substeps = solver.substeps;
     const double h = dt / substeps;
     // The spring may not be stiffer than the substep can follow (a quarter of its rate).
     const Softness soft =
         contact_softness(std::min(solver.contact_hertz, 0.25 / h), solver.contact_damping_ratio, h);
-    for (int s = 0; s < substeps; ++s) {
-      integrate_velocities(c, h, report);
-      warm_start(rows, c.rows, bodies);
-      for (int i = 0; i < solver.soft_iterations; ++i) {
-        ++report->velocity_iterations;
-        if (solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, &soft, h,
-                           (s + i) % 2 == 1) <= solver.velocity_tolerance)
-          break;
-      }
-      integrate_positions(c, h);
-      for (int i = 0; i < solver.relax_iterations; ++i) {
-        ++report->velocity_iterations;
-        if (solve_contacts(rows, c.rows, c.scratch.blocks, bodies, solver, nullptr, h,
-                           (s + i) % 2 == 0) <= solver.velocity_tolerance)
-          break;
-      }
-      if (s + 1 < substeps)
-        for (std::uint32_t r : c.rows)
-          rows[r].earlier_substeps_impulse += rows[r].normal_impulse;
+    for (int sub = 0; sub < substeps; ++sub) {
+      run.integrate_velocities(h);
+      run.warm_start();
+      for (int i = 0; i < solver.soft_iterations; ++i)
+        if (run.sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
+      run.integrate_positions(h);
+      for (int i = 0; i < solver.relax_iterations; ++i)
+        if (run.sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
+      if (sub + 1 < substeps) run.keep_substep_impulses();
     }
-    report->residual = normal_residual(rows, c.rows, bodies, h);
-    apply_restitution(rows, c.rows, c.scratch.blocks, bodies, solver);
+    run.finish(h);
     return;
   }
-
-  integrate_velocities(c, dt, report);
-  if (report->solver == IslandSolver::kExact && !c.rows.empty()) {
-    const ExactSolveResult exact = solve_contacts_exact(rows, c.rows, bodies, solver, dt);
-    report->lemke_pivots = exact.lemke.pivots;
-    if (!exact.solved()) {
-      report->exact_failed = true;
-      solve_pgs(c, dt, report);
-    } else {
-      report->needs_position_correction = !exact.pushed_out;
-    }
-  } else if (!c.rows.empty()) {
-    solve_pgs(c, dt, report);
+  run.integrate_velocities(dt);
+  bool pgs = run.has_rows();
+  if constexpr (Runner::kSolvesExact) {
+    if (report->solver == IslandSolver::kExact && run.has_rows()) pgs = !run.solve_exact(dt);
   }
-  report->residual = normal_residual(rows, c.rows, bodies, dt);
-  integrate_positions(c, dt);
+  if (pgs) {
+    run.warm_start();
+    for (int i = 0; i < solver.iterations; ++i)
+      if (run.sweep(nullptr, dt, i % 2 == 1) <= solver.velocity_tolerance) break;
+  }
   // After the move, as in the soft path: a body stopped by a speculative contact first lands,
   // then leaves with its bounce.
-  apply_restitution(rows, c.rows, c.scratch.blocks, bodies, solver);
+  run.finish(dt, [&] { run.integrate_positions(dt); });
 }
+
+// advance_with's parts for one island on one thread (any island: exact, soft, pgs).
+class SerialIsland {
+ public:
+  static constexpr bool kSolvesExact = true;
+  SerialIsland(const IslandContext& c, IslandReport* report)
+      : c_(c), report_(report), rows_(c.scratch.rows), bodies_(c.scratch.bodies) {}
+
+  bool has_rows() const { return !c_.rows.empty(); }
+  void integrate_velocities(double h) {
+    for (std::uint32_t slot : c_.bodies) {
+      if (!integrate_velocity(*c_.body_of_slot[slot], c_.scratch.poses[slot].orientation,
+                              c_.settings.gravity, h, &bodies_[slot]))
+        ++report_->gyroscopic_limit_hits;
+    }
+  }
+  void integrate_positions(double h) {
+    for (std::uint32_t slot : c_.bodies)
+      integrate_position(h, &bodies_[slot], &c_.scratch.poses[slot]);
+  }
+  void warm_start() { tumble::warm_start(rows_, c_.rows, bodies_); }
+  double sweep(const Softness* soft, double h, bool backward) {
+    ++report_->velocity_iterations;
+    return solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver, soft, h,
+                          backward);
+  }
+  void keep_substep_impulses() {
+    for (std::uint32_t r : c_.rows)
+      rows_[r].earlier_substeps_impulse += rows_[r].normal_impulse;
+  }
+  // True when the LCP's answer was taken; false when it was refused (then pgs solves the island).
+  bool solve_exact(double dt) {
+    const ExactSolveResult exact =
+        solve_contacts_exact(rows_, c_.rows, bodies_, c_.settings.solver, dt);
+    report_->lemke_pivots = exact.lemke.pivots;
+    if (!exact.solved()) {
+      report_->exact_failed = true;
+      return false;
+    }
+    report_->needs_position_correction = !exact.pushed_out;
+    return true;
+  }
+  // The residual at the velocities solved, then `move` (pgs and exact move here, soft moved in its
+  // substeps), then restitution.
+  template <class Move = void (*)()>
+  void finish(
+      double h, Move move = [] {}) {
+    report_->residual = normal_residual(rows_, c_.rows, bodies_, h);
+    move();
+    apply_restitution(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver);
+  }
+
+ private:
+  const IslandContext& c_;
+  IslandReport* report_;
+  std::span<ContactRow> rows_;
+  std::span<SolverBody> bodies_;
+};
 
 IslandContext island_context(StepScratch& s, const WorldSettings& settings, std::size_t i) {
   return {
@@ -193,70 +216,70 @@ void team_integrate_positions(const IslandContext& c, double h) {
   }
 }
 
-// advance_island for a coloured island (soft or pgs), the same scheme split over the team.
-void team_advance_island(const IslandContext& c, std::uint32_t first, std::uint32_t last, double dt,
-                         IslandReport* report) {
-  StepScratch& s = c.scratch;
-  const SolverSettings& solver = c.settings.solver;
-  const bool lead = omp_get_thread_num() == 0;
-  std::uint64_t iterations = 0;
-  std::uint32_t hits = 0;
-  auto warm = [&](std::span<const std::uint32_t> ids) {
-    warm_start(s.rows, ids, s.bodies);
-    return 0.0;
-  };
-  auto sweep = [&](const Softness* soft, double h, bool backward) {
-    ++iterations;
-    return sweep_colours(s, first, last, backward, [&](std::span<const std::uint32_t> ids) {
-      return solve_contacts(s.rows, ids, s.blocks, s.bodies, solver, soft, h, false);
+// advance_with's parts for a coloured island (soft or pgs) over the whole team: every member
+// is called by every thread of the team and contains the worksharing.
+class TeamIsland {
+ public:
+  static constexpr bool kSolvesExact = false;
+  TeamIsland(const IslandContext& c, std::uint32_t first, std::uint32_t last, IslandReport* report)
+      : c_(c), s_(c.scratch), first_(first), last_(last), report_(report) {}
+
+  bool has_rows() const { return true; }  // coloured islands have many
+  void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
+  void integrate_positions(double h) { team_integrate_positions(c_, h); }
+  void warm_start() {
+    each_manifold(
+        [&](std::span<const std::uint32_t> ids) { tumble::warm_start(s_.rows, ids, s_.bodies); });
+  }
+  double sweep(const Softness* soft, double h, bool backward) {
+    ++iterations_;
+    return sweep_colours(s_, first_, last_, backward, [&](std::span<const std::uint32_t> ids) {
+      return solve_contacts(s_.rows, ids, s_.blocks, s_.bodies, c_.settings.solver, soft, h, false);
     });
-  };
-  auto add_substep_impulse = [&](std::span<const std::uint32_t> ids) {
-    for (std::uint32_t r : ids)
-      s.rows[r].earlier_substeps_impulse += s.rows[r].normal_impulse;
-    return 0.0;
-  };
-  double h = dt;
-  if (report->solver == IslandSolver::kSoft) {
-    h = dt / solver.substeps;
-    const Softness soft =
-        contact_softness(std::min(solver.contact_hertz, 0.25 / h), solver.contact_damping_ratio, h);
-    for (int sub = 0; sub < solver.substeps; ++sub) {
-      hits += team_integrate_velocities(c, h);
-      sweep_colours(s, first, last, false, warm, false);
-      for (int i = 0; i < solver.soft_iterations; ++i)
-        if (sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
-      team_integrate_positions(c, h);
-      for (int i = 0; i < solver.relax_iterations; ++i)
-        if (sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
-      if (sub + 1 < solver.substeps)
-        sweep_colours(s, first, last, false, add_substep_impulse, false);
-    }
-  } else {
-    hits += team_integrate_velocities(c, dt);
-    sweep_colours(s, first, last, false, warm, false);
-    for (int i = 0; i < solver.iterations; ++i)
-      if (sweep(nullptr, dt, i % 2 == 1) <= solver.velocity_tolerance) break;
   }
-  const double residual =
-      sweep_colours(s, first, last, false, [&](std::span<const std::uint32_t> ids) {
-        return normal_residual(s.rows, ids, s.bodies, h);
-      });
-  if (report->solver != IslandSolver::kSoft) team_integrate_positions(c, dt);
-  sweep_colours(
-      s, first, last, false,
-      [&](std::span<const std::uint32_t> ids) {
-        apply_restitution(s.rows, ids, s.blocks, s.bodies, solver);
-        return 0.0;
-      },
-      false);
+  void keep_substep_impulses() {
+    each_manifold([&](std::span<const std::uint32_t> ids) {
+      for (std::uint32_t r : ids)
+        s_.rows[r].earlier_substeps_impulse += s_.rows[r].normal_impulse;
+    });
+  }
+  template <class Move = void (*)()>
+  void finish(
+      double h, Move move = [] {}) {
+    const double residual =
+        sweep_colours(s_, first_, last_, false, [&](std::span<const std::uint32_t> ids) {
+          return normal_residual(s_.rows, ids, s_.bodies, h);
+        });
+    move();
+    each_manifold([&](std::span<const std::uint32_t> ids) {
+      apply_restitution(s_.rows, ids, s_.blocks, s_.bodies, c_.settings.solver);
+    });
 #pragma omp atomic
-  report->gyroscopic_limit_hits += hits;
-  if (lead) {
-    report->velocity_iterations = iterations;
-    report->residual = residual;
+    report_->gyroscopic_limit_hits += hits_;
+    if (omp_get_thread_num() == 0) {
+      report_->velocity_iterations = iterations_;
+      report_->residual = residual;
+    }
   }
-}
+
+ private:
+  template <class Fn>
+  void each_manifold(Fn&& fn) {
+    sweep_colours(
+        s_, first_, last_, false,
+        [&](std::span<const std::uint32_t> ids) {
+          fn(ids);
+          return 0.0;
+        },
+        false);
+  }
+  const IslandContext& c_;
+  StepScratch& s_;
+  std::uint32_t first_, last_;
+  IslandReport* report_;
+  std::uint64_t iterations_ = 0;
+  std::uint32_t hits_ = 0;
+};
 
 }  // namespace
 
@@ -457,12 +480,17 @@ void World::solve_islands(double dt) {
   // islands share no body and no row, and colours share no moving body, so any thread count gives
   // the same bits.
   run_region(threads, parallel, [&] {
-    for (std::uint32_t i : s.team_islands)
-      team_advance_island(island_context(s, settings_, i), s.island_colour_begin[i],
-                          s.island_colour_begin[i + 1], dt, &s.reports[i]);
+    for (std::uint32_t i : s.team_islands) {
+      const IslandContext context = island_context(s, settings_, i);
+      TeamIsland team(context, s.island_colour_begin[i], s.island_colour_begin[i + 1],
+                      &s.reports[i]);
+      advance_with(team, &s.reports[i], settings_.solver, dt);
+    }
     team_for_dynamic(singles, [&](std::int64_t k) {
       const std::uint32_t i = s.single_islands[k];
-      advance_island(island_context(s, settings_, i), dt, &s.reports[i]);
+      const IslandContext context = island_context(s, settings_, i);
+      SerialIsland island(context, &s.reports[i]);
+      advance_with(island, &s.reports[i], settings_.solver, dt);
     });
   });
   for (const IslandReport& report : s.reports) {
