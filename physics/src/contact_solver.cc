@@ -35,7 +35,7 @@ bool less_pair(const CachedImpulse& c, BodyId a, BodyId b) {
 
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
                   const Body& b, std::span<const CachedImpulse> cache, std::uint32_t block_index,
-                  ContactRow* rows, NormalBlock* block) {
+                  ContactRow* rows, ContactRowCold* cold, NormalBlock* block) {
   const Vec3& n = manifold.normal;
   const double friction = std::sqrt(a.friction * b.friction);
   const double restitution = std::max(a.restitution, b.restitution);
@@ -49,38 +49,39 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   for (int i = 0; i < manifold.count; ++i) {
     const ContactPoint& point = manifold.points[i];
     ContactRow row;
+    ContactRowCold far;
     row.a = id_a.index;
     row.b = id_b.index;
     row.normal = n;
-    row.ra = point.point_a - a.position;
-    row.rb = point.point_b - b.position;
-    row.local_a = ra_to_local * row.ra;
-    row.local_b = rb_to_local * row.rb;
+    far.ra = point.point_a - a.position;
+    far.rb = point.point_b - b.position;
+    far.local_a = ra_to_local * far.ra;
+    far.local_b = rb_to_local * far.rb;
     row.separation = -point.depth;
     row.friction = friction;
-    row.restitution = restitution;
-    row.feature = point.feature_id;
+    far.restitution = restitution;
+    far.feature = point.feature_id;
     row.manifold = block_index;
     row.block_index = static_cast<std::uint8_t>(i);
     row.block_size = static_cast<std::uint8_t>(manifold.count);
 
-    const Vec3 dv = b.linear_velocity + b.angular_velocity.cross(row.rb) - a.linear_velocity -
-                    a.angular_velocity.cross(row.ra);
-    row.relative_velocity = dv.dot(n);
+    const Vec3 dv = b.linear_velocity + b.angular_velocity.cross(far.rb) - a.linear_velocity -
+                    a.angular_velocity.cross(far.ra);
+    far.relative_velocity = dv.dot(n);
     // Friction along the sliding direction when sliding: a sliding body then feels exactly the
     // Coulomb force, whatever its direction (no bias from the basis).
-    const Vec3 slip = dv - row.relative_velocity * n;
+    const Vec3 slip = dv - far.relative_velocity * n;
     const double slip_speed = slip.norm();
     row.tangent1 = slip_speed > kSlidingSpeed ? Vec3(slip / slip_speed) : any_perpendicular(n);
     row.tangent2 = n.cross(row.tangent1);
-    row.ra_cross_n = row.ra.cross(n);
-    row.rb_cross_n = row.rb.cross(n);
+    row.ra_cross_n = far.ra.cross(n);
+    row.rb_cross_n = far.rb.cross(n);
     row.angular_a = a.inverse_inertia_world * row.ra_cross_n;
     row.angular_b = b.inverse_inertia_world * row.rb_cross_n;
-    row.ra_cross_t1 = row.ra.cross(row.tangent1);
-    row.rb_cross_t1 = row.rb.cross(row.tangent1);
-    row.ra_cross_t2 = row.ra.cross(row.tangent2);
-    row.rb_cross_t2 = row.rb.cross(row.tangent2);
+    row.ra_cross_t1 = far.ra.cross(row.tangent1);
+    row.rb_cross_t1 = far.rb.cross(row.tangent1);
+    row.ra_cross_t2 = far.ra.cross(row.tangent2);
+    row.rb_cross_t2 = far.rb.cross(row.tangent2);
     row.angular_a_t1 = a.inverse_inertia_world * row.ra_cross_t1;
     row.angular_b_t1 = b.inverse_inertia_world * row.rb_cross_t1;
     row.angular_a_t2 = a.inverse_inertia_world * row.ra_cross_t2;
@@ -98,11 +99,11 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     const CachedImpulse* match = nullptr;
     double nearest = match_distance * match_distance;
     for (auto it = first; it != cache.end() && it->a == id_a && it->b == id_b; ++it) {
-      if (it->feature == row.feature) {
+      if (it->feature == far.feature) {
         match = &*it;
         break;
       }
-      const double d2 = (it->local_a - row.local_a).squaredNorm();
+      const double d2 = (it->local_a - far.local_a).squaredNorm();
       if (d2 < nearest) {
         nearest = d2;
         match = &*it;
@@ -114,6 +115,7 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
       row.tangent_impulse2 = match->friction.dot(row.tangent2);
     }
     rows[i] = row;
+    cold[i] = far;
   }
 
   NormalBlock normal_block;
@@ -154,13 +156,14 @@ Softness contact_softness(double hertz, double damping_ratio, double h) {
   return {omega / a1, a2 * a3, a3};
 }
 
-void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                std::span<SolverBody> bodies) {
+void warm_start(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,
+                std::span<const std::uint32_t> ids, std::span<SolverBody> bodies) {
   for (std::uint32_t id : ids) {
     const ContactRow& row = rows[id];
     apply_normal_impulse(row, row.normal_impulse, bodies);
     if (row.tangent_impulse1 != 0 || row.tangent_impulse2 != 0)
-      apply_impulse(row, row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2,
+      apply_impulse(row, cold[id],
+                    row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2,
                     bodies);
   }
 }
@@ -299,12 +302,17 @@ double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t>
   return change;
 }
 
-void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                       std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                       const SolverSettings& settings) {
-  auto bounces = [&](const ContactRow& row) {
-    return row.restitution > 0 && row.relative_velocity < -settings.restitution_threshold &&
-           row.max_normal_impulse > 0;
+void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,
+                       std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
+                       std::span<SolverBody> bodies, const SolverSettings& settings) {
+  auto bounces = [&](std::uint32_t id) {
+    return cold[id].restitution > 0 &&
+           cold[id].relative_velocity < -settings.restitution_threshold &&
+           rows[id].max_normal_impulse > 0;
+  };
+  // The normal velocity restitution asks of a row: e times the approach velocity.
+  auto rebound = [&](std::uint32_t id) {
+    return cold[id].restitution * cold[id].relative_velocity;
   };
   for (std::size_t k = 0; k < ids.size();) {
     const int count = rows[ids[k]].block_size;
@@ -312,15 +320,14 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
     k += count;
     int bouncing = 0;
     for (int i = 0; i < count; ++i)
-      bouncing += bounces(rows[block[i]]) ? 1 : 0;
+      bouncing += bounces(block[i]) ? 1 : 0;
     if (bouncing == 0) continue;
     // A face landing flat bounces as one: the block solve gives every corner its target at
     // once, where single points would each undo part of the others' work.
     if (bouncing == count && count > 1) {
       Eigen::Vector4d error = Eigen::Vector4d::Zero();
       for (int i = 0; i < count; ++i) {
-        const ContactRow& row = rows[block[i]];
-        error[i] = normal_velocity(row, bodies) + row.restitution * row.relative_velocity;
+        error[i] = normal_velocity(rows[block[i]], bodies) + rebound(block[i]);
       }
       const Eigen::Vector4d step = blocks[rows[block[0]].manifold].inverse * error;
       bool feasible = true;
@@ -336,10 +343,10 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
       }
     }
     for (int i = 0; i < count; ++i) {
+      if (!bounces(block[i])) continue;
       ContactRow& row = rows[block[i]];
-      if (!bounces(row)) continue;
       const double vn = normal_velocity(row, bodies);
-      const double delta = -row.normal_mass * (vn + row.restitution * row.relative_velocity);
+      const double delta = -row.normal_mass * (vn + rebound(block[i]));
       const double updated = std::max(row.normal_impulse + delta, 0.0);
       apply_normal_impulse(row, updated - row.normal_impulse, bodies);
       row.normal_impulse = updated;
@@ -347,15 +354,15 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t
   }
 }
 
-void correct_positions(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
-                       std::span<const SolverBody> bodies, std::span<Pose> poses,
-                       const SolverSettings& settings) {
+void correct_positions(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,
+                       std::span<const std::uint32_t> ids, std::span<const SolverBody> bodies,
+                       std::span<Pose> poses, const SolverSettings& settings) {
   for (std::uint32_t id : ids) {
     const ContactRow& row = rows[id];
     Pose& pa = poses[row.a];
     Pose& pb = poses[row.b];
-    const Vec3 ra = pa.orientation * row.local_a;
-    const Vec3 rb = pb.orientation * row.local_b;
+    const Vec3 ra = pa.orientation * cold[id].local_a;
+    const Vec3 rb = pb.orientation * cold[id].local_b;
     const double separation = (pb.position + rb - pa.position - ra).dot(row.normal);
     const double error = std::clamp(settings.baumgarte * (separation + settings.slop),
                                     -settings.max_correction, 0.0);

@@ -39,30 +39,39 @@ struct SolverBody {
   Vec3 w_free = Vec3::Zero();
 };
 
-// One contact point between bodies `a` and `b` (slot indices).
+// One contact point between bodies `a` and `b` (slot indices): what the velocity sweeps read and
+// write, every sweep (the rest is in ContactRowCold, so that the sweeps stream through less).
 struct ContactRow {
   std::uint32_t a = 0, b = 0;
   Vec3 normal, tangent1, tangent2;  // world; normal from a to b
-  Vec3 ra, rb;                      // lever arms from the centres of mass at the step start
-  // ra x n, rb x n and the inverse inertias applied to them: the normal row's angular parts.
+  // ra x n, rb x n (ra, rb: the lever arms from the centres of mass at the step start) and the
+  // inverse inertias applied to them: the normal row's angular parts.
   Vec3 ra_cross_n, rb_cross_n, angular_a, angular_b;
   // The same for the two tangent rows.
   Vec3 ra_cross_t1, rb_cross_t1, ra_cross_t2, rb_cross_t2;
   Vec3 angular_a_t1, angular_b_t1, angular_a_t2, angular_b_t2;
-  Vec3 local_a, local_b;  // the same anchors in body axes, for position correction
   double separation = 0;  // m at the step start; < 0 overlapping
   double normal_mass = 0, tangent_mass1 = 0, tangent_mass2 = 0;
-  double friction = 0, restitution = 0;
-  double relative_velocity = 0;  // normal velocity at the step start, m/s
+  double friction = 0;
   double normal_impulse = 0, tangent_impulse1 = 0, tangent_impulse2 = 0;
   double max_normal_impulse = 0;
+  std::uint32_t manifold = 0;                    // index of its NormalBlock
+  std::uint8_t block_index = 0, block_size = 1;  // place among its manifold's rows
+};
+
+// What a contact point needs outside the sweeps, row for row beside ContactRow: the warm start and
+// the exact solver (lever arms), restitution (once a step), position correction and matching the
+// next step's points to this step's impulses (anchors in body axes, feature id).
+struct ContactRowCold {
+  Vec3 ra, rb;            // lever arms from the centres of mass at the step start, world
+  Vec3 local_a, local_b;  // the same anchors in body axes
+  std::uint64_t feature = 0;
+  double restitution = 0;
+  double relative_velocity = 0;  // normal velocity at the step start, m/s
   // Soft solver: the normal impulses of the step's substeps before the last. Each substep starts
   // from the last one's impulse (warm start) and ends with its own in normal_impulse, so the
   // step's whole impulse, which is what the world reports, is this sum plus normal_impulse.
   double earlier_substeps_impulse = 0;
-  std::uint64_t feature = 0;
-  std::uint32_t manifold = 0;                    // index of its NormalBlock
-  std::uint8_t block_index = 0, block_size = 1;  // place among its manifold's rows
 };
 
 // The normal rows of one manifold solved together: K = J A J^T over its points and the inverse of
@@ -76,12 +85,13 @@ struct NormalBlock {
 // Impulses of the last step, looked up by body pair and feature to warm-start the next one.
 using CachedImpulse = WarmStartImpulse;
 
-// Writes the manifold.count rows of one manifold to `rows` and its block to `block`, which is
+// Writes the manifold.count rows of one manifold to `rows` and `cold` and its block to `block`,
+// which is
 // blocks[block_index]. `cache` is sorted by (a, b); a row starts from the impulse of the cached
 // point with its feature id, or else of the nearest cached point close enough.
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
                   const Body& b, std::span<const CachedImpulse> cache, std::uint32_t block_index,
-                  ContactRow* rows, NormalBlock* block);
+                  ContactRow* rows, ContactRowCold* cold, NormalBlock* block);
 
 // Spring parameters of a soft contact over a substep h (Catto 2011, "Soft constraints").
 struct Softness {
@@ -89,8 +99,8 @@ struct Softness {
 };
 Softness contact_softness(double hertz, double damping_ratio, double h);
 
-void warm_start(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                std::span<SolverBody> bodies);
+void warm_start(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,
+                std::span<const std::uint32_t> ids, std::span<SolverBody> bodies);
 
 // One Gauss-Seidel sweep. With `soft` set, penetration beyond the slop is pushed out through the
 // spring; without it contacts are rigid and only gaps (speculative contacts) add bias. Sweeps
@@ -102,15 +112,15 @@ double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t>
                       bool backward);
 
 // Gives bouncing contacts their outgoing velocity, e times the approach velocity.
-void apply_restitution(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                       std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                       const SolverSettings& settings);
+void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,
+                       std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
+                       std::span<SolverBody> bodies, const SolverSettings& settings);
 
 // Nonlinear Gauss-Seidel on positions (Catto, Box2D 2.x): moves bodies out of penetration
 // without touching velocities.
-void correct_positions(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
-                       std::span<const SolverBody> bodies, std::span<Pose> poses,
-                       const SolverSettings& settings);
+void correct_positions(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,
+                       std::span<const std::uint32_t> ids, std::span<const SolverBody> bodies,
+                       std::span<Pose> poses, const SolverSettings& settings);
 
 // |min(impulse / effective mass, normal velocity - target)| over the normal rows, m/s.
 double normal_residual(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
@@ -124,17 +134,17 @@ inline double normal_velocity(const ContactRow& row, std::span<const SolverBody>
 
 // Static bodies (inverse mass 0) are never written: islands and colours solved in parallel
 // share them.
-inline void apply_impulse(const ContactRow& row, const Vec3& impulse,
+inline void apply_impulse(const ContactRow& row, const ContactRowCold& cold, const Vec3& impulse,
                           std::span<SolverBody> bodies) {
   SolverBody& a = bodies[row.a];
   SolverBody& b = bodies[row.b];
   if (a.inverse_mass > 0) {
     a.v -= a.inverse_mass * impulse;
-    a.w -= a.inverse_inertia * row.ra.cross(impulse);
+    a.w -= a.inverse_inertia * cold.ra.cross(impulse);
   }
   if (b.inverse_mass > 0) {
     b.v += b.inverse_mass * impulse;
-    b.w += b.inverse_inertia * row.rb.cross(impulse);
+    b.w += b.inverse_inertia * cold.rb.cross(impulse);
   }
 }
 

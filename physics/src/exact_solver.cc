@@ -15,13 +15,13 @@ struct Jacobian {
   Eigen::Matrix<double, 6, 1> aj[2];
 };
 
-Jacobian make_jacobian(const ContactRow& row, const Vec3& direction,
+Jacobian make_jacobian(const ContactRow& row, const ContactRowCold& cold, const Vec3& direction,
                        std::span<const SolverBody> bodies) {
   Jacobian out;
   out.body[0] = row.a;
   out.body[1] = row.b;
-  out.j[0] << -direction, -row.ra.cross(direction);
-  out.j[1] << direction, row.rb.cross(direction);
+  out.j[0] << -direction, -cold.ra.cross(direction);
+  out.j[1] << direction, cold.rb.cross(direction);
   for (int s = 0; s < 2; ++s) {
     const SolverBody& body = bodies[out.body[s]];
     out.aj[s] << body.inverse_mass * out.j[s].head<3>(), body.inverse_inertia * out.j[s].tail<3>();
@@ -140,6 +140,7 @@ double exact_velocity_error(const Eigen::Ref<const Eigen::MatrixXd>& m,
 }
 
 ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
+                                      std::span<const ContactRowCold> cold,
                                       std::span<const std::uint32_t> ids,
                                       std::span<SolverBody> bodies, const SolverSettings& settings,
                                       double h) {
@@ -157,13 +158,13 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
   std::vector<Jacobian>& jac = workspace.jacobians;
   jac.clear();
   for (std::uint32_t id : ids)
-    jac.push_back(make_jacobian(rows[id], rows[id].normal, bodies));
+    jac.push_back(make_jacobian(rows[id], cold[id], rows[id].normal, bodies));
   for (std::uint32_t id : ids) {
     const ContactRow& row = rows[id];
     for (int j = 0; j < k; ++j) {
       const double angle = 2 * std::numbers::pi * j / k;
       const Vec3 d = std::cos(angle) * row.tangent1 + std::sin(angle) * row.tangent2;
-      jac.push_back(make_jacobian(row, d, bodies));
+      jac.push_back(make_jacobian(row, cold[id], d, bodies));
     }
   }
 

@@ -44,6 +44,7 @@ double exact_velocity_error(const Eigen::Ref<const Eigen::MatrixXd>& m,
 // settings.exact_velocity_tolerance is a failure (kInaccurate). On success, penetration is
 // pushed out through the bodies' pseudo-velocities (push_v, push_w), not their velocities.
 ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
+                                      std::span<const ContactRowCold> cold,
                                       std::span<const std::uint32_t> ids,
                                       std::span<SolverBody> bodies, const SolverSettings& settings,
                                       double h);

@@ -84,7 +84,11 @@ class SerialIsland {
  public:
   static constexpr bool kSolvesExact = true;
   SerialIsland(const IslandContext& c, IslandReport* report)
-      : c_(c), report_(report), rows_(c.scratch.rows), bodies_(c.scratch.bodies) {}
+      : c_(c),
+        report_(report),
+        rows_(c.scratch.rows),
+        cold_(c.scratch.cold_rows),
+        bodies_(c.scratch.bodies) {}
 
   bool has_rows() const { return !c_.rows.empty(); }
   void integrate_velocities(double h) {
@@ -98,7 +102,7 @@ class SerialIsland {
     for (std::uint32_t slot : c_.bodies)
       integrate_position(h, &bodies_[slot], &c_.scratch.poses[slot]);
   }
-  void warm_start() { tumble::warm_start(rows_, c_.rows, bodies_); }
+  void warm_start() { tumble::warm_start(rows_, cold_, c_.rows, bodies_); }
   double sweep(const Softness* soft, double h, bool backward) {
     ++report_->velocity_iterations;
     return solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver, soft, h,
@@ -106,12 +110,12 @@ class SerialIsland {
   }
   void keep_substep_impulses() {
     for (std::uint32_t r : c_.rows)
-      rows_[r].earlier_substeps_impulse += rows_[r].normal_impulse;
+      cold_[r].earlier_substeps_impulse += rows_[r].normal_impulse;
   }
   // True when the LCP's answer was taken; false when it was refused (then pgs solves the island).
   bool solve_exact(double dt) {
     const ExactSolveResult exact =
-        solve_contacts_exact(rows_, c_.rows, bodies_, c_.settings.solver, dt);
+        solve_contacts_exact(rows_, cold_, c_.rows, bodies_, c_.settings.solver, dt);
     report_->lemke_pivots = exact.lemke.pivots;
     if (!exact.solved()) {
       report_->exact_failed = true;
@@ -127,13 +131,14 @@ class SerialIsland {
       double h, Move move = [] {}) {
     report_->residual = normal_residual(rows_, c_.rows, bodies_, h);
     move();
-    apply_restitution(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver);
+    apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver);
   }
 
  private:
   const IslandContext& c_;
   IslandReport* report_;
   std::span<ContactRow> rows_;
+  std::span<ContactRowCold> cold_;
   std::span<SolverBody> bodies_;
 };
 
@@ -228,8 +233,9 @@ class TeamIsland {
   void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
   void integrate_positions(double h) { team_integrate_positions(c_, h); }
   void warm_start() {
-    each_manifold(
-        [&](std::span<const std::uint32_t> ids) { tumble::warm_start(s_.rows, ids, s_.bodies); });
+    each_manifold([&](std::span<const std::uint32_t> ids) {
+      tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies);
+    });
   }
   double sweep(const Softness* soft, double h, bool backward) {
     ++iterations_;
@@ -240,7 +246,7 @@ class TeamIsland {
   void keep_substep_impulses() {
     each_manifold([&](std::span<const std::uint32_t> ids) {
       for (std::uint32_t r : ids)
-        s_.rows[r].earlier_substeps_impulse += s_.rows[r].normal_impulse;
+        s_.cold_rows[r].earlier_substeps_impulse += s_.rows[r].normal_impulse;
     });
   }
   template <class Move = void (*)()>
@@ -252,7 +258,7 @@ class TeamIsland {
         });
     move();
     each_manifold([&](std::span<const std::uint32_t> ids) {
-      apply_restitution(s_.rows, ids, s_.blocks, s_.bodies, c_.settings.solver);
+      apply_restitution(s_.rows, s_.cold_rows, ids, s_.blocks, s_.bodies, c_.settings.solver);
     });
 #pragma omp atomic
     report_->gyroscopic_limit_hits += hits_;
@@ -375,6 +381,7 @@ void World::prepare_contacts(double /*dt*/) {
     deepest = std::max(deepest, contact.manifold.depth);
   }
   s.rows.resize(s.row_begin[manifolds]);
+  s.cold_rows.resize(s.rows.size());
   s.blocks.resize(manifolds);
   if (s.row_ids.size() < s.rows.size()) {
     const std::size_t from = s.row_ids.size();
@@ -387,7 +394,7 @@ void World::prepare_contacts(double /*dt*/) {
     const Contact& contact = contacts_[m];
     prepare_rows(contact.manifold, contact.a, bodies_[contact.a.index].body, contact.b,
                  bodies_[contact.b.index].body, s.cache, static_cast<std::uint32_t>(m),
-                 &s.rows[s.row_begin[m]], &s.blocks[m]);
+                 &s.rows[s.row_begin[m]], &s.cold_rows[s.row_begin[m]], &s.blocks[m]);
   });
   build_islands(s.dynamic, s.links, &s.islands);
 
@@ -531,7 +538,7 @@ void World::correct_positions() {
         sweep_colours(
             s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
             [&](std::span<const std::uint32_t> ids) {
-              tumble::correct_positions(s.rows, ids, s.bodies, s.poses, solver);
+              tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses, solver);
               return 0.0;
             },
             false);
@@ -541,7 +548,7 @@ void World::correct_positions() {
       if (!needs_correction(i)) return;
       const auto rows = island_context(s, settings_, i).rows;
       for (int n = 0; n < solver.position_iterations; ++n)
-        tumble::correct_positions(s.rows, rows, s.bodies, s.poses, solver);
+        tumble::correct_positions(s.rows, s.cold_rows, rows, s.bodies, s.poses, solver);
     });
   });
 }
@@ -614,13 +621,14 @@ void World::finish_step(double dt) {
     for (std::int64_t m = 0; m < manifolds; ++m) {
       for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r) {
         const ContactRow& row = s.rows[r];
+        const ContactRowCold& cold = s.cold_rows[r];
         s.cache[r] = {contacts_[m].a,
                       contacts_[m].b,
-                      row.feature,
-                      row.local_a,
+                      cold.feature,
+                      cold.local_a,
                       row.normal_impulse,
                       row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2};
-        impulses_[r] = row.earlier_substeps_impulse + row.normal_impulse;
+        impulses_[r] = cold.earlier_substeps_impulse + row.normal_impulse;
       }
     }
   });

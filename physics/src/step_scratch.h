@@ -30,10 +30,11 @@ struct StepScratch {
   std::vector<SolverBody> bodies;  // by slot
   std::vector<Pose> poses;         // by slot
   std::vector<std::uint8_t> dynamic;
-  std::vector<ContactRow> rows;          // manifold order
-  std::vector<NormalBlock> blocks;       // one per manifold
-  std::vector<std::uint32_t> row_begin;  // rows of manifold m: [row_begin[m], row_begin[m+1])
-  std::vector<IslandLink> links;         // one per manifold
+  std::vector<ContactRow> rows;           // manifold order
+  std::vector<ContactRowCold> cold_rows;  // beside rows, row for row
+  std::vector<NormalBlock> blocks;        // one per manifold
+  std::vector<std::uint32_t> row_begin;   // rows of manifold m: [row_begin[m], row_begin[m+1])
+  std::vector<IslandLink> links;          // one per manifold
   Islands islands;
   std::vector<std::uint32_t> island_rows;  // row ids, island by island
   std::vector<std::uint32_t> island_row_begin;
