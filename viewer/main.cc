@@ -34,8 +34,9 @@ int main(int argc, char** argv) {
   bool contacts = false;
   app.add_flag("--contacts", contacts, "draw contact points and normals");
   app.add_flag("--offscreen", offscreen, "render with OSMesa into PNG files (no display needed)");
-  app.add_option("--screenshot", screenshot,
-                 "window: save the picture after --frames drawn frames into this PNG and close");
+  app.add_option(
+      "--screenshot", screenshot,
+      "window: save the picture after --frames pictures of the world into this PNG and close");
   app.add_option("--out", out_dir, "folder for the PNG frames");
   app.add_option("--frames", frames, "how many pictures to write")->check(CLI::PositiveNumber);
   app.add_option("--every", every, "draw every Nth frame received")->check(CLI::PositiveNumber);

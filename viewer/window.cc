@@ -140,9 +140,10 @@ int run_window(client::Client& client, const WindowOptions& options) {
         }
         v1::Frame frame;
         while (!closing && stream.next(&frame)) {
-          connected = true;
           std::lock_guard lock(mutex);
           view.apply(frame);
+          // Under the lock and after the frame: a picture drawn while `connected` shows a world.
+          connected = true;
         }
         {
           std::lock_guard lock(mutex);
@@ -189,6 +190,7 @@ int run_window(client::Client& client, const WindowOptions& options) {
       std::uint64_t step = 0;
       double time = 0;
       std::size_t bodies = 0;
+      bool showing_world = false;
       {
         std::lock_guard lock(mutex);
         if (input.follow_next > 0) {
@@ -201,13 +203,16 @@ int run_window(client::Client& client, const WindowOptions& options) {
         if (input.contact_toggles % 2 == 1) contacts = !contacts;
         input.contact_toggles = 0;
         instances = view.instances(renderer, contacts);
+        showing_world = connected;
         step = view.step();
         time = view.time();
         bodies = view.body_count();
       }
       renderer.draw(instances, orbit.camera(options.camera), lighting, width, height);
-      ++drawn;
-      if (!options.screenshot.empty() && drawn >= options.frames && connected) {
+      // The screenshot counts pictures of the world only: a loaded machine may draw several
+      // before the first frame arrives.
+      if (showing_world) ++drawn;
+      if (!options.screenshot.empty() && drawn >= options.frames) {
         std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
         gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
         gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());

@@ -36,6 +36,7 @@ bool less_pair(const CachedImpulse& c, BodyId a, BodyId b) {
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
                   const Body& b, std::span<const CachedImpulse> cache, std::uint32_t block_index,
                   ContactRow* rows, ContactRowCold* cold, NormalBlock* block) {
+  TUMBLE_ASSERT(manifold.count >= 1 && manifold.count <= 4);
   const Vec3& n = manifold.normal;
   const double friction = std::sqrt(a.friction * b.friction);
   const double restitution = std::max(a.restitution, b.restitution);

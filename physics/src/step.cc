@@ -595,6 +595,8 @@ void World::finish_step(double dt) {
   const int threads = team_size(settings_.threads);
   const std::int64_t slots = static_cast<std::int64_t>(bodies_.size());
   const std::int64_t manifolds = static_cast<std::int64_t>(contacts_.size());
+  TUMBLE_ASSERT(s.cold_rows.size() == s.rows.size() && s.row_begin.size() == contacts_.size() + 1 &&
+                s.row_begin.back() == s.rows.size());
   // Impulses for the next step's warm start, sorted by body pair as the contacts are.
   s.cache.resize(s.rows.size());
   impulses_.resize(s.rows.size());

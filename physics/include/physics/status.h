@@ -2,13 +2,25 @@
 // names what is wrong; programmer misuse is an assert (TUMBLE_ASSERT).
 #pragma once
 
-#include <cassert>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
 
-#define TUMBLE_ASSERT(condition) assert(condition)
+namespace tumble {
+// Prints what failed and where, then aborts.
+[[noreturn]] void internal_check_failed(const char* condition, const char* file, int line);
+}  // namespace tumble
+
+// Programmer misuse and broken invariants. On in Debug and RelWithDebInfo, and so in the sanitizer
+// builds, whatever NDEBUG says (CMake defines TUMBLE_ASSERTS=1 for those); off in Release, where
+// the step's cost is measured. The condition is not evaluated when off.
+#if TUMBLE_ASSERTS
+#define TUMBLE_ASSERT(condition) \
+  ((condition) ? void(0) : ::tumble::internal_check_failed(#condition, __FILE__, __LINE__))
+#else
+#define TUMBLE_ASSERT(condition) ((void)sizeof(!(condition)))
+#endif
 
 namespace tumble {
 
