@@ -93,42 +93,41 @@ class Frame:
         protobuf; anything unexpected in the bytes is left to protobuf entirely."""
         try:
             chunks, rest = wire.split(data, (3, 4, 5, 6, 7, 8))
-            message = pb.Frame.FromString(rest)
-            return Frame(
-                step=message.step,
-                time=message.time,
+            return Frame._assembled(
+                pb.Frame.FromString(rest), stats,
                 ids=wire.varints(chunks[3]),
                 positions=wire.doubles(chunks[4], 3),
                 orientations=wire.doubles(chunks[5], 4),
                 linear_velocities=wire.doubles(chunks[6], 3) if velocities else None,
                 angular_velocities=wire.doubles(chunks[7], 3) if velocities else None,
                 # Several chunks of one message field merge: their bytes concatenate.
-                contacts=Contacts.from_bytes(b"".join(chunks[8])) if contacts else None,
-                stats=plain(message.stats) if stats else None,
-                added=[Description.from_proto(d) for d in message.added],
-                removed=list(message.removed),
-                dropped=message.dropped,
-                stepped_at_unix_ns=message.stepped_at_unix_ns,
-            )
+                contacts=Contacts.from_bytes(b"".join(chunks[8])) if contacts else None)
         except ValueError:
             return Frame.from_proto(pb.Frame.FromString(data), velocities, contacts, stats)
 
     @staticmethod
     def from_proto(frame, velocities, contacts, stats):
-        return Frame(
-            step=frame.step,
-            time=frame.time,
+        return Frame._assembled(
+            frame, stats,
             ids=np.array(frame.ids, dtype=np.uint64),
             positions=_rows(frame.positions, 3),
             orientations=_rows(frame.orientations, 4),
             linear_velocities=_rows(frame.linear_velocities, 3) if velocities else None,
             angular_velocities=_rows(frame.angular_velocities, 3) if velocities else None,
-            contacts=Contacts.from_proto(frame.contacts) if contacts else None,
-            stats=plain(frame.stats) if stats else None,
-            added=[Description.from_proto(d) for d in frame.added],
-            removed=list(frame.removed),
-            dropped=frame.dropped,
-            stepped_at_unix_ns=frame.stepped_at_unix_ns,
+            contacts=Contacts.from_proto(frame.contacts) if contacts else None)
+
+    @staticmethod
+    def _assembled(message, stats, **arrays):
+        """The frame of the arrays given and of `message`'s other fields."""
+        return Frame(
+            step=message.step,
+            time=message.time,
+            stats=plain(message.stats) if stats else None,
+            added=[Description.from_proto(d) for d in message.added],
+            removed=list(message.removed),
+            dropped=message.dropped,
+            stepped_at_unix_ns=message.stepped_at_unix_ns,
+            **arrays,
         )
 
 
