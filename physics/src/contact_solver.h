@@ -20,15 +20,17 @@
 
 namespace tumble {
 
-// Velocities and what the solvers need of a body, kept compact; statics have zero inverse mass.
+// Velocities and what the solvers need of a body; statics have zero inverse mass. What every
+// sweep reads (velocities, inverse mass, motion since the step start) comes first, in two cache
+// lines; the rest is read once a substep or less.
 struct SolverBody {
   Vec3 v = Vec3::Zero(), w = Vec3::Zero();
   double inverse_mass = 0;
-  Mat3 inverse_inertia = Mat3::Zero();  // world, fixed during the step
   // Motion since the start of the step, for the separation of moving anchors: the translation
   // and the rotation vector (sum of w h over substeps; a step turns a body by little).
   Vec3 delta_position = Vec3::Zero();
   Vec3 delta_angle = Vec3::Zero();
+  Mat3 inverse_inertia = Mat3::Zero();  // world, fixed during the step
   // Pseudo-velocities that push the body out of penetration (exact solver): the position update
   // moves the body by them once, and no velocity is left behind.
   Vec3 push_v = Vec3::Zero(), push_w = Vec3::Zero();
