@@ -157,10 +157,12 @@ Softness contact_softness(double hertz, double damping_ratio, double h) {
   return {omega / a1, a2 * a3, a3};
 }
 
-void warm_start(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,
-                std::span<const std::uint32_t> ids, std::span<SolverBody> bodies) {
+void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,
+                std::span<const std::uint32_t> ids, std::span<SolverBody> bodies,
+                bool keep_last_substep) {
   for (std::uint32_t id : ids) {
     const ContactRow& row = rows[id];
+    if (keep_last_substep) cold[id].earlier_substeps_impulse += row.normal_impulse;
     apply_normal_impulse(row, row.normal_impulse, bodies);
     if (row.tangent_impulse1 != 0 || row.tangent_impulse2 != 0)
       apply_impulse(row, cold[id],

@@ -101,8 +101,12 @@ struct Softness {
 };
 Softness contact_softness(double hertz, double damping_ratio, double h);
 
-void warm_start(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,
-                std::span<const std::uint32_t> ids, std::span<SolverBody> bodies);
+// Applies each row's impulse, which it starts the sweeps from. With `keep_last_substep` (the soft
+// solver's substeps after the first) that impulse is the last substep's whole and is added to the
+// row's earlier_substeps_impulse on the way.
+void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,
+                std::span<const std::uint32_t> ids, std::span<SolverBody> bodies,
+                bool keep_last_substep);
 
 // One Gauss-Seidel sweep. With `soft` set, penetration beyond the slop is pushed out through the
 // spring; without it contacts are rigid and only gaps (speculative contacts) add bias. Sweeps

@@ -53,13 +53,13 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
         contact_softness(std::min(solver.contact_hertz, 0.25 / h), solver.contact_damping_ratio, h);
     for (int sub = 0; sub < substeps; ++sub) {
       run.integrate_velocities(h);
-      run.warm_start();
+      // From the second substep on, the impulse a row starts from is the last substep's whole.
+      run.warm_start(sub > 0);
       for (int i = 0; i < solver.soft_iterations; ++i)
         if (run.sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
       run.integrate_positions(h);
       for (int i = 0; i < solver.relax_iterations; ++i)
         if (run.sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
-      if (sub + 1 < substeps) run.keep_substep_impulses();
     }
     run.finish(h);
     return;
@@ -70,7 +70,7 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
     if (report->solver == IslandSolver::kExact && run.has_rows()) pgs = !run.solve_exact(dt);
   }
   if (pgs) {
-    run.warm_start();
+    run.warm_start(false);
     for (int i = 0; i < solver.iterations; ++i)
       if (run.sweep(nullptr, dt, i % 2 == 1) <= solver.velocity_tolerance) break;
   }
@@ -102,15 +102,13 @@ class SerialIsland {
     for (std::uint32_t slot : c_.bodies)
       integrate_position(h, &bodies_[slot], &c_.scratch.poses[slot]);
   }
-  void warm_start() { tumble::warm_start(rows_, cold_, c_.rows, bodies_); }
+  void warm_start(bool keep_last_substep) {
+    tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep);
+  }
   double sweep(const Softness* soft, double h, bool backward) {
     ++report_->velocity_iterations;
     return solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver, soft, h,
                           backward);
-  }
-  void keep_substep_impulses() {
-    for (std::uint32_t r : c_.rows)
-      cold_[r].earlier_substeps_impulse += rows_[r].normal_impulse;
   }
   // True when the LCP's answer was taken; false when it was refused (then pgs solves the island).
   bool solve_exact(double dt) {
@@ -232,21 +230,15 @@ class TeamIsland {
   bool has_rows() const { return true; }  // coloured islands have many
   void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
   void integrate_positions(double h) { team_integrate_positions(c_, h); }
-  void warm_start() {
+  void warm_start(bool keep_last_substep) {
     each_manifold([&](std::span<const std::uint32_t> ids) {
-      tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies);
+      tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies, keep_last_substep);
     });
   }
   double sweep(const Softness* soft, double h, bool backward) {
     ++iterations_;
     return sweep_colours(s_, first_, last_, backward, [&](std::span<const std::uint32_t> ids) {
       return solve_contacts(s_.rows, ids, s_.blocks, s_.bodies, c_.settings.solver, soft, h, false);
-    });
-  }
-  void keep_substep_impulses() {
-    each_manifold([&](std::span<const std::uint32_t> ids) {
-      for (std::uint32_t r : ids)
-        s_.cold_rows[r].earlier_substeps_impulse += s_.rows[r].normal_impulse;
     });
   }
   template <class Move = void (*)()>

@@ -154,8 +154,6 @@ class FrameStream:
             raise StopIteration
         try:
             message = next(self._call)
-        except StopIteration:
-            raise
         except grpc.RpcError as error:
             # Closed by us, or the duration asked for is over: the end, not a failure.
             if error.code() == grpc.StatusCode.CANCELLED or (
