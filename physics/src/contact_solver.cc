@@ -13,12 +13,15 @@ namespace {
 // contacts keep one basis from step to step.
 constexpr double kSlidingSpeed = 1e-3;
 
-// 1 / (J M^-1 J^T) of a row from its precomputed angular parts: r x d and I^-1 (r x d).
-double effective_mass(const Body& a, const Body& b, const Vec3& ra_cross, const Vec3& angular_a,
-                      const Vec3& rb_cross, const Vec3& angular_b) {
-  const double k =
-      a.inverse_mass + b.inverse_mass + ra_cross.dot(angular_a) + rb_cross.dot(angular_b);
-  return k > 0 ? 1.0 / k : 0.0;
+// J M^-1 J^T of a row from its precomputed angular parts, r x d and I^-1 (r x d): the velocity
+// change a unit impulse gives the contact.
+double velocity_response(const Body& a, const Body& b, const Vec3& ra_cross, const Vec3& angular_a,
+                         const Vec3& rb_cross, const Vec3& angular_b) {
+  return a.inverse_mass + b.inverse_mass + ra_cross.dot(angular_a) + rb_cross.dot(angular_b);
+}
+
+double mass_of(double response) {
+  return response > 0 ? 1.0 / response : 0.0;
 }
 
 // A unit vector perpendicular to `n`, chosen the same way every time.
@@ -87,12 +90,15 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     row.angular_b_t1 = b.inverse_inertia_world * row.rb_cross_t1;
     row.angular_a_t2 = a.inverse_inertia_world * row.ra_cross_t2;
     row.angular_b_t2 = b.inverse_inertia_world * row.rb_cross_t2;
-    row.normal_mass =
-        effective_mass(a, b, row.ra_cross_n, row.angular_a, row.rb_cross_n, row.angular_b);
-    row.tangent_mass1 =
-        effective_mass(a, b, row.ra_cross_t1, row.angular_a_t1, row.rb_cross_t1, row.angular_b_t1);
-    row.tangent_mass2 =
-        effective_mass(a, b, row.ra_cross_t2, row.angular_a_t2, row.rb_cross_t2, row.angular_b_t2);
+    row.normal_response =
+        velocity_response(a, b, row.ra_cross_n, row.angular_a, row.rb_cross_n, row.angular_b);
+    row.tangent_response1 = velocity_response(a, b, row.ra_cross_t1, row.angular_a_t1,
+                                              row.rb_cross_t1, row.angular_b_t1);
+    row.tangent_response2 = velocity_response(a, b, row.ra_cross_t2, row.angular_a_t2,
+                                              row.rb_cross_t2, row.angular_b_t2);
+    row.normal_mass = mass_of(row.normal_response);
+    row.tangent_mass1 = mass_of(row.tangent_response1);
+    row.tangent_mass2 = mass_of(row.tangent_response2);
 
     // Feature ids change when a vertex of a face resting on an equal face moves across the
     // other's edge by a nanometre; the point has not moved, so its impulse still applies
@@ -187,13 +193,55 @@ NormalTarget normal_target(const ContactRow& row, std::span<const SolverBody> bo
   return {};
 }
 
-double solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
+// The velocities of a manifold's two bodies, held in registers while its rows are solved and
+// written back once: the rows of one manifold share both bodies, so going through memory for
+// every row would reload them (the compiler cannot tell a row from a body). Statics are read,
+// never written (islands and colours solved in parallel share them).
+struct PairVelocities {
+  Vec3 va, wa, vb, wb;
+  double inverse_mass_a = 0, inverse_mass_b = 0;
+
+  PairVelocities() = default;
+  PairVelocities(const SolverBody& a, const SolverBody& b)
+      : va(a.v),
+        wa(a.w),
+        vb(b.v),
+        wb(b.w),
+        inverse_mass_a(a.inverse_mass),
+        inverse_mass_b(b.inverse_mass) {}
+
+  void store(SolverBody& a, SolverBody& b) const {
+    if (inverse_mass_a > 0) {
+      a.v = va;
+      a.w = wa;
+    }
+    if (inverse_mass_b > 0) {
+      b.v = vb;
+      b.w = wb;
+    }
+  }
+  double normal_velocity(const ContactRow& row) const {
+    return row.normal.dot(vb - va) + wb.dot(row.rb_cross_n) - wa.dot(row.ra_cross_n);
+  }
+  void apply_normal(const ContactRow& row, double impulse) {
+    if (inverse_mass_a > 0) {
+      va -= (inverse_mass_a * impulse) * row.normal;
+      wa -= impulse * row.angular_a;
+    }
+    if (inverse_mass_b > 0) {
+      vb += (inverse_mass_b * impulse) * row.normal;
+      wb += impulse * row.angular_b;
+    }
+  }
+};
+
+double solve_friction(ContactRow& row, PairVelocities& pair) {
   if (row.friction <= 0) return 0;
-  SolverBody& a = bodies[row.a];
-  SolverBody& b = bodies[row.b];
-  const Vec3 dv = b.v - a.v;
-  const double v1 = row.tangent1.dot(dv) + b.w.dot(row.rb_cross_t1) - a.w.dot(row.ra_cross_t1);
-  const double v2 = row.tangent2.dot(dv) + b.w.dot(row.rb_cross_t2) - a.w.dot(row.ra_cross_t2);
+  const Vec3 dv = pair.vb - pair.va;
+  const double v1 =
+      row.tangent1.dot(dv) + pair.wb.dot(row.rb_cross_t1) - pair.wa.dot(row.ra_cross_t1);
+  const double v2 =
+      row.tangent2.dot(dv) + pair.wb.dot(row.rb_cross_t2) - pair.wa.dot(row.ra_cross_t2);
   const double limit = row.friction * row.normal_impulse;
   const double old1 = row.tangent_impulse1, old2 = row.tangent_impulse2;
   double new1 = old1 - row.tangent_mass1 * v1;
@@ -209,48 +257,41 @@ double solve_friction(ContactRow& row, std::span<SolverBody> bodies) {
   row.tangent_impulse2 = new2;
   const double d1 = new1 - old1, d2 = new2 - old2;
   const Vec3 linear = d1 * row.tangent1 + d2 * row.tangent2;
-  if (a.inverse_mass > 0) {
-    a.v -= a.inverse_mass * linear;
-    a.w -= d1 * row.angular_a_t1 + d2 * row.angular_a_t2;
+  if (pair.inverse_mass_a > 0) {
+    pair.va -= pair.inverse_mass_a * linear;
+    pair.wa -= d1 * row.angular_a_t1 + d2 * row.angular_a_t2;
   }
-  if (b.inverse_mass > 0) {
-    b.v += b.inverse_mass * linear;
-    b.w += d1 * row.angular_b_t1 + d2 * row.angular_b_t2;
+  if (pair.inverse_mass_b > 0) {
+    pair.vb += pair.inverse_mass_b * linear;
+    pair.wb += d1 * row.angular_b_t1 + d2 * row.angular_b_t2;
   }
   // The velocity change this gave the contact, m/s.
-  return std::max(std::abs(d1) / row.tangent_mass1, std::abs(d2) / row.tangent_mass2);
+  return std::max(std::abs(d1) * row.tangent_response1, std::abs(d2) * row.tangent_response2);
 }
 
-double solve_normal(ContactRow& row, std::span<SolverBody> bodies, const NormalTarget& target) {
-  const double vn = normal_velocity(row, bodies);
+double solve_normal(ContactRow& row, PairVelocities& pair, const NormalTarget& target) {
+  const double vn = pair.normal_velocity(row);
   const double delta = -row.normal_mass * target.mass_scale * (vn + target.bias) -
                        target.impulse_scale * row.normal_impulse;
   const double updated = std::max(row.normal_impulse + delta, 0.0);
-  const double change = std::abs(updated - row.normal_impulse) / row.normal_mass;
-  apply_normal_impulse(row, updated - row.normal_impulse, bodies);
+  const double change = std::abs(updated - row.normal_impulse) * row.normal_response;
+  pair.apply_normal(row, updated - row.normal_impulse);
   row.normal_impulse = updated;
   row.max_normal_impulse = std::max(row.max_normal_impulse, updated);
   return change;
 }
 
-// The manifold's rows rows[ids[0..count)]: friction point by point, then the normals as a block
-// when the block solution keeps every impulse non-negative, else point by point.
-// Returns the largest velocity change it gave a contact (m/s).
-double solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int count,
-                      std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                      const SolverSettings& settings, const Softness* soft, double inverse_h) {
-  double change = 0;
-  for (int i = 0; i < count; ++i)
-    change = std::max(change, solve_friction(rows[ids[i]], bodies));
-  NormalTarget targets[4];
-  for (int i = 0; i < count; ++i)
-    targets[i] = normal_target(rows[ids[i]], bodies, settings, soft, inverse_h);
-  if (count == 1) return std::max(change, solve_normal(rows[ids[0]], bodies, targets[0]));
+// The normals of one manifold as a block when the block solution keeps every impulse
+// non-negative, else point by point. Returns the largest velocity change it gave a contact.
+double solve_normals(std::span<ContactRow> rows, const ManifoldRows& manifold,
+                     std::span<const NormalBlock> blocks, PairVelocities& pair,
+                     const NormalTarget* targets) {
+  const std::uint32_t* ids = manifold.ids;
+  const int count = manifold.count;
+  if (count == 1) return solve_normal(rows[ids[0]], pair, targets[0]);
   Eigen::Vector4d error = Eigen::Vector4d::Zero();
-  for (int i = 0; i < count; ++i) {
-    const ContactRow& row = rows[ids[i]];
-    error[i] = normal_velocity(row, bodies) + targets[i].bias;
-  }
+  for (int i = 0; i < count; ++i)
+    error[i] = pair.normal_velocity(rows[ids[i]]) + targets[i].bias;
   const Eigen::Matrix4d& inverse = blocks[rows[ids[0]].manifold].inverse;
   const Eigen::Vector4d step = inverse * error;
   double updated[4];
@@ -261,19 +302,60 @@ double solve_manifold(std::span<ContactRow> rows, const std::uint32_t* ids, int 
                  targets[i].impulse_scale * row.normal_impulse;
     feasible &= updated[i] >= 0;
   }
+  double change = 0;
   if (!feasible) {
     for (int i = 0; i < count; ++i)
-      change = std::max(change, solve_normal(rows[ids[i]], bodies, targets[i]));
+      change = std::max(change, solve_normal(rows[ids[i]], pair, targets[i]));
     return change;
   }
   for (int i = 0; i < count; ++i) {
     ContactRow& row = rows[ids[i]];
-    change = std::max(change, std::abs(updated[i] - row.normal_impulse) / row.normal_mass);
-    apply_normal_impulse(row, updated[i] - row.normal_impulse, bodies);
+    change = std::max(change, std::abs(updated[i] - row.normal_impulse) * row.normal_response);
+    pair.apply_normal(row, updated[i] - row.normal_impulse);
     row.normal_impulse = updated[i];
     row.max_normal_impulse = std::max(row.max_normal_impulse, updated[i]);
   }
   return change;
+}
+
+// Solves `Lanes` manifolds that share no moving body: each manifold's friction point by point,
+// then its normals (solve_normals). A manifold's rows form one chain of dependent arithmetic (each
+// row reads the velocities the last one wrote), which leaves the core waiting on latencies; the
+// lanes' chains are independent, so interleaving them stage by stage keeps it busy. Manifolds
+// that share no moving body give the same bits in any order, so one lane or four is the same
+// answer. Returns the largest velocity change it gave a contact (m/s).
+template <int Lanes>
+double solve_lanes(std::span<ContactRow> rows, const ManifoldRows* manifolds,
+                   std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                   const SolverSettings& settings, const Softness* soft, double inverse_h) {
+  SolverBody* body_a[Lanes];
+  SolverBody* body_b[Lanes];
+  PairVelocities pair[Lanes];
+  double change[Lanes];
+  int most = 0;
+  for (int k = 0; k < Lanes; ++k) {
+    const ContactRow& first = rows[manifolds[k].ids[0]];
+    body_a[k] = &bodies[first.a];
+    body_b[k] = &bodies[first.b];
+    pair[k] = PairVelocities(*body_a[k], *body_b[k]);
+    change[k] = 0;
+    most = std::max(most, manifolds[k].count);
+  }
+  for (int i = 0; i < most; ++i)
+    for (int k = 0; k < Lanes; ++k)
+      if (i < manifolds[k].count)
+        change[k] = std::max(change[k], solve_friction(rows[manifolds[k].ids[i]], pair[k]));
+  NormalTarget targets[Lanes][4];
+  for (int k = 0; k < Lanes; ++k)
+    for (int i = 0; i < manifolds[k].count; ++i)
+      targets[k][i] = normal_target(rows[manifolds[k].ids[i]], bodies, settings, soft, inverse_h);
+  double largest = 0;
+  for (int k = 0; k < Lanes; ++k) {
+    change[k] = std::max(change[k], solve_normals(rows, manifolds[k], blocks, pair[k], targets[k]));
+    pair[k].store(*body_a[k], *body_b[k]);
+    largest = std::max(largest, change[k]);
+  }
+  return largest;
 }
 
 }  // namespace
@@ -288,20 +370,38 @@ double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t>
   // A manifold's rows are consecutive in `ids`; visit manifolds forwards or backwards.
   if (!backward) {
     for (std::size_t k = 0; k < count;) {
-      const int size = rows[ids[k]].block_size;
-      change = std::max(
-          change, solve_manifold(rows, &ids[k], size, blocks, bodies, settings, soft, inverse_h));
-      k += size;
+      const ManifoldRows manifold{&ids[k], rows[ids[k]].block_size};
+      change = std::max(change,
+                        solve_lanes<1>(rows, &manifold, blocks, bodies, settings, soft, inverse_h));
+      k += manifold.count;
     }
   } else {
     for (std::size_t end = count; end > 0;) {
       const ContactRow& last = rows[ids[end - 1]];
       const std::size_t start = end - 1 - last.block_index;
-      change = std::max(change, solve_manifold(rows, &ids[start], last.block_size, blocks, bodies,
-                                               settings, soft, inverse_h));
+      const ManifoldRows manifold{&ids[start], last.block_size};
+      change = std::max(change,
+                        solve_lanes<1>(rows, &manifold, blocks, bodies, settings, soft, inverse_h));
       end = start;
     }
   }
+  return change;
+}
+
+double solve_independent_manifolds(std::span<ContactRow> rows,
+                                   std::span<const ManifoldRows> manifolds,
+                                   std::span<const NormalBlock> blocks,
+                                   std::span<SolverBody> bodies, const SolverSettings& settings,
+                                   const Softness* soft, double h) {
+  const double inverse_h = 1 / h;
+  double change = 0;
+  std::size_t k = 0;
+  for (; k + kSolverLanes <= manifolds.size(); k += kSolverLanes)
+    change = std::max(change, solve_lanes<kSolverLanes>(rows, &manifolds[k], blocks, bodies,
+                                                        settings, soft, inverse_h));
+  for (; k < manifolds.size(); ++k)
+    change = std::max(
+        change, solve_lanes<1>(rows, &manifolds[k], blocks, bodies, settings, soft, inverse_h));
   return change;
 }
 

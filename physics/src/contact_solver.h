@@ -54,6 +54,9 @@ struct ContactRow {
   Vec3 angular_a_t1, angular_b_t1, angular_a_t2, angular_b_t2;
   double separation = 0;  // m at the step start; < 0 overlapping
   double normal_mass = 0, tangent_mass1 = 0, tangent_mass2 = 0;
+  // Their inverses (J M^-1 J^T): the velocity change per unit impulse, which measures how much a
+  // sweep changed a contact without a division.
+  double normal_response = 0, tangent_response1 = 0, tangent_response2 = 0;
   double friction = 0;
   double normal_impulse = 0, tangent_impulse1 = 0, tangent_impulse2 = 0;
   double max_normal_impulse = 0;
@@ -116,6 +119,24 @@ double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t>
                       std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
                       const SolverSettings& settings, const Softness* soft, double h,
                       bool backward);
+
+// A manifold's rows: rows[ids[0..count)].
+struct ManifoldRows {
+  const std::uint32_t* ids = nullptr;
+  int count = 0;
+};
+
+// How many manifolds solve_independent_manifolds interleaves.
+constexpr std::size_t kSolverLanes = 4;
+
+// One sweep over manifolds that share no moving body (one colour), kSolverLanes at a time: the
+// same bits as solving them one after the other, in any order, and faster (contact_solver.cc
+// says why). Returns the largest velocity change the sweep gave any contact (m/s).
+double solve_independent_manifolds(std::span<ContactRow> rows,
+                                   std::span<const ManifoldRows> manifolds,
+                                   std::span<const NormalBlock> blocks,
+                                   std::span<SolverBody> bodies, const SolverSettings& settings,
+                                   const Softness* soft, double h);
 
 // Gives bouncing contacts their outgoing velocity, e times the approach velocity.
 void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,

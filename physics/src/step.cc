@@ -170,10 +170,16 @@ double team_max(double local, std::vector<double>& values) {
   return largest;
 }
 
-// Calls fn(row ids of a manifold) for colours [first, last), forwards or backwards. Manifolds
-// of one colour share no moving body, so the team splits them; the overflow colour runs on one
-// thread. Returns the largest value fn returned, on every thread (0 without `reduce`, which
-// spares the two barriers of the reduction).
+ManifoldRows manifold_rows_of(const StepScratch& s, std::uint32_t manifold) {
+  const std::span<const std::uint32_t> ids = manifold_rows(s, manifold);
+  return {ids.data(), static_cast<int>(ids.size())};
+}
+
+// Calls fn(manifolds) for colours [first, last), forwards or backwards, with the manifolds of a
+// colour in groups of up to kSolverLanes. Manifolds of one colour share no moving body, so the
+// team splits the groups; the overflow colour runs on one thread, a manifold at a time and in
+// order. Returns the largest value fn returned, on every thread (0 without `reduce`, which spares
+// the two barriers of the reduction).
 template <class Fn>
 double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
                      Fn&& fn, bool reduce = true) {
@@ -186,15 +192,34 @@ double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
 #pragma omp single
       for (std::int64_t i = begin; i < end; ++i) {
         const std::int64_t at = backward ? begin + end - 1 - i : i;
-        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[at])));
+        const ManifoldRows manifold = manifold_rows_of(s, colouring.manifolds[at]);
+        local = std::max(local, fn(std::span(&manifold, 1)));
       }
     } else {
+      constexpr std::int64_t lanes = kSolverLanes;
+      const std::int64_t groups = (end - begin + lanes - 1) / lanes;
 #pragma omp for schedule(static)
-      for (std::int64_t i = begin; i < end; ++i)
-        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[i])));
+      for (std::int64_t g = 0; g < groups; ++g) {
+        ManifoldRows group[kSolverLanes];
+        const std::int64_t from = begin + g * lanes, to = std::min(end, from + lanes);
+        for (std::int64_t i = from; i < to; ++i)
+          group[i - from] = manifold_rows_of(s, colouring.manifolds[i]);
+        local = std::max(local, fn(std::span<const ManifoldRows>(group, to - from)));
+      }
     }
   }
   return reduce ? team_max(local, s.team_values) : 0.0;
+}
+
+// fn(row ids of one manifold) for each manifold of a group, as sweep_colours calls it.
+template <class Fn>
+auto each_of_group(Fn&& fn) {
+  return [fn = std::forward<Fn>(fn)](std::span<const ManifoldRows> group) {
+    double largest = 0;
+    for (const ManifoldRows& m : group)
+      largest = std::max(largest, fn(std::span<const std::uint32_t>(m.ids, m.count)));
+    return largest;
+  };
 }
 
 std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
@@ -237,17 +262,18 @@ class TeamIsland {
   }
   double sweep(const Softness* soft, double h, bool backward) {
     ++iterations_;
-    return sweep_colours(s_, first_, last_, backward, [&](std::span<const std::uint32_t> ids) {
-      return solve_contacts(s_.rows, ids, s_.blocks, s_.bodies, c_.settings.solver, soft, h, false);
+    return sweep_colours(s_, first_, last_, backward, [&](std::span<const ManifoldRows> group) {
+      return solve_independent_manifolds(s_.rows, group, s_.blocks, s_.bodies, c_.settings.solver,
+                                         soft, h);
     });
   }
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    const double residual =
-        sweep_colours(s_, first_, last_, false, [&](std::span<const std::uint32_t> ids) {
-          return normal_residual(s_.rows, ids, s_.bodies, h);
-        });
+    const double residual = sweep_colours(s_, first_, last_, false,
+                                          each_of_group([&](std::span<const std::uint32_t> ids) {
+                                            return normal_residual(s_.rows, ids, s_.bodies, h);
+                                          }));
     move();
     each_manifold([&](std::span<const std::uint32_t> ids) {
       apply_restitution(s_.rows, s_.cold_rows, ids, s_.blocks, s_.bodies, c_.settings.solver);
@@ -263,13 +289,11 @@ class TeamIsland {
  private:
   template <class Fn>
   void each_manifold(Fn&& fn) {
-    sweep_colours(
-        s_, first_, last_, false,
-        [&](std::span<const std::uint32_t> ids) {
-          fn(ids);
-          return 0.0;
-        },
-        false);
+    sweep_colours(s_, first_, last_, false, each_of_group([&](std::span<const std::uint32_t> ids) {
+                    fn(ids);
+                    return 0.0;
+                  }),
+                  false);
   }
   const IslandContext& c_;
   StepScratch& s_;
@@ -527,13 +551,13 @@ void World::correct_positions() {
     for (std::uint32_t i : s.team_islands) {
       if (!needs_correction(i)) continue;
       for (int k = 0; k < solver.position_iterations; ++k)
-        sweep_colours(
-            s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
-            [&](std::span<const std::uint32_t> ids) {
-              tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses, solver);
-              return 0.0;
-            },
-            false);
+        sweep_colours(s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
+                      each_of_group([&](std::span<const std::uint32_t> ids) {
+                        tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses,
+                                                  solver);
+                        return 0.0;
+                      }),
+                      false);
     }
     team_for_dynamic(singles, [&](std::int64_t k) {
       const std::uint32_t i = s.single_islands[k];
