@@ -163,11 +163,18 @@ Softness contact_softness(double hertz, double damping_ratio, double h) {
   return {omega / a1, a2 * a3, a3};
 }
 
+void update_separations(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                        std::span<const SolverBody> bodies) {
+  for (std::uint32_t id : ids)
+    rows[id].substep_separation = current_separation(rows[id], bodies);
+}
+
 void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,
                 std::span<const std::uint32_t> ids, std::span<SolverBody> bodies,
                 bool keep_last_substep) {
   for (std::uint32_t id : ids) {
-    const ContactRow& row = rows[id];
+    ContactRow& row = rows[id];
+    row.substep_separation = current_separation(row, bodies);
     if (keep_last_substep) cold[id].earlier_substeps_impulse += row.normal_impulse;
     apply_normal_impulse(row, row.normal_impulse, bodies);
     if (row.tangent_impulse1 != 0 || row.tangent_impulse2 != 0)
@@ -183,9 +190,9 @@ struct NormalTarget {
   double bias = 0, mass_scale = 1, impulse_scale = 0;
 };
 
-NormalTarget normal_target(const ContactRow& row, std::span<const SolverBody> bodies,
-                           const SolverSettings& settings, const Softness* soft, double inverse_h) {
-  const double separation = current_separation(row, bodies);
+NormalTarget normal_target(const ContactRow& row, const SolverSettings& settings,
+                           const Softness* soft, double inverse_h) {
+  const double separation = row.substep_separation;
   if (separation > 0) return {separation * inverse_h, 1, 0};  // may close the gap, no more
   if (soft != nullptr && separation + settings.slop < 0)
     return {std::max(soft->bias_rate * (separation + settings.slop), -settings.max_push_velocity),
@@ -348,7 +355,7 @@ double solve_lanes(std::span<ContactRow> rows, const ManifoldRows* manifolds,
   NormalTarget targets[Lanes][4];
   for (int k = 0; k < Lanes; ++k)
     for (int i = 0; i < manifolds[k].count; ++i)
-      targets[k][i] = normal_target(rows[manifolds[k].ids[i]], bodies, settings, soft, inverse_h);
+      targets[k][i] = normal_target(rows[manifolds[k].ids[i]], settings, soft, inverse_h);
   double largest = 0;
   for (int k = 0; k < Lanes; ++k) {
     change[k] = std::max(change[k], solve_normals(rows, manifolds[k], blocks, pair[k], targets[k]));

@@ -53,6 +53,9 @@ struct ContactRow {
   Vec3 ra_cross_t1, rb_cross_t1, ra_cross_t2, rb_cross_t2;
   Vec3 angular_a_t1, angular_b_t1, angular_a_t2, angular_b_t2;
   double separation = 0;  // m at the step start; < 0 overlapping
+  // The separation after the bodies' last move (current_separation): sweeps do not move bodies,
+  // so it is computed once for all the sweeps between two moves.
+  double substep_separation = 0;
   double normal_mass = 0, tangent_mass1 = 0, tangent_mass2 = 0;
   // Their inverses (J M^-1 J^T): the velocity change per unit impulse, which measures how much a
   // sweep changed a contact without a division.
@@ -104,7 +107,13 @@ struct Softness {
 };
 Softness contact_softness(double hertz, double damping_ratio, double h);
 
-// Applies each row's impulse, which it starts the sweeps from. With `keep_last_substep` (the soft
+// Sets each row's substep_separation from where the bodies are now: after every move, before the
+// sweeps that follow it.
+void update_separations(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
+                        std::span<const SolverBody> bodies);
+
+// Sets each row's substep_separation (update_separations) and applies its impulse, which
+// it starts the sweeps from. With `keep_last_substep` (the soft
 // solver's substeps after the first) that impulse is the last substep's whole and is added to the
 // row's earlier_substeps_impulse on the way.
 void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,

@@ -101,6 +101,7 @@ class SerialIsland {
   void integrate_positions(double h) {
     for (std::uint32_t slot : c_.bodies)
       integrate_position(h, &bodies_[slot], &c_.scratch.poses[slot]);
+    update_separations(rows_, c_.rows, bodies_);
   }
   void warm_start(bool keep_last_substep) {
     tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep);
@@ -254,7 +255,11 @@ class TeamIsland {
 
   bool has_rows() const { return true; }  // coloured islands have many
   void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
-  void integrate_positions(double h) { team_integrate_positions(c_, h); }
+  void integrate_positions(double h) {
+    team_integrate_positions(c_, h);
+    each_manifold(
+        [&](std::span<const std::uint32_t> ids) { update_separations(s_.rows, ids, s_.bodies); });
+  }
   void warm_start(bool keep_last_substep) {
     each_manifold([&](std::span<const std::uint32_t> ids) {
       tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies, keep_last_substep);
