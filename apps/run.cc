@@ -91,6 +91,8 @@ int main(int argc, char** argv) {
   // Bounded loops that hit their bound, summed over the run: none of their answers was used as if
   // it were right, but a run that hits them is one to look at.
   std::uint64_t exact_fallbacks = 0, exact_oversized = 0, gyroscopic = 0, continuous = 0;
+  // Islands tall enough to buckle, given more substeps (island-steps), and those at the bound.
+  std::uint64_t stiffened = 0, stiffness_capped = 0;
   // The world's limits held by the step (body-steps).
   std::uint64_t non_finite = 0, slowed = 0, at_edge = 0;
   double window_seconds = 0;
@@ -106,6 +108,8 @@ int main(int argc, char** argv) {
     exact_oversized += world.last_step().exact_oversized;
     gyroscopic += world.last_step().gyroscopic_limit_hits;
     continuous += world.last_step().continuous_limit_hits;
+    stiffened += world.last_step().stiffened_islands;
+    stiffness_capped += world.last_step().stiffness_capped;
     non_finite += world.last_step().non_finite_bodies;
     slowed += world.last_step().slowed_bodies;
     at_edge += world.last_step().bodies_at_edge;
@@ -149,6 +153,11 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(exact_fallbacks),
       static_cast<unsigned long long>(exact_oversized), static_cast<unsigned long long>(gyroscopic),
       static_cast<unsigned long long>(continuous));
+  std::printf(
+      "tall stacks over the run (island-steps): given more substeps %llu, of those at the "
+      "32-substep bound %llu\n",
+      static_cast<unsigned long long>(stiffened),
+      static_cast<unsigned long long>(stiffness_capped));
   std::printf(
       "limits held over the run (body-steps): non-finite results kept at rest %llu, slowed to the "
       "speed limits %llu, held at the edge of the world %llu\n",

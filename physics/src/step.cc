@@ -13,6 +13,7 @@
 #include "physics/world.h"
 #include "step_limits.h"
 #include "step_scratch.h"
+#include "tall_stacks.h"
 
 namespace tumble {
 namespace {
@@ -46,11 +47,14 @@ struct IslandContext {
 template <class Runner>
 void advance_with(Runner& run, IslandReport* report, const SolverSettings& solver, double dt) {
   if (report->solver == IslandSolver::kSoft) {
-    const int substeps = solver.substeps;
+    // Tall stacks take more substeps and a stiffer spring (tall_stacks.h), the rest the settings'.
+    const bool stiffened = report->substeps > 0;
+    const int substeps = stiffened ? report->substeps : solver.substeps;
+    const double hertz = stiffened ? report->contact_hertz : solver.contact_hertz;
     const double h = dt / substeps;
     // The spring may not be stiffer than the substep can follow (a quarter of its rate).
     const Softness soft =
-        contact_softness(std::min(solver.contact_hertz, 0.25 / h), solver.contact_damping_ratio, h);
+        contact_softness(std::min(hertz, 0.25 / h), solver.contact_damping_ratio, h);
     for (int sub = 0; sub < substeps; ++sub) {
       run.integrate_velocities(h);
       // From the second substep on, the impulse a row starts from is the last substep's whole.
@@ -367,7 +371,7 @@ Status World::step(double dt) {
   return Status::ok();
 }
 
-void World::prepare_contacts(double /*dt*/) {
+void World::prepare_contacts(double dt) {
   StepScratch& s = *scratch_;
   const std::size_t slots = bodies_.size();
   s.bodies.resize(slots);
@@ -394,11 +398,13 @@ void World::prepare_contacts(double /*dt*/) {
   s.row_begin.resize(manifolds + 1);
   s.row_begin[0] = 0;
   s.links.resize(manifolds);
+  s.touching.resize(manifolds);
   double deepest = 0;
   for (std::size_t m = 0; m < manifolds; ++m) {
     const Contact& contact = contacts_[m];
     s.row_begin[m + 1] = s.row_begin[m] + static_cast<std::uint32_t>(contact.manifold.count);
     s.links[m] = {contact.a.index, contact.b.index};
+    s.touching[m] = contact.manifold.depth > -settings_.solver.slop;
     deepest = std::max(deepest, contact.manifold.depth);
   }
   s.rows.resize(s.row_begin[manifolds]);
@@ -418,6 +424,10 @@ void World::prepare_contacts(double /*dt*/) {
                  &s.rows[s.row_begin[m]], &s.cold_rows[s.row_begin[m]], &s.blocks[m]);
   });
   build_islands(s.dynamic, s.links, &s.islands);
+  s.body_of_slot.resize(slots);  // reused: no allocation once warmed up
+  for (std::size_t i = 0; i < slots; ++i)
+    s.body_of_slot[i] = &bodies_[i].body;
+  s.support_level.resize(slots);
 
   const std::size_t islands = s.islands.count();
   s.island_rows.clear();
@@ -463,6 +473,20 @@ void World::prepare_contacts(double /*dt*/) {
       }
     }
     s.reports[i].solver = kind;
+    if (kind == IslandSolver::kSoft) {
+      const IslandStiffness stiffness =
+          island_stiffness(std::span(s.islands.bodies)
+                               .subspan(s.islands.body_begin[i],
+                                        s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
+                           std::span(s.islands.links)
+                               .subspan(s.islands.link_begin[i],
+                                        s.islands.link_begin[i + 1] - s.islands.link_begin[i]),
+                           s.links, s.touching, s.dynamic, s.body_of_slot, settings_.gravity, dt,
+                           solver, &s.support_level, &s.bodies_per_level);
+      s.reports[i].substeps = stiffness.substeps;
+      s.reports[i].contact_hertz = stiffness.contact_hertz;
+      s.reports[i].stiffness_capped = stiffness.capped;
+    }
   }
 
   // Large iterative islands are coloured for the team; the others go one island per thread.
@@ -497,9 +521,6 @@ void World::prepare_contacts(double /*dt*/) {
 
 void World::solve_islands(double dt) {
   StepScratch& s = *scratch_;
-  s.body_of_slot.resize(bodies_.size());  // reused: no allocation once warmed up
-  for (std::size_t i = 0; i < bodies_.size(); ++i)
-    s.body_of_slot[i] = &bodies_[i].body;
   const int threads = team_size(settings_.threads);
   if (s.team_values.size() < static_cast<std::size_t>(threads)) s.team_values.resize(threads);
   const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
@@ -528,6 +549,8 @@ void World::solve_islands(double dt) {
       ++stats_.iterative_islands;
     stats_.exact_fallbacks += report.exact_failed ? 1 : 0;
     stats_.exact_oversized += report.exact_oversized ? 1 : 0;
+    stats_.stiffened_islands += report.substeps > 0 ? 1 : 0;
+    stats_.stiffness_capped += report.stiffness_capped ? 1 : 0;
     stats_.lemke_pivots += report.lemke_pivots;
     stats_.velocity_iterations += report.velocity_iterations;
     stats_.gyroscopic_limit_hits += report.gyroscopic_limit_hits;

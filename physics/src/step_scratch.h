@@ -20,6 +20,11 @@ struct IslandReport {
   std::uint32_t gyroscopic_limit_hits = 0;
   std::uint64_t lemke_pivots = 0, velocity_iterations = 0;
   double residual = 0;
+  // Soft islands tall enough to buckle (tall_stacks.h): their substeps and spring; 0 for the
+  // settings'.
+  int substeps = 0;
+  double contact_hertz = 0;
+  bool stiffness_capped = false;
 };
 
 // An island this large is worth splitting over threads (and is split with one thread too, so the
@@ -35,6 +40,7 @@ struct StepScratch {
   std::vector<NormalBlock> blocks;        // one per manifold
   std::vector<std::uint32_t> row_begin;   // rows of manifold m: [row_begin[m], row_begin[m+1])
   std::vector<IslandLink> links;          // one per manifold
+  std::vector<std::uint8_t> touching;     // per manifold: apart by less than the slop
   Islands islands;
   std::vector<std::uint32_t> island_rows;  // row ids, island by island
   std::vector<std::uint32_t> island_row_begin;
@@ -52,6 +58,8 @@ struct StepScratch {
   std::vector<ImpactResult> impacts;
   std::vector<double> first_impact;
   std::vector<const Body*> body_of_slot;
+  std::vector<std::uint32_t> support_level;  // by slot, for tall_stacks.h
+  std::vector<std::uint32_t> bodies_per_level;
   std::vector<CachedImpulse> cache;  // last step's impulses, sorted by body pair
 };
 

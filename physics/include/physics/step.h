@@ -89,6 +89,10 @@ struct StepStats {
   // Islands the exact solver was asked for but were larger than exact_max_island_points: soft.
   std::uint32_t exact_oversized = 0;
   std::uint64_t lemke_pivots = 0;
+  // Soft islands tall enough to buckle under the contact spring, given more substeps and a
+  // stiffer spring (docs/DYNAMICS.md "Tall stacks"), and of those the ones that needed more than
+  // the bound of 32 substeps (they take 32).
+  std::uint32_t stiffened_islands = 0, stiffness_capped = 0;
   std::uint64_t velocity_iterations = 0;  // pgs and soft, summed over islands and substeps
   // Largest complementarity residual of a normal contact row after the solve, m/s:
   // |min(impulse / effective mass, normal velocity - target)|; 0 when exactly solved.

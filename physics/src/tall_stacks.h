@@ -1,0 +1,52 @@
+// Substeps for islands tall enough to buckle under the soft contact spring.
+//
+// A face resting on a face through soft points resists a tilt with a moment proportional to the
+// spring's stiffness, so a stack of blocks is an elastic column, and a column under its own
+// weight stands only while q L^3 / EI < 7.84 (Greenhill, 1881). The soft spring's stiffness in a
+// mode is the mode's inertia times w^2, so a face resists a tilt of the block above with about
+// w^2 I / 2 (I its moment of inertia about a horizontal axis); for blocks of mass m and height s
+// the number is then about 2 g m s D^3 / (I w^2) for a tower D blocks high (docs/DYNAMICS.md
+// derives it and checks it on towers and rods): a tower of 50 unit boxes at the default 60 Hz is
+// at 100 and falls; at 240 Hz (16 substeps) it is at 6.5 and stands. The spring cannot be stiffer
+// than a quarter of the substep rate, so an island past the bound gets more substeps and the
+// stiffer spring they allow; every other island keeps the settings and pays only the walk over its
+// contacts that measures its depth.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "islands.h"
+#include "physics/body.h"
+#include "physics/math.h"
+#include "physics/step.h"
+
+namespace tumble {
+
+// Largest buckling number an island is left at: Greenhill's 7.84 with a margin of 1.74. Measured
+// (docs/DYNAMICS.md): towers of 20 to 100 boxes then stand 60 s with the top box within 5
+// microns; at 6.7 the tower of 30 swayed 13 cm after its settling transient.
+constexpr double kBucklingBound = 4.5;
+// Substeps a stiffened island may take: time stays bounded whatever the stack.
+constexpr int kMaxStiffenedSubsteps = 32;
+
+struct IslandStiffness {
+  int substeps = 0;  // 0: the settings' substeps and spring
+  double contact_hertz = 0;
+  bool capped = false;  // needed more than kMaxStiffenedSubsteps
+  std::uint32_t support_depth = 0;
+};
+
+// One island's bodies (slots) and links (indices into `links`): the substeps and spring it
+// needs. Only links marked `touching` (overlapping, or apart by less than the slop) carry load:
+// speculative contacts between falling bodies make no column. `level` (by slot) and
+// `bodies_per_level` are working memory.
+IslandStiffness island_stiffness(
+    std::span<const std::uint32_t> island_bodies, std::span<const std::uint32_t> island_links,
+    std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
+    std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of_slot,
+    const Vec3& gravity, double dt, const SolverSettings& solver, std::vector<std::uint32_t>* level,
+    std::vector<std::uint32_t>* bodies_per_level);
+
+}  // namespace tumble
