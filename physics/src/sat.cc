@@ -34,6 +34,18 @@ EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) {
     b_vertices[i] = rotation * pb.vertices[i] + translation;
   for (std::size_t i = 0; i < pb.faces.size(); ++i)
     b_normals[i] = rotation * pb.faces[i].normal;
+  // B's Gauss-map arcs, negated for the Minkowski difference A - B: the same for every edge of A.
+  struct Arc {
+    Vec3 w1, w2, w2xw1;
+  };
+  thread_local std::vector<Arc> b_arcs;
+  b_arcs.resize(pb.edges.size());
+  for (std::size_t j = 0; j < pb.edges.size(); ++j) {
+    Arc& arc = b_arcs[j];
+    arc.w1 = -b_normals[pb.edges[j].left];
+    arc.w2 = -b_normals[pb.edges[j].right];
+    arc.w2xw1 = arc.w2.cross(arc.w1);
+  }
 
   EdgeQuery best;
   for (std::uint32_t i = 0; i < pa.edges.size(); ++i) {
@@ -44,17 +56,15 @@ EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) {
     const Vec3 dir_a = pa.vertices[ea.head] - tail_a;
     const Vec3 u2xu1 = u2.cross(u1);
     for (std::uint32_t j = 0; j < pb.edges.size(); ++j) {
-      const auto& eb = pb.edges[j];
-      // Gauss-map arcs u1-u2 (A) and -v1..-v2 (B, negated for the Minkowski difference A - B).
-      const Vec3 w1 = -b_normals[eb.left];
-      const Vec3 w2 = -b_normals[eb.right];
-      const double cba = w1.dot(u2xu1);
-      const double dba = w2.dot(u2xu1);
-      const Vec3 w2xw1 = w2.cross(w1);
-      const double adc = u1.dot(w2xw1);
-      const double bdc = u2.dot(w2xw1);
+      // Do arcs u1-u2 (A) and w1-w2 (B's, negated) cross on the Gauss map?
+      const Arc& arc = b_arcs[j];
+      const double cba = arc.w1.dot(u2xu1);
+      const double dba = arc.w2.dot(u2xu1);
+      const double adc = u1.dot(arc.w2xw1);
+      const double bdc = u2.dot(arc.w2xw1);
       if (!(cba * dba < 0 && adc * bdc < 0 && cba * bdc > 0)) continue;
 
+      const auto& eb = pb.edges[j];
       const Vec3 tail_b = b_vertices[eb.tail];
       const Vec3 dir_b = b_vertices[eb.head] - tail_b;
       Vec3 axis = dir_a.cross(dir_b);
