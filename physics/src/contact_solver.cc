@@ -9,6 +9,10 @@
 namespace tumble {
 namespace {
 
+// The sweep's per-row parts are inlined into the manifold loop, so that a manifold's two bodies'
+// velocities stay in registers across its rows (out of line, they go through memory every call).
+#define TUMBLE_INLINE inline __attribute__((always_inline))
+
 // Relative tangential speeds below this leave the friction basis fixed to the normal, so resting
 // contacts keep one basis from step to step.
 constexpr double kSlidingSpeed = 1e-3;
@@ -190,8 +194,8 @@ struct NormalTarget {
   double bias = 0, mass_scale = 1, impulse_scale = 0;
 };
 
-NormalTarget normal_target(const ContactRow& row, const SolverSettings& settings,
-                           const Softness* soft, double inverse_h) {
+TUMBLE_INLINE NormalTarget normal_target(const ContactRow& row, const SolverSettings& settings,
+                                         const Softness* soft, double inverse_h) {
   const double separation = row.substep_separation;
   if (separation > 0) return {separation * inverse_h, 1, 0};  // may close the gap, no more
   if (soft != nullptr && separation + settings.slop < 0)
@@ -227,10 +231,10 @@ struct PairVelocities {
       b.w = wb;
     }
   }
-  double normal_velocity(const ContactRow& row) const {
+  TUMBLE_INLINE double normal_velocity(const ContactRow& row) const {
     return row.normal.dot(vb - va) + wb.dot(row.rb_cross_n) - wa.dot(row.ra_cross_n);
   }
-  void apply_normal(const ContactRow& row, double impulse) {
+  TUMBLE_INLINE void apply_normal(const ContactRow& row, double impulse) {
     if (inverse_mass_a > 0) {
       va -= (inverse_mass_a * impulse) * row.normal;
       wa -= impulse * row.angular_a;
@@ -242,7 +246,7 @@ struct PairVelocities {
   }
 };
 
-double solve_friction(ContactRow& row, PairVelocities& pair) {
+TUMBLE_INLINE double solve_friction(ContactRow& row, PairVelocities& pair) {
   if (row.friction <= 0) return 0;
   const Vec3 dv = pair.vb - pair.va;
   const double v1 =
@@ -276,7 +280,8 @@ double solve_friction(ContactRow& row, PairVelocities& pair) {
   return std::max(std::abs(d1) * row.tangent_response1, std::abs(d2) * row.tangent_response2);
 }
 
-double solve_normal(ContactRow& row, PairVelocities& pair, const NormalTarget& target) {
+TUMBLE_INLINE double solve_normal(ContactRow& row, PairVelocities& pair,
+                                  const NormalTarget& target) {
   const double vn = pair.normal_velocity(row);
   const double delta = -row.normal_mass * target.mass_scale * (vn + target.bias) -
                        target.impulse_scale * row.normal_impulse;
@@ -290,9 +295,9 @@ double solve_normal(ContactRow& row, PairVelocities& pair, const NormalTarget& t
 
 // The normals of one manifold as a block when the block solution keeps every impulse
 // non-negative, else point by point. Returns the largest velocity change it gave a contact.
-double solve_normals(std::span<ContactRow> rows, const ManifoldRows& manifold,
-                     std::span<const NormalBlock> blocks, PairVelocities& pair,
-                     const NormalTarget* targets) {
+TUMBLE_INLINE double solve_normals(std::span<ContactRow> rows, const ManifoldRows& manifold,
+                                   std::span<const NormalBlock> blocks, PairVelocities& pair,
+                                   const NormalTarget* targets) {
   const std::uint32_t* ids = manifold.ids;
   const int count = manifold.count;
   if (count == 1) return solve_normal(rows[ids[0]], pair, targets[0]);
