@@ -335,11 +335,13 @@ TUMBLE_INLINE double solve_normals(std::span<ContactRow> rows, const ManifoldRow
 // row reads the velocities the last one wrote), which leaves the core waiting on latencies; the
 // lanes' chains are independent, so interleaving them stage by stage keeps it busy. Manifolds
 // that share no moving body give the same bits in any order, so one lane or four is the same
-// answer. Returns the largest velocity change it gave a contact (m/s).
+// answer. Returns the largest velocity change it gave a contact (m/s), and each manifold's in
+// `lane_changes` when given.
 template <int Lanes>
 double solve_lanes(std::span<ContactRow> rows, const ManifoldRows* manifolds,
                    std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                   const SolverSettings& settings, const Softness* soft, double inverse_h) {
+                   const SolverSettings& settings, const Softness* soft, double inverse_h,
+                   double* lane_changes = nullptr) {
   SolverBody* body_a[Lanes];
   SolverBody* body_b[Lanes];
   PairVelocities pair[Lanes];
@@ -366,6 +368,7 @@ double solve_lanes(std::span<ContactRow> rows, const ManifoldRows* manifolds,
     change[k] = std::max(change[k], solve_normals(rows, manifolds[k], blocks, pair[k], targets[k]));
     pair[k].store(*body_a[k], *body_b[k]);
     largest = std::max(largest, change[k]);
+    if (lane_changes != nullptr) lane_changes[k] = change[k];
   }
   return largest;
 }
@@ -415,6 +418,31 @@ double solve_independent_manifolds(std::span<ContactRow> rows,
     change = std::max(
         change, solve_lanes<1>(rows, &manifolds[k], blocks, bodies, settings, soft, inverse_h));
   return change;
+}
+
+void solve_manifold_group(std::span<ContactRow> rows, std::span<const ManifoldRows> manifolds,
+                          std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                          const SolverSettings& settings, const Softness* soft, double h,
+                          double* changes) {
+  TUMBLE_ASSERT(manifolds.size() <= kSolverLanes);
+  const double inverse_h = 1 / h;
+  const ManifoldRows* m = manifolds.data();
+  switch (manifolds.size()) {
+    case 4:
+      solve_lanes<4>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
+      break;
+    case 3:
+      solve_lanes<3>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
+      break;
+    case 2:
+      solve_lanes<2>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
+      break;
+    case 1:
+      solve_lanes<1>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
+      break;
+    default:
+      break;
+  }
 }
 
 void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,

@@ -147,6 +147,13 @@ double solve_independent_manifolds(std::span<ContactRow> rows,
                                    std::span<SolverBody> bodies, const SolverSettings& settings,
                                    const Softness* soft, double h);
 
+// Solves up to kSolverLanes manifolds that share no moving body (of different islands, or of one
+// colour) interleaved, and writes each one's largest velocity change (m/s) to changes[k].
+void solve_manifold_group(std::span<ContactRow> rows, std::span<const ManifoldRows> manifolds,
+                          std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                          const SolverSettings& settings, const Softness* soft, double h,
+                          double* changes);
+
 // Gives bouncing contacts their outgoing velocity, e times the approach velocity.
 void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,
                        std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,

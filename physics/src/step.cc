@@ -2,10 +2,12 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include "exact_solver.h"
 #include "integrate.h"
@@ -132,9 +134,16 @@ class SerialIsland {
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    report_->residual = normal_residual(rows_, c_.rows, bodies_, h);
+    record_residual(h);
     move();
-    apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver);
+    apply_restitution();
+  }
+  void record_residual(double h) {
+    report_->residual = normal_residual(rows_, c_.rows, bodies_, h);
+  }
+  void apply_restitution() {
+    tumble::apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_,
+                              c_.settings.solver);
   }
 
  private:
@@ -153,6 +162,104 @@ IslandContext island_context(StepScratch& s, const WorldSettings& settings, std:
           .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]),
       s, settings, s.body_of_slot};
 }
+
+// advance_with's parts for up to kSolverLanes small islands of the same recipe (soft with the
+// settings' substeps, or pgs) at once, on one thread. A small island's sweep is a chain of
+// dependent arithmetic too short to keep the core busy; islands share no moving body, so their
+// sweeps run interleaved, manifold by manifold (solve_manifold_group), each island visiting its
+// own manifolds in its own order and stopping its sweeps when it alone has converged: the same
+// bits as solving them one after the other.
+class IslandLanes {
+ public:
+  static constexpr bool kSolvesExact = false;
+  IslandLanes(StepScratch& s, const WorldSettings& settings, std::span<const std::uint32_t> islands)
+      : s_(s), settings_(settings), count_(islands.size()) {
+    TUMBLE_ASSERT(count_ <= kSolverLanes);
+    for (std::size_t k = 0; k < count_; ++k) {
+      const std::uint32_t i = islands[k];
+      contexts_[k].emplace(island_context(s, settings, i));
+      lanes_[k].emplace(*contexts_[k], &s.reports[i]);
+      reports_[k] = &s.reports[i];
+      manifolds_[k] = std::span(s.island_manifolds)
+                          .subspan(s.island_manifold_begin[i],
+                                   s.island_manifold_begin[i + 1] - s.island_manifold_begin[i]);
+    }
+  }
+  IslandLanes(const IslandLanes&) = delete;
+  IslandLanes& operator=(const IslandLanes&) = delete;
+
+  bool has_rows() const { return true; }  // only islands with rows are given lanes
+  void integrate_velocities(double h) {
+    for (std::size_t k = 0; k < count_; ++k)
+      lanes_[k]->integrate_velocities(h);
+  }
+  // Each run of sweeps follows a warm start or a move: every island sweeps again.
+  void integrate_positions(double h) {
+    for (std::size_t k = 0; k < count_; ++k) {
+      lanes_[k]->integrate_positions(h);
+      active_[k] = true;
+    }
+  }
+  void warm_start(bool keep_last_substep) {
+    for (std::size_t k = 0; k < count_; ++k) {
+      lanes_[k]->warm_start(keep_last_substep);
+      active_[k] = true;
+    }
+  }
+  // Returns the largest change over the islands still sweeping; an island whose own sweep changed
+  // nothing beyond the tolerance stops, as it would alone.
+  double sweep(const Softness* soft, double h, bool backward) {
+    std::size_t most = 0;
+    double change[kSolverLanes] = {};
+    for (std::size_t k = 0; k < count_; ++k) {
+      if (!active_[k]) continue;
+      ++reports_[k]->velocity_iterations;
+      most = std::max(most, manifolds_[k].size());
+    }
+    for (std::size_t j = 0; j < most; ++j) {
+      ManifoldRows group[kSolverLanes];
+      std::size_t lane_of[kSolverLanes];
+      std::size_t n = 0;
+      for (std::size_t k = 0; k < count_; ++k) {
+        const std::size_t size = manifolds_[k].size();
+        if (!active_[k] || j >= size) continue;
+        group[n] = manifolds_[k][backward ? size - 1 - j : j];
+        lane_of[n++] = k;
+      }
+      double changes[kSolverLanes];
+      solve_manifold_group(s_.rows, std::span<const ManifoldRows>(group, n), s_.blocks, s_.bodies,
+                           settings_.solver, soft, h, changes);
+      for (std::size_t g = 0; g < n; ++g)
+        change[lane_of[g]] = std::max(change[lane_of[g]], changes[g]);
+    }
+    double largest = 0;
+    for (std::size_t k = 0; k < count_; ++k) {
+      if (!active_[k]) continue;
+      largest = std::max(largest, change[k]);
+      if (change[k] <= settings_.solver.velocity_tolerance) active_[k] = false;
+    }
+    return largest;
+  }
+  template <class Move = void (*)()>
+  void finish(
+      double h, Move move = [] {}) {
+    for (std::size_t k = 0; k < count_; ++k)
+      lanes_[k]->record_residual(h);
+    move();
+    for (std::size_t k = 0; k < count_; ++k)
+      lanes_[k]->apply_restitution();
+  }
+
+ private:
+  StepScratch& s_;
+  const WorldSettings& settings_;
+  std::size_t count_;
+  std::array<std::optional<IslandContext>, kSolverLanes> contexts_;
+  std::array<std::optional<SerialIsland>, kSolverLanes> lanes_;
+  std::array<IslandReport*, kSolverLanes> reports_{};
+  std::array<std::span<const ManifoldRows>, kSolverLanes> manifolds_;
+  std::array<bool, kSolverLanes> active_{};
+};
 
 // --- Islands solved by the whole team, colour by colour. Every function below is called by
 // every thread of the team (or by one thread outside any team) and contains the worksharing.
@@ -489,6 +596,18 @@ void World::prepare_contacts(double dt) {
     }
   }
 
+  // Each island's manifolds as row-id spans, for sweeping several islands at once.
+  s.island_manifolds.clear();
+  s.island_manifold_begin.assign(1, 0);
+  for (std::size_t i = 0; i < islands; ++i) {
+    for (std::uint32_t r = s.island_row_begin[i]; r < s.island_row_begin[i + 1];) {
+      const int count = s.rows[s.island_rows[r]].block_size;
+      s.island_manifolds.push_back({&s.island_rows[r], count});
+      r += count;
+    }
+    s.island_manifold_begin.push_back(static_cast<std::uint32_t>(s.island_manifolds.size()));
+  }
+
   // Large iterative islands are coloured for the team; the others go one island per thread.
   s.colouring.clear();
   s.island_colour_begin.assign(1, 0);
@@ -523,8 +642,34 @@ void World::solve_islands(double dt) {
   StepScratch& s = *scratch_;
   const int threads = team_size(settings_.threads);
   if (s.team_values.size() < static_cast<std::size_t>(threads)) s.team_values.resize(threads);
-  const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
-  const bool parallel = threads > 1 && (singles > 1 || !s.team_islands.empty());
+  // The small islands as work: soft (with the settings' substeps) and pgs islands with rows in
+  // groups of kSolverLanes (IslandLanes), every other one alone (SerialIsland).
+  s.work_islands.clear();
+  s.work_begin.assign(1, 0);
+  auto lane_kind = [&](std::uint32_t i) -> int {
+    const IslandReport& report = s.reports[i];
+    if (s.island_row_begin[i + 1] == s.island_row_begin[i]) return -1;
+    if (report.solver == IslandSolver::kSoft && report.substeps == 0) return 0;
+    if (report.solver == IslandSolver::kPgs) return 1;
+    return -1;
+  };
+  for (int kind = 0; kind < 2; ++kind) {
+    for (std::uint32_t i : s.single_islands) {
+      if (lane_kind(i) != kind) continue;
+      if (s.work_islands.size() - s.work_begin.back() == kSolverLanes)
+        s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
+      s.work_islands.push_back(i);
+    }
+    if (s.work_islands.size() > s.work_begin.back())
+      s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
+  }
+  for (std::uint32_t i : s.single_islands) {
+    if (lane_kind(i) >= 0) continue;
+    s.work_islands.push_back(i);
+    s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
+  }
+  const std::int64_t work = static_cast<std::int64_t>(s.work_begin.size()) - 1;
+  const bool parallel = threads > 1 && (work > 1 || !s.team_islands.empty());
   // Large islands one after the other with the whole team, then the rest one island per thread:
   // islands share no body and no row, and colours share no moving body, so any thread count gives
   // the same bits.
@@ -535,11 +680,17 @@ void World::solve_islands(double dt) {
                       &s.reports[i]);
       advance_with(team, &s.reports[i], settings_.solver, dt);
     }
-    team_for_dynamic(singles, [&](std::int64_t k) {
-      const std::uint32_t i = s.single_islands[k];
-      const IslandContext context = island_context(s, settings_, i);
-      SerialIsland island(context, &s.reports[i]);
-      advance_with(island, &s.reports[i], settings_.solver, dt);
+    team_for_dynamic(work, [&](std::int64_t k) {
+      const std::span<const std::uint32_t> islands =
+          std::span(s.work_islands).subspan(s.work_begin[k], s.work_begin[k + 1] - s.work_begin[k]);
+      if (islands.size() == 1) {
+        const IslandContext context = island_context(s, settings_, islands[0]);
+        SerialIsland island(context, &s.reports[islands[0]]);
+        advance_with(island, &s.reports[islands[0]], settings_.solver, dt);
+      } else {
+        IslandLanes lanes(s, settings_, islands);
+        advance_with(lanes, &s.reports[islands[0]], settings_.solver, dt);
+      }
     });
   });
   for (const IslandReport& report : s.reports) {

@@ -46,6 +46,13 @@ struct StepScratch {
   std::vector<std::uint32_t> island_row_begin;
   std::vector<IslandReport> reports;
   std::vector<std::uint32_t> row_ids;  // 0, 1, 2, ...: a manifold's rows as an id span
+  // Island i's manifolds: island_manifolds[island_manifold_begin[i] .. [i+1]), spans of
+  // island_rows.
+  std::vector<ManifoldRows> island_manifolds;
+  std::vector<std::uint32_t> island_manifold_begin;
+  // The small islands' work: item k is islands work_islands[work_begin[k] .. work_begin[k+1]),
+  // several only when they are solved together (IslandLanes).
+  std::vector<std::uint32_t> work_islands, work_begin;
   // Islands with at least kColouredIsland manifolds are solved by the whole team, colour by
   // colour: island i has colours [island_colour_begin[i], island_colour_begin[i+1]).
   Colouring colouring;
