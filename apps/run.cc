@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(exact_oversized), static_cast<unsigned long long>(gyroscopic),
       static_cast<unsigned long long>(continuous));
   std::printf(
-      "tall stacks over the run (island-steps): given more substeps %llu, of those at the "
+      "tall stacks over the run (island-steps): given more substeps %llu, needing more than the "
       "32-substep bound %llu\n",
       static_cast<unsigned long long>(stiffened),
       static_cast<unsigned long long>(stiffness_capped));

@@ -589,7 +589,7 @@ void World::prepare_contacts(double dt) {
                                .subspan(s.islands.link_begin[i],
                                         s.islands.link_begin[i + 1] - s.islands.link_begin[i]),
                            s.links, s.touching, s.dynamic, s.body_of_slot, settings_.gravity, dt,
-                           solver, &s.support_level, &s.bodies_per_level);
+                           solver, &s.support_level, &s.level_sums);
       s.reports[i].substeps = stiffness.substeps;
       s.reports[i].contact_hertz = stiffness.contact_hertz;
       s.reports[i].stiffness_capped = stiffness.capped;

@@ -7,6 +7,7 @@
 #include "contact_solver.h"
 #include "continuous.h"
 #include "islands.h"
+#include "tall_stacks.h"
 
 namespace tumble {
 
@@ -66,7 +67,7 @@ struct StepScratch {
   std::vector<double> first_impact;
   std::vector<const Body*> body_of_slot;
   std::vector<std::uint32_t> support_level;  // by slot, for tall_stacks.h
-  std::vector<std::uint32_t> bodies_per_level;
+  std::vector<LevelSums> level_sums;
   std::vector<CachedImpulse> cache;  // last step's impulses, sorted by body pair
 };
 

@@ -50,18 +50,35 @@ std::uint32_t support_depth(std::span<const std::uint32_t> island_bodies,
   return depth;
 }
 
-// m s / I of a body: mass times height along `up` over its smaller moment of inertia about a
-// horizontal axis. The soft spring's stiffness in a mode is the mode's inertia times w^2, so a
-// face resists a tilt with the bodies' moments of inertia, not with its width.
-double tilt_slenderness(const Body& body, const Vec3& up, const Vec3& across1,
-                        const Vec3& across2) {
-  const Quat to_body = body.orientation.conjugate();
-  const Vec3 d = to_body * up;
-  const double height = body.shape.support(d).dot(d) + body.shape.support(-d).dot(-d);
-  const Mat3& inverse_inertia = body.inverse_inertia_world;
-  const double most_turnable =
-      std::max(across1.dot(inverse_inertia * across1), across2.dot(inverse_inertia * across2));
-  return body.inverse_mass > 0 ? height * most_turnable / body.inverse_mass : 0.0;
+// The height of a body along `up`.
+double height_along(const Body& body, const Vec3& up) {
+  const Vec3 d = body.orientation.conjugate() * up;
+  return body.shape.support(d).dot(d) + body.shape.support(-d).dot(-d);
+}
+
+// What a level's bodies resist a tilt with: the soft spring's stiffness in a mode is the mode's
+// inertia times w^2, and a level turning as one slab about a horizontal axis has its bodies'
+// own moments of inertia plus their masses times the square of their distance from the axis
+// through the level's centre of mass. A tower's level is one block (its moment of inertia); a
+// pile's level spreads over metres, and its slab is far stiffer than any single block.
+void add_to_level(const Body& body, const Vec3& across1, const Vec3& across2, LevelSums* sums) {
+  const double mass = 1 / body.inverse_mass;
+  const double c1 = body.position.dot(across1), c2 = body.position.dot(across2);
+  sums->mass += mass;
+  sums->first1 += mass * c1;
+  sums->first2 += mass * c2;
+  sums->second1 += mass * c1 * c1;
+  sums->second2 += mass * c2 * c2;
+  // Turning about across1 moves the bodies along across2, and the other way round.
+  sums->own_about1 += 1 / across1.dot(body.inverse_inertia_world * across1);
+  sums->own_about2 += 1 / across2.dot(body.inverse_inertia_world * across2);
+}
+
+double tilt_inertia(const LevelSums& sums) {
+  if (!(sums.mass > 0)) return 0;
+  const double spread2 = std::max(0.0, sums.second2 - sums.first2 * sums.first2 / sums.mass);
+  const double spread1 = std::max(0.0, sums.second1 - sums.first1 * sums.first1 / sums.mass);
+  return std::min(sums.own_about1 + spread2, sums.own_about2 + spread1);
 }
 
 }  // namespace
@@ -71,7 +88,7 @@ IslandStiffness island_stiffness(
     std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
     std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of_slot,
     const Vec3& gravity, double dt, const SolverSettings& solver, std::vector<std::uint32_t>* level,
-    std::vector<std::uint32_t>* bodies_per_level) {
+    std::vector<LevelSums>* level_sums) {
   IslandStiffness result;
   const double g = gravity.norm();
   if (!(g > 0) || island_links.empty()) return result;
@@ -83,29 +100,31 @@ IslandStiffness island_stiffness(
   const Vec3 up = -gravity / g;
   const Vec3 across1 = up.unitOrthogonal();
   const Vec3 across2 = up.cross(across1);
-  // Bodies per level, and the buckling number of a column whose level l carries the bodies above
-  // it on the bodies of its own: a Rayleigh-type sum over levels of (load above over the
-  // level's stiffness) times the height of that load, 3 sum (D - l)^2 = D^3 for a tower of
-  // single blocks, half that for a wall-like pyramid, little for a pile.
-  std::vector<std::uint32_t>& per_level = *bodies_per_level;
-  per_level.assign(result.support_depth + 1, 0);
-  double most_slender = 0;
+  // The buckling number of a column whose level l carries the mass above it on its own tilt
+  // stiffness: a Rayleigh-type sum over levels of (weight above x its height x block height)
+  // over the level's tilt inertia. For a tower of blocks of mass m, height s and moment of
+  // inertia I it is g m s sum (D - l)^2 / I, about g m s D^3 / (3 I); a one-block-thick pyramid
+  // shares each level's load among its blocks (half a tower's); a pile's wide levels add little.
+  std::vector<LevelSums>& levels = *level_sums;
+  levels.assign(result.support_depth + 1, LevelSums{});
+  double tallest = 0;
   for (std::uint32_t slot : island_bodies) {
     const std::uint32_t l = (*level)[slot];
-    if (l == 0) continue;
-    ++per_level[l];
-    most_slender =
-        std::max(most_slender, tilt_slenderness(*body_of_slot[slot], up, across1, across2));
+    const Body& body = *body_of_slot[slot];
+    if (l == 0 || !(body.inverse_mass > 0)) continue;
+    add_to_level(body, across1, across2, &levels[l]);
+    tallest = std::max(tallest, height_along(body, up));
   }
-  double column = 0, above = 0;
+  double column = 0, mass_above = 0;
   for (std::uint32_t l = result.support_depth; l >= 1; --l) {
-    if (per_level[l] > 0) column += above / per_level[l] * (depth - l);
-    above += per_level[l];
+    const double inertia = tilt_inertia(levels[l]);
+    if (inertia > 0) column += g * mass_above * (depth - l) * tallest / inertia;
+    mass_above += levels[l].mass;
   }
   const double h = dt / solver.substeps;
   const double hertz = std::min(solver.contact_hertz, 0.25 / h);
   const double omega = 2 * std::numbers::pi * hertz;
-  const double buckling = 2 * g * 3 * column * most_slender / (omega * omega);
+  const double buckling = 2 * 3 * column / (omega * omega);
   if (!(buckling > kBucklingBound) || !(hertz > 0)) return result;
   const double needed_hertz = hertz * std::sqrt(buckling / kBucklingBound);
   // The spring may be a quarter of the substep rate: 4 f dt substeps, within the bound.
@@ -113,6 +132,10 @@ IslandStiffness island_stiffness(
   const int most = std::max(kMaxStiffenedSubsteps, solver.substeps);
   int substeps = wanted > most ? most : std::max(static_cast<int>(wanted), solver.substeps);
   result.capped = wanted > most;
+  // Past what the bound's spring can nearly reach (a light block under a billion times its mass),
+  // more substeps would cost their time and hold nothing: the island keeps the settings.
+  const double at_most = std::min(needed_hertz, 0.25 * substeps / dt);
+  if (buckling * (hertz / at_most) * (hertz / at_most) > kHopelessBuckling) return result;
   if (substeps <= solver.substeps) return result;
   result.substeps = substeps;
   result.contact_hertz = std::min(needed_hertz, 0.25 * substeps / dt);

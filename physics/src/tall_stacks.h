@@ -25,30 +25,42 @@
 namespace tumble {
 
 // Largest buckling number an island is left at: Greenhill's 7.84 with a margin of 1.74. Measured
-// over 60 s (docs/DYNAMICS.md): the tops of towers of 20 to 100 boxes then stay within 3 mm, but
-// the tower of 70's within 1.5 cm; at 6.7 the tower of 30 swayed 13 cm after its settling
-// transient. The sway left by that transient varies with the spring without a trend (3.0 and 6.0
-// were tried), so the bound is set where the tower of 50 stands best.
+// over 60 s (docs/DYNAMICS.md): the tops of towers of 20, 30, 50 and 100 boxes then stay within
+// 1 cm (the tower of 50's within 0.04 mm), the tower of 70's within 1.5 cm; at 6.7 the tower of
+// 30 swayed 13 cm after its settling transient. That sway is chaotic and varies with the spring
+// without a trend (3.0 and 6.0 were tried), so the bound is set where the tower of 50 stands best.
 constexpr double kBucklingBound = 4.5;
 // Substeps a stiffened island may take: time stays bounded whatever the stack.
 constexpr int kMaxStiffenedSubsteps = 32;
+// An island still past this with the most substeps (ten times the bound) is not stiffened: it
+// would pay for the substeps and fall all the same (the tower of 100 is at 12.8 there and stands).
+constexpr double kHopelessBuckling = 10 * kBucklingBound;
+
+// Per level of an island: its mass, first and second moments of mass along two horizontal axes,
+// and its bodies' own moments of inertia about them (tall_stacks.cc).
+struct LevelSums {
+  double mass = 0, first1 = 0, first2 = 0, second1 = 0, second2 = 0;
+  double own_about1 = 0, own_about2 = 0;
+};
 
 struct IslandStiffness {
   int substeps = 0;  // 0: the settings' substeps and spring
   double contact_hertz = 0;
-  bool capped = false;  // needed more than kMaxStiffenedSubsteps
+  // Needed more than kMaxStiffenedSubsteps: it takes that many, or none when even that leaves it
+  // past kHopelessBuckling.
+  bool capped = false;
   std::uint32_t support_depth = 0;
 };
 
 // One island's bodies (slots) and links (indices into `links`): the substeps and spring it
 // needs. Only links marked `touching` (overlapping, or apart by less than the slop) carry load:
 // speculative contacts between falling bodies make no column. `level` (by slot) and
-// `bodies_per_level` are working memory.
+// `level_sums` are working memory.
 IslandStiffness island_stiffness(
     std::span<const std::uint32_t> island_bodies, std::span<const std::uint32_t> island_links,
     std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
     std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of_slot,
     const Vec3& gravity, double dt, const SolverSettings& solver, std::vector<std::uint32_t>* level,
-    std::vector<std::uint32_t>* bodies_per_level);
+    std::vector<LevelSums>* level_sums);
 
 }  // namespace tumble

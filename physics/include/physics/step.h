@@ -90,8 +90,9 @@ struct StepStats {
   std::uint32_t exact_oversized = 0;
   std::uint64_t lemke_pivots = 0;
   // Soft islands tall enough to buckle under the contact spring, given more substeps and a
-  // stiffer spring (docs/DYNAMICS.md "Tall stacks"), and of those the ones that needed more than
-  // the bound of 32 substeps (they take 32).
+  // stiffer spring (docs/DYNAMICS.md "Tall stacks"); and islands that needed more than the bound
+  // of 32 substeps: they take 32, or keep the settings when even 32 would leave them far past
+  // the bound (a light block under a billion times its mass).
   std::uint32_t stiffened_islands = 0, stiffness_capped = 0;
   std::uint64_t velocity_iterations = 0;  // pgs and soft, summed over islands and substeps
   // Largest complementarity residual of a normal contact row after the solve, m/s:
