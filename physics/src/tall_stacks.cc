@@ -2,16 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <numbers>
 
 namespace tumble {
 namespace {
 
 // Levels of a breadth-first walk up from the bodies touching a static, found by relaxing the
-// links until nothing changes (a stack listed bottom to top settles in one pass). Bounded: a
-// depth past the bound is counted as the bound, which already asks for the most substeps.
+// links until nothing changes (a stack listed bottom to top settles in one pass, a pass per level
+// at worst). Bounded: after kMaxDepthPasses the bodies not reached yet are left out, the depth
+// found is at least the bound, far past what any substeps hold, and `exhausted` says so.
 constexpr int kMaxDepthPasses = 256;
 
 std::uint32_t support_depth(std::span<const std::uint32_t> island_bodies,
@@ -19,7 +18,7 @@ std::uint32_t support_depth(std::span<const std::uint32_t> island_bodies,
                             std::span<const IslandLink> links,
                             std::span<const std::uint8_t> touching,
                             std::span<const std::uint8_t> dynamic,
-                            std::vector<std::uint32_t>& level) {
+                            std::vector<std::uint32_t>& level, bool* exhausted) {
   for (std::uint32_t slot : island_bodies)
     level[slot] = 0;  // not reached
   for (std::uint32_t l : island_links) {
@@ -28,6 +27,7 @@ std::uint32_t support_depth(std::span<const std::uint32_t> island_bodies,
     if (!dynamic[link.a]) level[link.b] = 1;
     if (!dynamic[link.b]) level[link.a] = 1;
   }
+  *exhausted = true;
   for (int pass = 0; pass < kMaxDepthPasses; ++pass) {
     bool changed = false;
     for (std::uint32_t l : island_links) {
@@ -42,7 +42,10 @@ std::uint32_t support_depth(std::span<const std::uint32_t> island_bodies,
       lift(link.a, link.b);
       lift(link.b, link.a);
     }
-    if (!changed) break;
+    if (!changed) {
+      *exhausted = false;
+      break;
+    }
   }
   std::uint32_t depth = 0;
   for (std::uint32_t slot : island_bodies)
@@ -92,8 +95,10 @@ IslandStiffness island_stiffness(
   IslandStiffness result;
   const double g = gravity.norm();
   if (!(g > 0) || island_links.empty()) return result;
+  bool exhausted = false;
   result.support_depth =
-      support_depth(island_bodies, island_links, links, touching, dynamic, *level);
+      support_depth(island_bodies, island_links, links, touching, dynamic, *level, &exhausted);
+  result.capped = exhausted;
   const double depth = result.support_depth;
   // Two blocks high cannot buckle: a face tilts only under a load offset beyond its own edge.
   if (depth < 2) return result;
@@ -131,7 +136,7 @@ IslandStiffness island_stiffness(
   const double wanted = std::ceil(4 * needed_hertz * dt);
   const int most = std::max(kMaxStiffenedSubsteps, solver.substeps);
   int substeps = wanted > most ? most : std::max(static_cast<int>(wanted), solver.substeps);
-  result.capped = wanted > most;
+  result.capped = result.capped || wanted > most;
   // Past what the bound's spring can nearly reach (a light block under a billion times its mass),
   // more substeps would cost their time and hold nothing: the island keeps the settings.
   const double at_most = std::min(needed_hertz, 0.25 * substeps / dt);
