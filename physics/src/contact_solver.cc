@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 
 #include "rotation.h"
@@ -426,23 +427,13 @@ void solve_manifold_group(std::span<ContactRow> rows, std::span<const ManifoldRo
                           double* changes) {
   TUMBLE_ASSERT(manifolds.size() <= kSolverLanes);
   const double inverse_h = 1 / h;
-  const ManifoldRows* m = manifolds.data();
-  switch (manifolds.size()) {
-    case 4:
-      solve_lanes<4>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
-      break;
-    case 3:
-      solve_lanes<3>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
-      break;
-    case 2:
-      solve_lanes<2>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
-      break;
-    case 1:
-      solve_lanes<1>(rows, m, blocks, bodies, settings, soft, inverse_h, changes);
-      break;
-    default:
-      break;
-  }
+  // solve_lanes<n> for a group of n, chosen at run time.
+  constexpr decltype(&solve_lanes<1>) by_size[] = {nullptr, &solve_lanes<1>, &solve_lanes<2>,
+                                                   &solve_lanes<3>, &solve_lanes<4>};
+  static_assert(std::size(by_size) == kSolverLanes + 1);
+  if (!manifolds.empty())
+    by_size[manifolds.size()](rows, manifolds.data(), blocks, bodies, settings, soft, inverse_h,
+                              changes);
 }
 
 void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,

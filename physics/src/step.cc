@@ -64,6 +64,7 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
       for (int i = 0; i < solver.soft_iterations; ++i)
         if (run.sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
       run.integrate_positions(h);
+      run.refresh_separations();  // the relaxation sweeps see where the move left the bodies
       for (int i = 0; i < solver.relax_iterations; ++i)
         if (run.sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
     }
@@ -107,8 +108,8 @@ class SerialIsland {
   void integrate_positions(double h) {
     for (std::uint32_t slot : c_.bodies)
       integrate_position(h, &bodies_[slot], &c_.scratch.poses[slot]);
-    update_separations(rows_, c_.rows, bodies_);
   }
+  void refresh_separations() { update_separations(rows_, c_.rows, bodies_); }
   void warm_start(bool keep_last_substep) {
     tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep);
   }
@@ -199,6 +200,10 @@ class IslandLanes {
       lanes_[k]->integrate_positions(h);
       active_[k] = true;
     }
+  }
+  void refresh_separations() {
+    for (std::size_t k = 0; k < count_; ++k)
+      lanes_[k]->refresh_separations();
   }
   void warm_start(bool keep_last_substep) {
     for (std::size_t k = 0; k < count_; ++k) {
@@ -366,11 +371,12 @@ class TeamIsland {
 
   bool has_rows() const { return true; }  // coloured islands have many
   void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
-  void integrate_positions(double h) {
-    team_integrate_positions(c_, h);
+  void integrate_positions(double h) { team_integrate_positions(c_, h); }
+  void refresh_separations() {
     each_manifold(
         [&](std::span<const std::uint32_t> ids) { update_separations(s_.rows, ids, s_.bodies); });
   }
+
   void warm_start(bool keep_last_substep) {
     each_manifold([&](std::span<const std::uint32_t> ids) {
       tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies, keep_last_substep);

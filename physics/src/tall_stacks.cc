@@ -96,10 +96,10 @@ IslandStiffness island_stiffness(
   const double g = gravity.norm();
   if (!(g > 0) || island_links.empty()) return result;
   bool exhausted = false;
-  result.support_depth =
+  const std::uint32_t levels_found =
       support_depth(island_bodies, island_links, links, touching, dynamic, *level, &exhausted);
   result.capped = exhausted;
-  const double depth = result.support_depth;
+  const double depth = levels_found;
   // Two blocks high cannot buckle: a face tilts only under a load offset beyond its own edge.
   if (depth < 2) return result;
   const Vec3 up = -gravity / g;
@@ -111,7 +111,7 @@ IslandStiffness island_stiffness(
   // inertia I it is g m s sum (D - l)^2 / I, about g m s D^3 / (3 I); a one-block-thick pyramid
   // shares each level's load among its blocks (half a tower's); a pile's wide levels add little.
   std::vector<LevelSums>& levels = *level_sums;
-  levels.assign(result.support_depth + 1, LevelSums{});
+  levels.assign(levels_found + 1, LevelSums{});
   double tallest = 0;
   for (std::uint32_t slot : island_bodies) {
     const std::uint32_t l = (*level)[slot];
@@ -121,7 +121,7 @@ IslandStiffness island_stiffness(
     tallest = std::max(tallest, height_along(body, up));
   }
   double column = 0, mass_above = 0;
-  for (std::uint32_t l = result.support_depth; l >= 1; --l) {
+  for (std::uint32_t l = levels_found; l >= 1; --l) {
     const double inertia = tilt_inertia(levels[l]);
     if (inertia > 0) column += g * mass_above * (depth - l) * tallest / inertia;
     mass_above += levels[l].mass;

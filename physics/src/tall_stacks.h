@@ -49,7 +49,6 @@ struct IslandStiffness {
   // Needed more than kMaxStiffenedSubsteps: it takes that many, or none when even that leaves it
   // past kHopelessBuckling.
   bool capped = false;
-  std::uint32_t support_depth = 0;
 };
 
 // One island's bodies (slots) and links (indices into `links`): the substeps and spring it
