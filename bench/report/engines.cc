@@ -41,6 +41,25 @@ std::vector<Engine> tumble_engines(bool quick) {
   return out;
 }
 
+std::vector<Engine> soft_sweep_engines() {
+  struct Split {
+    int substeps, solve, relax;
+  };
+  const Split splits[] = {{4, 1, 1}, {4, 2, 1}, {4, 2, 2}, {6, 1, 1}, {8, 1, 1}, {4, 4, 4}};
+  std::vector<Engine> out;
+  for (const Split& split : splits) {
+    const std::string label = "Tumble soft " + std::to_string(split.substeps) + "x(" +
+                              std::to_string(split.solve) + "+" + std::to_string(split.relax) + ")";
+    out.push_back(tumble(label, [split](WorldSettings& w) {
+      solver(w, SolverKind::kSoft);
+      w.solver.substeps = split.substeps;
+      w.solver.soft_iterations = split.solve;
+      w.solver.relax_iterations = split.relax;
+    }));
+  }
+  return out;
+}
+
 std::vector<Engine> peer_engines() {
   std::vector<Engine> out;
 #ifdef TUMBLE_HAVE_PEERS

@@ -22,6 +22,9 @@ struct Engine {
 
 // Tumble's configurations: solver, iterations, substeps, threads. `quick` keeps one of each kind.
 std::vector<Engine> tumble_engines(bool quick);
+// The soft solver with other splits of its work between substeps, sweeps with bias and relaxing
+// sweeps (`tumble-report --sweeps`): the measurement its defaults are chosen by (docs/DYNAMICS.md).
+std::vector<Engine> soft_sweep_engines();
 // Bullet float and double, ODE, MuJoCo: every peer this build has (none without the packages).
 std::vector<Engine> peer_engines();
 // Names of the peers built in, for the report's header and the test that checks they appear.

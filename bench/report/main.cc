@@ -3,16 +3,21 @@
 // files into --out; scripts/report-plots draws the PNG plots from the CSV.
 //
 //   tumble-report [--quick] [--out DIR] [--only work|stability] [--time-limit SECONDS]
-//                 [--commit ID]
+//                 [--commit ID] [--sweeps] [--engines SUBSTRING,...]
+//
+// --sweeps adds the soft solver's other splits of substeps and sweeps; --engines keeps the
+// engines whose label contains one of the substrings (case-sensitive).
 #include <omp.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "report_writer.h"
 #include "scenes/standard.h"
@@ -48,20 +53,36 @@ std::string today() {
   return text;
 }
 
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    if (comma > start) parts.push_back(text.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return parts;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace tumble::report;
-  bool quick = false;
+  bool quick = false, sweeps = false;
+  std::vector<std::string> engine_filter;
   std::string out = "docs/report", only, commit = "unrecorded";
   double time_limit = 60;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--quick") {
       quick = true;
-    } else if ((arg == "--out" || arg == "--only" || arg == "--time-limit" || arg == "--commit") &&
+    } else if (arg == "--sweeps") {
+      sweeps = true;
+    } else if ((arg == "--out" || arg == "--only" || arg == "--time-limit" || arg == "--commit" ||
+                arg == "--engines") &&
                i + 1 < argc) {
       const std::string value = argv[++i];
+      if (arg == "--engines") engine_filter = split_list(value);
       if (arg == "--commit") commit = value;
       if (arg == "--out") out = value;
       if (arg == "--only") only = value;
@@ -69,7 +90,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: tumble-report [--quick] [--out DIR] [--only work|stability] "
-                   "[--time-limit SECONDS] [--commit ID]\n(unknown or incomplete argument '%s')\n",
+                   "[--time-limit SECONDS] [--commit ID] [--sweeps] [--engines SUBSTRING,...]\n"
+                   "(unknown or incomplete argument '%s')\n",
                    arg.c_str());
       return 2;
     }
@@ -87,12 +109,31 @@ int main(int argc, char** argv) {
   }
 
   std::vector<Engine> engines = tumble_engines(quick);
+  if (sweeps)
+    for (Engine& variant : soft_sweep_engines())
+      engines.push_back(std::move(variant));
   for (Engine& peer : peer_engines())
     engines.push_back(std::move(peer));
+  if (!engine_filter.empty()) {
+    std::erase_if(engines, [&](const Engine& engine) {
+      return std::none_of(engine_filter.begin(), engine_filter.end(), [&](const std::string& part) {
+        return engine.label.find(part) != std::string::npos;
+      });
+    });
+    if (engines.empty()) {
+      std::fprintf(stderr, "--engines: no engine's label contains any of the given substrings\n");
+      return 2;
+    }
+  }
 
   ReportHeader header;
   header.quick = quick;
   header.command = quick ? "make report QUICK=1" : "make report";
+  if (sweeps || !engine_filter.empty()) {
+    header.command = "build/bench/tumble-report";
+    for (int i = 1; i < argc; ++i)
+      header.command += std::string(" ") + argv[i];
+  }
   header.date = today();
   header.machine = machine();
   header.commit = commit;
