@@ -25,13 +25,13 @@ Totals measure(const World& world) {
   Totals t;
   const Vec3 g = world.settings().gravity;
   for (std::uint32_t i = 0; i < world.slot_count(); ++i) {
-    const Body* body = world.body(world.id_at(i));
-    if (body == nullptr || body->is_static()) continue;
-    const Vec3 w_body = body->orientation.conjugate() * body->angular_velocity;
-    t.kinetic += 0.5 * body->mass * body->linear_velocity.squaredNorm() +
-                 0.5 * w_body.dot(body->inertia_body * w_body);
-    t.potential -= body->mass * g.dot(body->position);
-    t.max_speed = std::max(t.max_speed, body->linear_velocity.norm());
+    const BodyView body = world.body(world.id_at(i));
+    if (!body || body->is_static()) continue;
+    const Vec3 w_body = body->orientation().conjugate() * body->angular_velocity();
+    t.kinetic += 0.5 * body->mass() * body->linear_velocity().squaredNorm() +
+                 0.5 * w_body.dot(body->inertia_body() * w_body);
+    t.potential -= body->mass() * g.dot(body->position());
+    t.max_speed = std::max(t.max_speed, body->linear_velocity().norm());
   }
   return t;
 }

@@ -180,13 +180,14 @@ int main(int argc, char** argv) {
     frozen.bodies.clear();
     frozen.bodies.push_back(floor_plane());
     for (std::uint32_t i = 0; i < world.slot_count(); ++i) {
-      const Body* body = world.body(world.id_at(i));
-      if (body == nullptr || body->is_static()) continue;
+      const BodyView body = world.body(world.id_at(i));
+      if (!body || body->is_static()) continue;
       // Awake bodies stay dynamic, with their velocities: only the sleepers change.
-      BodyDef def = box_at(body->position, body->asleep ? BodyType::kStatic : BodyType::kDynamic);
-      def.orientation = body->orientation;
-      def.linear_velocity = body->linear_velocity;
-      def.angular_velocity = body->angular_velocity;
+      BodyDef def =
+          box_at(body->position(), body->asleep() ? BodyType::kStatic : BodyType::kDynamic);
+      def.orientation = body->orientation();
+      def.linear_velocity = body->linear_velocity();
+      def.angular_velocity = body->angular_velocity();
       frozen.bodies.push_back(def);
     }
     World still = make(frozen);

@@ -4,8 +4,8 @@
 
 namespace tumble::server {
 
-BodyLook look_of(const Body& body, std::uint32_t colour) {
-  return {body.shape, body.type, body.is_static() ? 0 : body.mass, colour};
+BodyLook look_of(BodyView body, std::uint32_t colour) {
+  return {body.shape(), body.type(), body.is_static() ? 0 : body.mass(), colour};
 }
 
 std::shared_ptr<const Catalogue> updated_catalogue(HostedWorld& hosted,
@@ -24,12 +24,12 @@ std::shared_ptr<const Catalogue> updated_catalogue(HostedWorld& hosted,
   fresh->reserve(world.body_count());
   for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
     const BodyId id = world.id_at(slot);
-    const Body* body = world.body(id);
-    if (body == nullptr) {
+    const BodyView body = world.body(id);
+    if (!body) {
       hosted.colours[slot] = 0;  // a later body in this slot starts with the viewer's choice
       continue;
     }
-    fresh->emplace(hosted.ids.wire(id), look_of(*body, hosted.colours[slot]));
+    fresh->emplace(hosted.ids.wire(id), look_of(body, hosted.colours[slot]));
   }
   return fresh;
 }
@@ -55,17 +55,17 @@ std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted,
   frame->angular_velocities.reserve(3 * n);
   for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
     const BodyId id = world.id_at(slot);
-    const Body* body = world.body(id);
-    if (body == nullptr) continue;
+    const BodyView body = world.body(id);
+    if (!body) continue;
     frame->ids.push_back(hosted.ids.wire(id));
-    frame->positions.insert(frame->positions.end(), body->position.data(),
-                            body->position.data() + 3);
-    const Quat& q = body->orientation;
+    auto append = [](const Vec3& v, std::vector<double>& out) {
+      out.insert(out.end(), {v.x(), v.y(), v.z()});
+    };
+    append(body.position(), frame->positions);
+    const Quat q = body.orientation();
     frame->orientations.insert(frame->orientations.end(), {q.w(), q.x(), q.y(), q.z()});
-    frame->linear_velocities.insert(frame->linear_velocities.end(), body->linear_velocity.data(),
-                                    body->linear_velocity.data() + 3);
-    frame->angular_velocities.insert(frame->angular_velocities.end(), body->angular_velocity.data(),
-                                     body->angular_velocity.data() + 3);
+    append(body.linear_velocity(), frame->linear_velocities);
+    append(body.angular_velocity(), frame->angular_velocities);
   }
   const auto impulses = world.contact_impulses();
   std::size_t row = 0;

@@ -51,7 +51,7 @@ struct FrameData {
   StepStats stats;
 };
 
-BodyLook look_of(const Body& body, std::uint32_t colour);
+BodyLook look_of(BodyView body, std::uint32_t colour);
 
 // The catalogue of `hosted`'s bodies: `current` itself while the set of bodies is the same (so a
 // steady world's frames share one), else a new one. Forgets the colours of empty slots.

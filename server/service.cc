@@ -178,7 +178,7 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
     }
     response->set_step(world.step_count());
     for (BodyId id : ids) {
-      const Body& body = *world.body(id);
+      const BodyView body = world.body(id);
       describe(hosted.ids.wire(id), look_of(body, hosted.colours[id.index]),
                response->add_descriptions());
       v1::BodyState* state = response->add_states();
@@ -188,14 +188,15 @@ grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
         out->set_y(v.y());
         out->set_z(v.z());
       };
-      set(body.position, state->mutable_position());
-      state->mutable_orientation()->set_w(body.orientation.w());
-      state->mutable_orientation()->set_x(body.orientation.x());
-      state->mutable_orientation()->set_y(body.orientation.y());
-      state->mutable_orientation()->set_z(body.orientation.z());
-      set(body.linear_velocity, state->mutable_linear_velocity());
-      set(body.angular_velocity, state->mutable_angular_velocity());
-      state->set_asleep(body.asleep);
+      set(body.position(), state->mutable_position());
+      const Quat q = body.orientation();
+      state->mutable_orientation()->set_w(q.w());
+      state->mutable_orientation()->set_x(q.x());
+      state->mutable_orientation()->set_y(q.y());
+      state->mutable_orientation()->set_z(q.z());
+      set(body.linear_velocity(), state->mutable_linear_velocity());
+      set(body.angular_velocity(), state->mutable_angular_velocity());
+      state->set_asleep(body.asleep());
     }
   });
   return to_grpc(read);

@@ -21,11 +21,10 @@ inline World build(const SceneDef& scene) {
 }
 
 // Dynamic bodies in slot order.
-inline std::vector<const Body*> dynamic_bodies(const World& world) {
-  std::vector<const Body*> out;
+inline std::vector<BodyView> dynamic_bodies(const World& world) {
+  std::vector<BodyView> out;
   for (std::uint32_t i = 0; i < world.slot_count(); ++i)
-    if (const Body* b = world.body(world.id_at(i)); b != nullptr && !b->is_static())
-      out.push_back(b);
+    if (const BodyView b = world.body(world.id_at(i)); b && !b->is_static()) out.push_back(b);
   return out;
 }
 
@@ -40,45 +39,47 @@ inline std::uint64_t state_hash(const World& world) {
       hash *= 1099511628211ull;
     }
   };
-  for (const Body* b : dynamic_bodies(world)) {
+  for (const BodyView b : dynamic_bodies(world)) {
     for (int k = 0; k < 3; ++k) {
-      mix(b->position[k]);
-      mix(b->linear_velocity[k]);
-      mix(b->angular_velocity[k]);
+      mix(b->position()[k]);
+      mix(b->linear_velocity()[k]);
+      mix(b->angular_velocity()[k]);
     }
     for (int k = 0; k < 4; ++k)
-      mix(b->orientation.coeffs()[k]);
+      mix(b->orientation().coeffs()[k]);
   }
   return hash;
 }
 
-inline double kinetic_energy(const Body& b) {
-  const Vec3 w_body = b.orientation.conjugate() * b.angular_velocity;
-  return 0.5 * b.mass * b.linear_velocity.squaredNorm() + 0.5 * w_body.dot(b.inertia_body * w_body);
+inline double kinetic_energy(BodyView b) {
+  const Vec3 w_body = b.orientation().conjugate() * b.angular_velocity();
+  return 0.5 * b.mass() * b.linear_velocity().squaredNorm() +
+         0.5 * w_body.dot(b.inertia_body() * w_body);
 }
 
 inline double total_energy(const World& world) {
   double e = 0;
-  for (const Body* b : dynamic_bodies(world))
-    e += kinetic_energy(*b) - b->mass * world.settings().gravity.dot(b->position);
+  for (const BodyView b : dynamic_bodies(world))
+    e += kinetic_energy(b) - b->mass() * world.settings().gravity.dot(b->position());
   return e;
 }
 
 // The lowest point of a box below z = 0 (0 when none is).
-inline double corner_depth(const Body& b) {
-  if (b.shape.type() != ShapeType::kBox) return 0;
+inline double corner_depth(BodyView b) {
+  if (b.shape().type() != ShapeType::kBox) return 0;
   double lowest = 0;
-  const Vec3 h = b.shape.half_extents();
+  const Vec3 h = b.shape().half_extents();
   for (int i = 0; i < 8; ++i) {
     const Vec3 corner((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z());
-    lowest = std::min(lowest, (b.orientation * corner + b.position).z());
+    lowest = std::min(lowest, (b.orientation() * corner + b.position()).z());
   }
   return -lowest;
 }
 
 inline bool all_finite(const World& world) {
-  for (const Body* b : dynamic_bodies(world))
-    if (!is_finite(b->position) || !is_finite(b->linear_velocity) || !is_finite(b->orientation))
+  for (const BodyView b : dynamic_bodies(world))
+    if (!is_finite(b->position()) || !is_finite(b->linear_velocity()) ||
+        !is_finite(b->orientation()))
       return false;
   return true;
 }

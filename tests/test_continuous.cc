@@ -110,12 +110,12 @@ TEST(Continuous, BoxAt1000MetresPerSecondStopsAtA1CentimetreWall) {
       double farthest = -1e9;
       run(world, 1.0 / 60, 30, [&](long) {
         impacts += world.last_step().continuous_impacts;
-        farthest = std::max(farthest, dynamic_bodies(world)[0]->position.x());
+        farthest = std::max(farthest, dynamic_bodies(world)[0]->position().x());
       });
       SCOPED_TRACE(std::string(solver_name(kind)) + " from x = " + std::to_string(start));
       // Never beyond touching the wall's near face (x = -0.005 - 0.05), and stopped there.
       EXPECT_LT(farthest, -0.055 + 1e-3);
-      EXPECT_LE(dynamic_bodies(world)[0]->linear_velocity.x(), 1e-6);
+      EXPECT_LE(dynamic_bodies(world)[0]->linear_velocity().x(), 1e-6);
       EXPECT_GE(impacts, 1u);
       EXPECT_EQ(world.last_step().continuous_limit_hits, 0u);
     }
@@ -130,11 +130,11 @@ TEST(Continuous, FastBoxPassingBesideAnotherIsNotTouched) {
   scene.bodies[1].position = Vec3(0, 0.3, 0);
   World world = build(scene);
   run(world, 1.0 / 60, 3);
-  const Body& box = *dynamic_bodies(world)[0];
-  EXPECT_EQ(box.linear_velocity, Vec3(1000, 0, 0));
-  EXPECT_EQ(box.angular_velocity, Vec3::Zero());
-  EXPECT_NEAR(box.position.x(), -20 + 3 * 1000.0 / 60, 1e-9);
-  EXPECT_EQ(box.position.y(), 0);
+  const BodyView box = dynamic_bodies(world)[0];
+  EXPECT_EQ(box.linear_velocity(), Vec3(1000, 0, 0));
+  EXPECT_EQ(box.angular_velocity(), Vec3::Zero());
+  EXPECT_NEAR(box.position().x(), -20 + 3 * 1000.0 / 60, 1e-9);
+  EXPECT_EQ(box.position().y(), 0);
   EXPECT_GT(world.last_step().swept_bodies, 0u);
 
   // Without the sweep, a speculative contact as long as the motion (16.7 m) stands in for it,
@@ -142,7 +142,7 @@ TEST(Continuous, FastBoxPassingBesideAnotherIsNotTouched) {
   scene.world.solver.continuous = false;
   World speculative_only = build(scene);
   run(speculative_only, 1.0 / 60, 3);
-  EXPECT_LT(dynamic_bodies(speculative_only)[0]->linear_velocity.x(), 999);
+  EXPECT_LT(dynamic_bodies(speculative_only)[0]->linear_velocity().x(), 999);
 }
 
 // A 1 cm thick plate spinning at 100 rad/s (1.7 rad per step) just above the floor: it never goes
@@ -164,9 +164,9 @@ TEST(Continuous, ThinPlateSpinningFastDoesNotPassTheFloor) {
     World world = build(scene);
     double deepest = 0, lowest_centre = 1e9;
     run(world, 1.0 / 60, 180, [&](long) {
-      const Body& body = *dynamic_bodies(world)[0];
+      const BodyView body = dynamic_bodies(world)[0];
       deepest = std::max(deepest, corner_depth(body));
-      lowest_centre = std::min(lowest_centre, body.position.z());
+      lowest_centre = std::min(lowest_centre, body.position().z());
     });
     SCOPED_TRACE(solver_name(kind));
     EXPECT_LT(deepest, 0.01);
@@ -201,7 +201,7 @@ TEST(Continuous, StoppingEarlyAddsNoEnergy) {
     impacts += world.last_step().continuous_impacts;
   });
   EXPECT_GE(impacts, 1u);
-  EXPECT_NEAR(dynamic_bodies(world)[0]->position.z(), 0.05, 0.01);
+  EXPECT_NEAR(dynamic_bodies(world)[0]->position().z(), 0.05, 0.01);
 }
 
 // Scenes without fast bodies sweep nothing.

@@ -28,13 +28,13 @@ TEST(FreeFall, MatchesTheSchemeExactlyAndConvergesToTheParabola) {
     const long n = 60L << refinement;  // one second
     World world = build(one_body(ball, g));
     run(world, dt, n);
-    const Body& b = *dynamic_bodies(world)[0];
+    const BodyView b = dynamic_bodies(world)[0];
     const double t = n * dt;
     const Vec3 scheme = ball.position + ball.linear_velocity * t + g * dt * dt * n * (n + 1) / 2.0;
-    EXPECT_LT((b.position - scheme).norm(), 1e-10);
-    EXPECT_LT((b.linear_velocity - (ball.linear_velocity + g * t)).norm(), 1e-10);
+    EXPECT_LT((b.position() - scheme).norm(), 1e-10);
+    EXPECT_LT((b.linear_velocity() - (ball.linear_velocity + g * t)).norm(), 1e-10);
     const Vec3 exact = ball.position + ball.linear_velocity * t + 0.5 * g * t * t;
-    const double error = (b.position - exact).norm();
+    const double error = (b.position() - exact).norm();
     EXPECT_NEAR(error, 0.5 * 9.81 * t * dt, 1e-9);
     if (refinement > 0) {
       EXPECT_NEAR(previous_error / error, 2.0, 1e-6);
@@ -55,9 +55,9 @@ TEST(Slide, StopsWhereCoulombFrictionSays) {
       World world = build(scene);
       double deepest = 0;
       run(world, dt, std::lround(3 / dt),
-          [&](long) { deepest = std::max(deepest, corner_depth(*dynamic_bodies(world)[0])); });
-      const Body& box = *dynamic_bodies(world)[0];
-      const double distance = box.position.x();
+          [&](long) { deepest = std::max(deepest, corner_depth(dynamic_bodies(world)[0])); });
+      const BodyView box = dynamic_bodies(world)[0];
+      const double distance = box.position().x();
       SCOPED_TRACE(std::string(solver_name(kind)) + " dt " + std::to_string(dt));
       // The soft solver integrates in substeps.
       const double h = kind == SolverKind::kSoft ? dt / scene.world.solver.substeps : dt;
@@ -65,8 +65,8 @@ TEST(Slide, StopsWhereCoulombFrictionSays) {
       if (h <= 1.0 / 120) {
         EXPECT_NEAR(distance, exact, 0.01 * exact);
       }
-      EXPECT_LT(std::abs(box.position.y()), 1e-4);  // no sideways drift
-      EXPECT_LT(box.linear_velocity.norm(), 1e-6);  // stopped, not creeping
+      EXPECT_LT(std::abs(box.position().y()), 1e-4);  // no sideways drift
+      EXPECT_LT(box.linear_velocity().norm(), 1e-6);  // stopped, not creeping
       EXPECT_LT(deepest, 1e-3);
     }
   }
@@ -84,9 +84,9 @@ TEST(Bounce, ReachesRestitutionSquaredTimesHeight) {
     double apex = 0;
     bool bounced = false;
     run(world, dt, std::lround(1.5 / dt), [&](long) {
-      const Body& box = *dynamic_bodies(world)[0];
-      if (box.linear_velocity.z() > 0) bounced = true;
-      if (bounced) apex = std::max(apex, box.position.z() - 0.5);
+      const BodyView box = dynamic_bodies(world)[0];
+      if (box.linear_velocity().z() > 0) bounced = true;
+      if (bounced) apex = std::max(apex, box.position().z() - 0.5);
     });
     SCOPED_TRACE(solver_name(kind));
     EXPECT_TRUE(bounced);
@@ -101,7 +101,7 @@ TEST(Bounce, SlowImpactsDoNotBounce) {
   double highest_after = 0;
   run(world, 1.0 / 60, 120, [&](long s) {
     if (s > 30)
-      highest_after = std::max(highest_after, dynamic_bodies(world)[0]->position.z() - 0.5);
+      highest_after = std::max(highest_after, dynamic_bodies(world)[0]->position().z() - 0.5);
   });
   EXPECT_LT(highest_after, 1e-3);
 }
@@ -111,10 +111,10 @@ TEST(Bounce, SlowImpactsDoNotBounce) {
 TEST(Spin, KeepsEnergyAndMomentumAndFlips) {
   for (double dt : {1.0 / 60, 1.0 / 240}) {
     World world = build(spin_scene());
-    const Body& box = *dynamic_bodies(world)[0];
+    const BodyView box = dynamic_bodies(world)[0];
     auto momentum = [&] {
-      return Vec3(box.orientation *
-                  (box.inertia_body * (box.orientation.conjugate() * box.angular_velocity)));
+      return Vec3(box.orientation() *
+                  (box.inertia_body() * (box.orientation().conjugate() * box.angular_velocity())));
     };
     const double ke0 = kinetic_energy(box);
     const Vec3 l0 = momentum();
@@ -123,7 +123,7 @@ TEST(Spin, KeepsEnergyAndMomentumAndFlips) {
     run(world, dt, std::lround(20 / dt), [&](long) {
       worst_ke = std::max(worst_ke, std::abs(kinetic_energy(box) / ke0 - 1));
       worst_l = std::max(worst_l, std::abs(momentum().norm() / l0.norm() - 1));
-      const double c = (box.orientation * Vec3::UnitY()).dot(l0.normalized());
+      const double c = (box.orientation() * Vec3::UnitY()).dot(l0.normalized());
       if (c * previous_c < 0) ++flips;
       if (c != 0) previous_c = c;
     });

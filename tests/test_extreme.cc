@@ -25,8 +25,9 @@ BodyDef box(const Vec3& half, const Vec3& position, double mass = 0) {
   return def;
 }
 
-Vec3 world_momentum(const Body& b) {
-  return b.orientation * (b.inertia_body * (b.orientation.conjugate() * b.angular_velocity));
+Vec3 world_momentum(BodyView b) {
+  return b.orientation() *
+         (b.inertia_body() * (b.orientation().conjugate() * b.angular_velocity()));
 }
 
 // The acceptance test of an LCP answer is in m/s and absolute: impulses of 1e10 N s that the old
@@ -59,8 +60,8 @@ TEST(ExactSolver, PileOfTwoHundredFiftyStaysSane) {
   // sanitizer build, where a step of this pile's exact islands costs 20 times as much).
   run(world, 1.0 / 60, 100, [&](long) {
     oversized += world.last_step().exact_oversized;
-    for (const Body* b : dynamic_bodies(world))
-      fastest = std::max(fastest, b->linear_velocity.norm());
+    for (const BodyView b : dynamic_bodies(world))
+      fastest = std::max(fastest, b->linear_velocity().norm());
   });
   ASSERT_TRUE(all_finite(world));
   // Free fall from the top layer (8.5 m) reaches 13 m/s; nothing may go faster than a fall.
@@ -88,15 +89,15 @@ TEST(Spin, FastSpinKeepsEnergyAndMomentum) {
     SceneDef scene = spin_scene();
     scene.bodies[0].angular_velocity = Vec3(0.01, 1, 0.01) * rate;
     World world = build(scene);
-    const Body* body = dynamic_bodies(world)[0];
-    const double energy = kinetic_energy(*body);
-    const double momentum = world_momentum(*body).norm();
+    BodyView body = dynamic_bodies(world)[0];
+    const double energy = kinetic_energy(body);
+    const double momentum = world_momentum(body).norm();
     double highest = 0, drift = 0;
     std::uint32_t hits = 0;
     run(world, 1.0 / 60, 600, [&](long) {
       body = dynamic_bodies(world)[0];
-      highest = std::max(highest, kinetic_energy(*body) / energy - 1);
-      drift = std::max(drift, std::abs(world_momentum(*body).norm() / momentum - 1));
+      highest = std::max(highest, kinetic_energy(body) / energy - 1);
+      drift = std::max(drift, std::abs(world_momentum(body).norm() / momentum - 1));
       hits += world.last_step().gyroscopic_limit_hits;
     });
     SCOPED_TRACE(rate);
@@ -113,10 +114,10 @@ TEST(Spin, BeyondTheBoundTheStepReportsAndGainsNothing) {
   scene.bodies[0].angular_velocity = Vec3(0.01, 1, 0.01) * 1e6;
   scene.world.limits.max_angular_speed = 1e7;  // the default limit refuses this spin at the door
   World world = build(scene);
-  const double energy = kinetic_energy(*dynamic_bodies(world)[0]);
+  const double energy = kinetic_energy(dynamic_bodies(world)[0]);
   run(world, 1.0 / 60, 10);
   EXPECT_EQ(world.last_step().gyroscopic_limit_hits, 1u);
-  EXPECT_LE(kinetic_energy(*dynamic_bodies(world)[0]) / energy - 1, 1e-10);
+  EXPECT_LE(kinetic_energy(dynamic_bodies(world)[0]) / energy - 1, 1e-10);
 }
 
 // Two boxes spawned half inside each other, no gravity: pushed apart, and then still. They once
@@ -132,10 +133,10 @@ TEST(Overlap, PushedApartWithoutKeepingSpeed) {
     run(world, 1.0 / 60, 120);
     const auto bodies = dynamic_bodies(world);
     SCOPED_TRACE(solver_name(kind));
-    EXPECT_GT((bodies[1]->position - bodies[0]->position).norm(), 1.0 - 2e-3);
-    for (const Body* b : bodies) {
-      EXPECT_LT(b->linear_velocity.norm(), 1e-3);
-      EXPECT_LT(b->angular_velocity.norm(), 1e-3);
+    EXPECT_GT((bodies[1]->position() - bodies[0]->position()).norm(), 1.0 - 2e-3);
+    for (const BodyView b : bodies) {
+      EXPECT_LT(b->linear_velocity().norm(), 1e-3);
+      EXPECT_LT(b->angular_velocity().norm(), 1e-3);
     }
   }
 }
@@ -168,8 +169,8 @@ CrushRun run_crush(World& world) {
   run(world, 1.0 / 60, 300, [&](long) {
     out.highest_energy = std::max(out.highest_energy, total_energy(world));
     out.fallbacks += world.last_step().exact_fallbacks;
-    for (const Body* b : dynamic_bodies(world))
-      out.deepest_corner = std::max(out.deepest_corner, corner_depth(*b));
+    for (const BodyView b : dynamic_bodies(world))
+      out.deepest_corner = std::max(out.deepest_corner, corner_depth(b));
   });
   return out;
 }
@@ -197,7 +198,7 @@ TEST(MassRatio, BillionToOneCrushesButNeverExplodes) {
     ASSERT_TRUE(all_finite(world));
     EXPECT_LT(crush.deepest_corner, 0.0105);  // never below the cubes' own height
     EXPECT_LE(crush.highest_energy, energy + 1e-9 * std::abs(energy));
-    EXPECT_GT(dynamic_bodies(world)[4]->position.z(), 5.0 - 0.0105);
+    EXPECT_GT(dynamic_bodies(world)[4]->position().z(), 5.0 - 0.0105);
   }
 }
 

@@ -35,9 +35,9 @@ std::string steps_soundly(World& world, double dt) {
   for (int k = 0; k < 3; ++k) {
     if (Status s = world.step(dt); !s) return "step " + std::to_string(k) + ": " + s.message();
     for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
-      const Body* body = world.body(world.id_at(slot));
-      if (body == nullptr) continue;
-      if (Status s = check_limits(*body, world.settings().limits); !s)
+      const BodyView body = world.body(world.id_at(slot));
+      if (!body) continue;
+      if (Status s = check_limits(body, world.settings().limits); !s)
         return "after step " + std::to_string(k) + ", slot " + std::to_string(slot) + ": " +
                s.message();
     }

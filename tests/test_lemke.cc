@@ -100,8 +100,8 @@ TEST(Solvers, ExactAndPgsAgreeOnSmallStacks) {
       scene.world.solver.sleeping = false;  // the impulses are compared at the end
       World world = build(scene);
       run(world, 1.0 / 60, 120);
-      for (const Body* b : dynamic_bodies(world))
-        final_positions[k].push_back(b->position);
+      for (const BodyView b : dynamic_bodies(world))
+        final_positions[k].push_back(b->position());
       for (double impulse : world.contact_impulses())
         impulses[k] += impulse;
       EXPECT_EQ(world.last_step().exact_fallbacks, 0u);

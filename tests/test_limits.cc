@@ -167,16 +167,16 @@ TEST(Limits, TheStepHoldsBodiesAtTheSpeedLimitAndTheEdgeOfTheWorld) {
   std::uint32_t slowed = 0, at_edge = 0;
   for (int step = 0; step < 400; ++step) {
     ASSERT_TRUE(world.step(1.0 / 60).is_ok());
-    const Body& body = *world.body(world.id_at(0));
-    ASSERT_LE(body.linear_velocity.norm(), 5 + 1e-12);
-    ASSERT_GE(body.position.z(), -20);
+    const BodyView body = world.body(world.id_at(0));
+    ASSERT_LE(body.linear_velocity().norm(), 5 + 1e-12);
+    ASSERT_GE(body.position().z(), -20);
     slowed += world.last_step().slowed_bodies;
     at_edge += world.last_step().bodies_at_edge;
   }
   EXPECT_GT(slowed, 100u);  // from about 0.5 s on, gravity would take it past 5 m/s
   // It reaches -20 m after about 4.3 s, is held there until it falls asleep (0.5 s at rest).
   EXPECT_GE(at_edge, 25u);
-  EXPECT_EQ(world.body(world.id_at(0))->position.z(), -20);
+  EXPECT_EQ(world.body(world.id_at(0))->position().z(), -20);
 }
 
 TEST(Limits, AStepResultThatIsNotFiniteKeepsThePoseFromBeforeAtRest) {

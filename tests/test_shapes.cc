@@ -130,10 +130,10 @@ TEST(Bodies, NearlyUnitQuaternionIsNormalisedAndMassSetsInertia) {
   def.orientation = Quat(1.0005, 0, 0, 0);
   def.mass = 3;
   const BodyId id = world.create_body(def).value();
-  const Body* body = world.body(id);
-  EXPECT_NEAR(body->orientation.norm(), 1.0, 1e-15);
-  EXPECT_NEAR(body->mass, 3.0, 1e-12);
-  EXPECT_NEAR(body->inertia_body(0, 0), 3.0 / 6.0, 1e-12);
+  const BodyView body = world.body(id);
+  EXPECT_NEAR(body->orientation().norm(), 1.0, 1e-15);
+  EXPECT_NEAR(body->mass(), 3.0, 1e-12);
+  EXPECT_NEAR(body->inertia_body()(0, 0), 3.0 / 6.0, 1e-12);
 }
 
 TEST(Bodies, HullBodyIsPlacedAtItsCentreOfMass) {
@@ -142,10 +142,10 @@ TEST(Bodies, HullBodyIsPlacedAtItsCentreOfMass) {
   def.shape = HullDef{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}};
   def.position = Vec3(10, 0, 0);
   def.orientation = Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()));
-  const Body* body = world.body(world.create_body(def).value());
-  EXPECT_TRUE(body->position.isApprox(Vec3(10 - 0.25, 0.25, 0.25), 1e-12));
+  const BodyView body = world.body(world.create_body(def).value());
+  EXPECT_TRUE(body->position().isApprox(Vec3(10 - 0.25, 0.25, 0.25), 1e-12));
   // The hull's vertices, placed by the body's pose, are where the definition put them.
-  const Vec3 corner = body->pose().transform(body->shape.polyhedron()->vertices[0]);
+  const Vec3 corner = body->pose().transform(body->shape().polyhedron()->vertices[0]);
   bool matches = false;
   for (const Vec3& p : std::get<HullDef>(def.shape).points)
     matches |= (corner - def.position - def.orientation * p).norm() < 1e-12;
@@ -172,7 +172,7 @@ TEST(World, RemovedIdsGoStaleAndSlotsAreReused) {
   const BodyId first = world.create_body(BodyDef{}).value();
   ASSERT_TRUE(world.remove_body(first).is_ok());
   EXPECT_FALSE(world.contains(first));
-  EXPECT_EQ(world.body(first), nullptr);
+  EXPECT_FALSE(world.body(first));
   EXPECT_EQ(world.remove_body(first).message(), "body: no body with this id");
   const BodyId second = world.create_body(BodyDef{}).value();
   EXPECT_EQ(second.index, first.index);

@@ -7,8 +7,8 @@ namespace tumble::testing {
 namespace {
 
 bool all_asleep(const World& world) {
-  for (const Body* b : dynamic_bodies(world))
-    if (!b->asleep) return false;
+  for (const BodyView b : dynamic_bodies(world))
+    if (!b->asleep()) return false;
   return true;
 }
 
@@ -35,9 +35,9 @@ TEST(Sleeping, SettledPileFallsAsleepSoonAfterSettling) {
   double last_moving = 0, all_asleep_at = -1;
   run(world, 1.0 / 60, 1200, [&](long s) {
     if (all_asleep_at >= 0) return;
-    for (const Body* b : dynamic_bodies(world))
-      if (b->linear_velocity.norm() >= solver.sleep_linear_speed ||
-          b->angular_velocity.norm() >= solver.sleep_angular_speed)
+    for (const BodyView b : dynamic_bodies(world))
+      if (b->linear_velocity().norm() >= solver.sleep_linear_speed ||
+          b->angular_velocity().norm() >= solver.sleep_angular_speed)
         last_moving = s / 60.0;
     if (all_asleep(world)) all_asleep_at = s / 60.0;
   });
@@ -53,11 +53,11 @@ TEST(Sleeping, RemovingTheBottomBoxWakesTheStackAndItFalls) {
   ASSERT_TRUE(all_asleep(world));
   const BodyId bottom = world.id_at(1);
   const BodyId top = world.id_at(3);
-  const double top_before = world.body(top)->position.z();
+  const double top_before = world.body(top)->position().z();
   ASSERT_TRUE(world.remove_body(bottom).is_ok());
-  EXPECT_FALSE(world.body(top)->asleep);
+  EXPECT_FALSE(world.body(top)->asleep());
   run(world, 1.0 / 60, 90);
-  EXPECT_NEAR(world.body(top)->position.z(), top_before - 1.0, 0.01);
+  EXPECT_NEAR(world.body(top)->position().z(), top_before - 1.0, 0.01);
 }
 
 TEST(Sleeping, SleeperHitByANewBoxWakes) {
@@ -73,8 +73,8 @@ TEST(Sleeping, SleeperHitByANewBoxWakes) {
   run(world, 1.0 / 60, 120, [&](long) { woken += world.last_step().woken_bodies; });
   EXPECT_EQ(woken, 1u);
   // The new box came to rest on the old one (which did not let it through).
-  const Body& top = *dynamic_bodies(world)[1];
-  EXPECT_NEAR(top.position.z(), 1.5, 0.01);
+  const BodyView top = dynamic_bodies(world)[1];
+  EXPECT_NEAR(top.position().z(), 1.5, 0.01);
   EXPECT_TRUE(all_finite(world));
 }
 

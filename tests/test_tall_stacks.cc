@@ -22,13 +22,13 @@ struct StackRun {
 StackRun run_stack(const SceneDef& scene, int steps) {
   World world = build(scene);
   StackRun out;
-  out.top_start = dynamic_bodies(world).back()->position;
+  out.top_start = dynamic_bodies(world).back()->position();
   for (int i = 0; i < steps; ++i) {
     EXPECT_TRUE(world.step(scene.dt).is_ok());
     out.most_stiffened = std::max(out.most_stiffened, world.last_step().stiffened_islands);
     out.capped += world.last_step().stiffness_capped;
   }
-  out.top_end = dynamic_bodies(world).back()->position;
+  out.top_end = dynamic_bodies(world).back()->position();
   out.finite = all_finite(world);
   return out;
 }

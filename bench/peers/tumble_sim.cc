@@ -33,14 +33,14 @@ class TumbleSimulation final : public Simulation {
     settings_ += "; " + (threads > 0 ? std::to_string(threads) : std::string("all")) + " thread" +
                  (threads == 1 ? "" : "s") + "; sleeping " + (s.sleeping ? "on" : "off");
     for (std::uint32_t i = 0; i < world_.slot_count(); ++i)
-      if (const Body* b = world_.body(world_.id_at(i)); b != nullptr && !b->is_static())
+      if (const BodyView b = world_.body(world_.id_at(i)); b && !b->is_static())
         dynamic_.push_back(world_.id_at(i));
   }
   bool step() override { return world_.step(dt_).is_ok(); }
   std::size_t body_count() const override { return dynamic_.size(); }
   BodyState body(std::size_t i) const override {
-    const Body* b = world_.body(dynamic_[i]);
-    return {b->position, b->orientation, b->linear_velocity, b->angular_velocity};
+    const BodyView b = world_.body(dynamic_[i]);
+    return {b->position(), b->orientation(), b->linear_velocity(), b->angular_velocity()};
   }
   double reported_depth() const override { return world_.last_step().max_penetration; }
   const World& world() const { return world_; }

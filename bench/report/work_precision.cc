@@ -269,8 +269,8 @@ class ConvergedPositions {
       for (long s = 0; s < steps; ++s)
         (void)world.step(fine_.dt);
       for (std::uint32_t i = 0; i < world.slot_count(); ++i)
-        if (const Body* b = world.body(world.id_at(i)); b != nullptr && !b->is_static())
-          positions_.push_back(b->position);
+        if (const BodyView b = world.body(world.id_at(i)); b && !b->is_static())
+          positions_.push_back(b->position());
     });
     return positions_;
   }

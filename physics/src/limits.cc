@@ -92,25 +92,51 @@ Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,
   return Status::ok();
 }
 
-Status check_limits(const Body& body, const WorldLimits& limits) {
-  if (!is_finite(body.position)) return Status::error("position: must be finite");
+namespace {
+
+// Both check_limits read a body through these getters (a Body's fields, or a view's).
+template <class AnyBody>
+Status check_body_limits(const AnyBody& body, const WorldLimits& limits) {
+  const Vec3 position = body.position();
+  if (!is_finite(position)) return Status::error("position: must be finite");
   for (int k = 0; k < 3; ++k)
-    if (std::abs(body.position[k]) > limits.max_coordinate)
-      return above("position[" + std::to_string(k) + "]", std::abs(body.position[k]), "m",
+    if (std::abs(position[k]) > limits.max_coordinate)
+      return above("position[" + std::to_string(k) + "]", std::abs(position[k]), "m",
                    "max_coordinate", limits.max_coordinate);
-  if (body.shape.type() != ShapeType::kHalfSpace) {
-    const ShapeSpan span = span_of(body.shape);
+  const Shape& shape = body.shape();
+  if (shape.type() != ShapeType::kHalfSpace) {
+    const ShapeSpan span = span_of(shape);
     if (!(span.smallest >= limits.min_size))
       return below(span.smallest_field, span.smallest, "m", "min_size", limits.min_size);
-    if (const double largest = body.shape.outer_radius(); !(largest <= limits.max_size))
+    if (const double largest = shape.outer_radius(); !(largest <= limits.max_size))
       return above(span.largest_field, largest, "m", "max_size", limits.max_size);
   }
   if (body.is_static()) return Status::ok();
-  if (!(body.mass >= limits.min_mass))
-    return below("mass", body.mass, "kg", "min_mass", limits.min_mass);
-  if (!(body.mass <= limits.max_mass))
-    return above("mass", body.mass, "kg", "max_mass", limits.max_mass);
-  return check_speeds(body.linear_velocity, body.angular_velocity, limits);
+  const double mass = body.mass();
+  if (!(mass >= limits.min_mass)) return below("mass", mass, "kg", "min_mass", limits.min_mass);
+  if (!(mass <= limits.max_mass)) return above("mass", mass, "kg", "max_mass", limits.max_mass);
+  return check_speeds(body.linear_velocity(), body.angular_velocity(), limits);
+}
+
+// A Body's fields through the getters check_body_limits reads.
+struct BodyFields {
+  const Body& body;
+  Vec3 position() const { return body.position; }
+  const Shape& shape() const { return body.shape; }
+  bool is_static() const { return body.is_static(); }
+  double mass() const { return body.mass; }
+  Vec3 linear_velocity() const { return body.linear_velocity; }
+  Vec3 angular_velocity() const { return body.angular_velocity; }
+};
+
+}  // namespace
+
+Status check_limits(const Body& body, const WorldLimits& limits) {
+  return check_body_limits(BodyFields{body}, limits);
+}
+
+Status check_limits(BodyView body, const WorldLimits& limits) {
+  return check_body_limits(body, limits);
 }
 
 }  // namespace tumble

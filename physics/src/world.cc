@@ -272,8 +272,8 @@ bool World::contains(BodyId id) const {
          bodies_[id.index].generation == id.generation;
 }
 
-const Body* World::body(BodyId id) const {
-  return contains(id) ? &bodies_[id.index].body : nullptr;
+BodyView World::body(BodyId id) const {
+  return contains(id) ? BodyView(&bodies_[id.index].body) : BodyView();
 }
 
 BodyId World::id_at(std::uint32_t index) const {

@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "physics/body.h"
+#include "physics/body_view.h"
 #include "physics/status.h"
 
 namespace tumble {
@@ -42,6 +43,8 @@ Status validate(const WorldLimits& limits);
 // Checks a built body against the limits; the message names the field and the limit
 // ("shape.radius: 1e+18 m is above limits.max_size (100000 m)").
 Status check_limits(const Body& body, const WorldLimits& limits);
+// The same for a body of a world (after a step, say).
+Status check_limits(BodyView body, const WorldLimits& limits);
 
 // Checks velocities a body would take ("linear_velocity: ... above limits.max_linear_speed").
 Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,

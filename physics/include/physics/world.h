@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "physics/body.h"
+#include "physics/body_view.h"
 #include "physics/collision.h"
 #include "physics/limits.h"
 #include "physics/math.h"
@@ -90,8 +91,8 @@ class World {
   static Result<World> from_state(const WorldSettings& settings, WorldStateData state);
 
   bool contains(BodyId id) const;
-  // The body, or null when `id` is stale or was never made.
-  const Body* body(BodyId id) const;
+  // A look at the body, false when `id` is stale or was never made.
+  BodyView body(BodyId id) const;
   BodyId id_at(std::uint32_t index) const;  // the live body in slot `index`, or an invalid id
   std::size_t body_count() const { return live_count_; }
   std::uint32_t slot_count() const { return static_cast<std::uint32_t>(bodies_.size()); }

@@ -1,0 +1,58 @@
+// A read-only look at one body of a world, got from World::body(id): what the server, the apps,
+// the benchmarks and the tests read of a body, so that none of them depends on how the world
+// stores its bodies (which may split a body's data by use, as Box2D v3 and Jolt do).
+//
+// A view shows the body as it is now: it follows steps, moves and impulses. It is good until
+// bodies are created or removed (which may move storage); after that, ask the world again.
+#pragma once
+
+#include "physics/body.h"
+#include "physics/math.h"
+#include "physics/shape.h"
+
+namespace tumble {
+
+class World;
+
+class BodyView {
+ public:
+  BodyView() = default;  // no body: false, and reading it is an error
+
+  // False for the view of a stale or unknown id.
+  explicit operator bool() const { return body_ != nullptr; }
+  // So that `world.body(id)->position()` reads like the pointer it replaces.
+  const BodyView* operator->() const { return this; }
+
+  BodyType type() const { return body().type; }
+  bool is_static() const { return body().is_static(); }
+  bool asleep() const { return body().asleep; }
+  // Dynamic and awake: what the step moves.
+  bool is_moving() const { return body().is_moving(); }
+
+  // The shape, re-centred on the centre of mass.
+  const Shape& shape() const { return body().shape; }
+  double mass() const { return body().mass; }                  // kg; 0 for static
+  double inverse_mass() const { return body().inverse_mass; }  // 1/kg; 0 for static
+  Mat3 inertia_body() const { return body().inertia_body; }    // kg m^2, body frame
+  Mat3 inverse_inertia_world() const { return body().inverse_inertia_world; }
+  double friction() const { return body().friction; }
+  double restitution() const { return body().restitution; }
+
+  Vec3 position() const { return body().position; }  // m, centre of mass
+  Quat orientation() const { return body().orientation; }
+  Pose pose() const { return body().pose(); }
+  Vec3 linear_velocity() const { return body().linear_velocity; }    // m/s
+  Vec3 angular_velocity() const { return body().angular_velocity; }  // rad/s, world
+
+ private:
+  friend class World;
+  explicit BodyView(const Body* body) : body_(body) {}
+  const Body& body() const {
+    TUMBLE_ASSERT(body_ != nullptr);
+    return *body_;
+  }
+
+  const Body* body_ = nullptr;
+};
+
+}  // namespace tumble
