@@ -34,34 +34,53 @@ EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) {
     b_vertices[i] = rotation * pb.vertices[i] + translation;
   for (std::size_t i = 0; i < pb.faces.size(); ++i)
     b_normals[i] = rotation * pb.faces[i].normal;
-  // B's Gauss-map arcs, negated for the Minkowski difference A - B: the same for every edge of A.
-  struct Arc {
-    Vec3 w1, w2, w2xw1;
-  };
-  thread_local std::vector<Arc> b_arcs;
+  // B's Gauss-map arcs (the planes through its edges' two normals), negated for the Minkowski
+  // difference A - B, and A's.
+  thread_local std::vector<Vec3> b_arcs, a_arcs;
   b_arcs.resize(pb.edges.size());
   for (std::size_t j = 0; j < pb.edges.size(); ++j) {
-    Arc& arc = b_arcs[j];
-    arc.w1 = -b_normals[pb.edges[j].left];
-    arc.w2 = -b_normals[pb.edges[j].right];
-    arc.w2xw1 = arc.w2.cross(arc.w1);
+    const Vec3 w1 = -b_normals[pb.edges[j].left];
+    const Vec3 w2 = -b_normals[pb.edges[j].right];
+    b_arcs[j] = w2.cross(w1);
   }
 
+  // The Gauss-map test of a pair of edges reads four dot products, each between a face normal of
+  // one polyhedron and an arc of the other's edge: computed once per (face, edge) here instead
+  // of once per pair of edges (faces are fewer than edges), with the same operands, so the same
+  // bits.
+  const std::size_t a_edge_count = pa.edges.size(), b_edge_count = pb.edges.size();
+  a_arcs.resize(a_edge_count);
+  for (std::size_t i = 0; i < a_edge_count; ++i)
+    a_arcs[i] = pa.faces[pa.edges[i].right].normal.cross(pa.faces[pa.edges[i].left].normal);
+  // b_side[i * |F_B| + f]: B's negated normal f against A's arc i; a_side[f * |E_B| + j]: A's
+  // normal f against B's arc j (laid out so that the loop over B's edges reads short rows).
+  thread_local std::vector<double> b_side, a_side;
+  b_side.resize(pb.faces.size() * a_edge_count);
+  a_side.resize(pa.faces.size() * b_edge_count);
+  const std::size_t b_face_count = pb.faces.size();
+  for (std::size_t f = 0; f < b_face_count; ++f) {
+    const Vec3 w = -b_normals[f];
+    for (std::size_t i = 0; i < a_edge_count; ++i)
+      b_side[i * b_face_count + f] = w.dot(a_arcs[i]);
+  }
+  for (std::size_t f = 0; f < pa.faces.size(); ++f)
+    for (std::size_t j = 0; j < b_edge_count; ++j)
+      a_side[f * b_edge_count + j] = pa.faces[f].normal.dot(b_arcs[j]);
+
   EdgeQuery best;
-  for (std::uint32_t i = 0; i < pa.edges.size(); ++i) {
+  for (std::uint32_t i = 0; i < a_edge_count; ++i) {
     const auto& ea = pa.edges[i];
-    const Vec3& u1 = pa.faces[ea.left].normal;
-    const Vec3& u2 = pa.faces[ea.right].normal;
     const Vec3 tail_a = pa.vertices[ea.tail];
     const Vec3 dir_a = pa.vertices[ea.head] - tail_a;
-    const Vec3 u2xu1 = u2.cross(u1);
-    for (std::uint32_t j = 0; j < pb.edges.size(); ++j) {
+    const double* u1_side = &a_side[ea.left * b_edge_count];
+    const double* u2_side = &a_side[ea.right * b_edge_count];
+    const double* arc_side = &b_side[i * b_face_count];
+    for (std::uint32_t j = 0; j < b_edge_count; ++j) {
       // Do arcs u1-u2 (A) and w1-w2 (B's, negated) cross on the Gauss map?
-      const Arc& arc = b_arcs[j];
-      const double cba = arc.w1.dot(u2xu1);
-      const double dba = arc.w2.dot(u2xu1);
-      const double adc = u1.dot(arc.w2xw1);
-      const double bdc = u2.dot(arc.w2xw1);
+      const double cba = arc_side[pb.edges[j].left];
+      const double dba = arc_side[pb.edges[j].right];
+      const double adc = u1_side[j];
+      const double bdc = u2_side[j];
       if (!(cba * dba < 0 && adc * bdc < 0 && cba * bdc > 0)) continue;
 
       const auto& eb = pb.edges[j];
