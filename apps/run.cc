@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   // Bounded loops that hit their bound, summed over the run: none of their answers was used as if
   // it were right, but a run that hits them is one to look at.
   std::uint64_t exact_fallbacks = 0, exact_oversized = 0, gyroscopic = 0, continuous = 0;
-  // Islands tall enough to buckle, given more substeps (island-steps), and those at the bound.
+  // Islands tall enough to buckle, given more substeps or sweeps (island-steps), and those at the
+  // bound.
   std::uint64_t stiffened = 0, stiffness_capped = 0;
   // The world's limits held by the step (body-steps).
   std::uint64_t non_finite = 0, slowed = 0, at_edge = 0;
@@ -154,8 +155,8 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(exact_oversized), static_cast<unsigned long long>(gyroscopic),
       static_cast<unsigned long long>(continuous));
   std::printf(
-      "tall stacks over the run (island-steps): given more substeps %llu, needing more than the "
-      "32-substep bound %llu\n",
+      "tall stacks over the run (island-steps): given more substeps (soft) or sweeps (pgs) %llu, "
+      "needing more than the bound (32 substeps, 256 sweeps) %llu\n",
       static_cast<unsigned long long>(stiffened),
       static_cast<unsigned long long>(stiffness_capped));
   std::printf(

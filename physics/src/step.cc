@@ -77,9 +77,14 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
     if (report->solver == IslandSolver::kExact && run.has_rows()) pgs = !run.solve_exact(dt);
   }
   if (pgs) {
+    // A tall pgs island sweeps more and to the end (tall_stacks.h): sweeps stopped early leave
+    // the compression it would buckle under.
+    const bool tall = report->solver == IslandSolver::kPgs && report->pgs_iterations > 0;
+    const int iterations = tall ? report->pgs_iterations : solver.iterations;
+    const double tolerance = tall ? 0.0 : solver.velocity_tolerance;
     run.warm_start(false);
-    for (int i = 0; i < solver.iterations; ++i)
-      if (run.sweep(nullptr, dt, i % 2 == 1) <= solver.velocity_tolerance) break;
+    for (int i = 0; i < iterations; ++i)
+      if (run.sweep(nullptr, dt, i % 2 == 1) <= tolerance) break;
   }
   // After the move, as in the soft path: a body stopped by a speculative contact first lands,
   // then leaves with its bounce.
@@ -599,6 +604,17 @@ void World::prepare_contacts(double dt) {
       s.reports[i].substeps = stiffness.substeps;
       s.reports[i].contact_hertz = stiffness.contact_hertz;
       s.reports[i].stiffness_capped = stiffness.capped;
+    } else if (kind == IslandSolver::kPgs) {
+      bool capped = false;
+      s.reports[i].pgs_iterations =
+          tall_pgs_iterations(std::span(s.islands.bodies)
+                                  .subspan(s.islands.body_begin[i],
+                                           s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
+                              std::span(s.islands.links)
+                                  .subspan(s.islands.link_begin[i],
+                                           s.islands.link_begin[i + 1] - s.islands.link_begin[i]),
+                              s.links, s.touching, s.dynamic, solver, &s.support_level, &capped);
+      s.reports[i].stiffness_capped = capped;
     }
   }
 
@@ -656,7 +672,7 @@ void World::solve_islands(double dt) {
     const IslandReport& report = s.reports[i];
     if (s.island_row_begin[i + 1] == s.island_row_begin[i]) return -1;
     if (report.solver == IslandSolver::kSoft && report.substeps == 0) return 0;
-    if (report.solver == IslandSolver::kPgs) return 1;
+    if (report.solver == IslandSolver::kPgs && report.pgs_iterations == 0) return 1;
     return -1;
   };
   for (int kind = 0; kind < 2; ++kind) {
@@ -706,7 +722,7 @@ void World::solve_islands(double dt) {
       ++stats_.iterative_islands;
     stats_.exact_fallbacks += report.exact_failed ? 1 : 0;
     stats_.exact_oversized += report.exact_oversized ? 1 : 0;
-    stats_.stiffened_islands += report.substeps > 0 ? 1 : 0;
+    stats_.stiffened_islands += report.substeps > 0 || report.pgs_iterations > 0 ? 1 : 0;
     stats_.stiffness_capped += report.stiffness_capped ? 1 : 0;
     stats_.lemke_pivots += report.lemke_pivots;
     stats_.velocity_iterations += report.velocity_iterations;

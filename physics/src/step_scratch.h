@@ -25,6 +25,8 @@ struct IslandReport {
   // settings'.
   int substeps = 0;
   double contact_hertz = 0;
+  // Pgs islands tall enough to buckle: all their sweeps, this many (0: the settings').
+  int pgs_iterations = 0;
   bool stiffness_capped = false;
 };
 

@@ -84,21 +84,27 @@ double tilt_inertia(const LevelSums& sums) {
   return std::min(sums.own_about1 + spread2, sums.own_about2 + spread1);
 }
 
-}  // namespace
+// An island's column: its support depth (levels above the statics), whether the walk that
+// measured it reached its pass bound, and sum over levels of (weight above x height x block
+// height) over the level's tilt inertia, which over the spring's w^2 is the buckling number.
+struct Column {
+  std::uint32_t depth = 0;
+  bool exhausted = false;
+  double load_over_inertia = 0;  // 1/s^2
+};
 
-IslandStiffness island_stiffness(
-    std::span<const std::uint32_t> island_bodies, std::span<const std::uint32_t> island_links,
-    std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
-    std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of_slot,
-    const Vec3& gravity, double dt, const SolverSettings& solver, std::vector<std::uint32_t>* level,
-    std::vector<LevelSums>* level_sums) {
-  IslandStiffness result;
+Column measure_column(std::span<const std::uint32_t> island_bodies,
+                      std::span<const std::uint32_t> island_links,
+                      std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
+                      std::span<const std::uint8_t> dynamic,
+                      std::span<const Body* const> body_of_slot, const Vec3& gravity,
+                      std::vector<std::uint32_t>* level, std::vector<LevelSums>* level_sums) {
+  Column result;
   const double g = gravity.norm();
   if (!(g > 0) || island_links.empty()) return result;
-  bool exhausted = false;
-  const std::uint32_t levels_found =
-      support_depth(island_bodies, island_links, links, touching, dynamic, *level, &exhausted);
-  result.capped = exhausted;
+  const std::uint32_t levels_found = support_depth(island_bodies, island_links, links, touching,
+                                                   dynamic, *level, &result.exhausted);
+  result.depth = levels_found;
   const double depth = levels_found;
   // Two blocks high cannot buckle: a face tilts only under a load offset beyond its own edge.
   if (depth < 2) return result;
@@ -126,10 +132,34 @@ IslandStiffness island_stiffness(
     if (inertia > 0) column += g * mass_above * (depth - l) * tallest / inertia;
     mass_above += levels[l].mass;
   }
+  result.load_over_inertia = column;
+  return result;
+}
+
+// The buckling number of a column at the settings' spring, and that spring.
+double buckling_at_settings(const Column& column, double dt, const SolverSettings& solver,
+                            double* hertz) {
   const double h = dt / solver.substeps;
-  const double hertz = std::min(solver.contact_hertz, 0.25 / h);
-  const double omega = 2 * std::numbers::pi * hertz;
-  const double buckling = 2 * 3 * column / (omega * omega);
+  *hertz = std::min(solver.contact_hertz, 0.25 / h);
+  const double omega = 2 * std::numbers::pi * *hertz;
+  return 2 * 3 * column.load_over_inertia / (omega * omega);
+}
+
+}  // namespace
+
+IslandStiffness island_stiffness(
+    std::span<const std::uint32_t> island_bodies, std::span<const std::uint32_t> island_links,
+    std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
+    std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of_slot,
+    const Vec3& gravity, double dt, const SolverSettings& solver, std::vector<std::uint32_t>* level,
+    std::vector<LevelSums>* level_sums) {
+  IslandStiffness result;
+  const Column column = measure_column(island_bodies, island_links, links, touching, dynamic,
+                                       body_of_slot, gravity, level, level_sums);
+  result.capped = column.exhausted;
+  if (column.depth < 2) return result;
+  double hertz = 0;
+  const double buckling = buckling_at_settings(column, dt, solver, &hertz);
   if (!(buckling > kBucklingBound) || !(hertz > 0)) return result;
   const double needed_hertz = hertz * std::sqrt(buckling / kBucklingBound);
   // The spring may be a quarter of the substep rate: 4 f dt substeps, within the bound.
@@ -145,6 +175,21 @@ IslandStiffness island_stiffness(
   result.substeps = substeps;
   result.contact_hertz = std::min(needed_hertz, 0.25 * substeps / dt);
   return result;
+}
+
+int tall_pgs_iterations(std::span<const std::uint32_t> island_bodies,
+                        std::span<const std::uint32_t> island_links,
+                        std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
+                        std::span<const std::uint8_t> dynamic, const SolverSettings& solver,
+                        std::vector<std::uint32_t>* level, bool* capped) {
+  if (island_links.empty()) return 0;
+  const double depth =
+      support_depth(island_bodies, island_links, links, touching, dynamic, *level, capped);
+  if (depth < kTallPgsDepth) return 0;
+  const double wanted = std::ceil(depth * depth / 8);
+  *capped = *capped || wanted > kMaxTallPgsIterations;
+  const int most = std::max(kMaxTallPgsIterations, solver.iterations);
+  return wanted > most ? most : std::max(static_cast<int>(wanted), solver.iterations);
 }
 
 }  // namespace tumble

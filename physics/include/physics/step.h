@@ -89,10 +89,11 @@ struct StepStats {
   // Islands the exact solver was asked for but were larger than exact_max_island_points: soft.
   std::uint32_t exact_oversized = 0;
   std::uint64_t lemke_pivots = 0;
-  // Soft islands tall enough to buckle under the contact spring, given more substeps and a
-  // stiffer spring (docs/DYNAMICS.md "Tall stacks"); and islands that needed more than the bound
-  // of 32 substeps: they take 32, or keep the settings when even 32 would leave them far past
-  // the bound (a light block under a billion times its mass).
+  // Islands tall enough to buckle (docs/DYNAMICS.md "Tall stacks"): soft ones given more
+  // substeps and a stiffer spring, pgs ones more sweeps and no early stop; and islands that
+  // needed more than the bounds (32 substeps, 256 sweeps): they take the bound, or (soft) keep
+  // the settings when even 32 substeps would leave them far past it (a light block under a
+  // billion times its mass).
   std::uint32_t stiffened_islands = 0, stiffness_capped = 0;
   std::uint64_t velocity_iterations = 0;  // pgs and soft, summed over islands and substeps
   // Largest complementarity residual of a normal contact row after the solve, m/s:
