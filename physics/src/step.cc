@@ -591,29 +591,24 @@ void World::prepare_contacts(double dt) {
       }
     }
     s.reports[i].solver = kind;
+    const auto island_bodies = std::span(s.islands.bodies)
+                                   .subspan(s.islands.body_begin[i],
+                                            s.islands.body_begin[i + 1] - s.islands.body_begin[i]);
+    const auto island_links = std::span(s.islands.links)
+                                  .subspan(s.islands.link_begin[i],
+                                           s.islands.link_begin[i + 1] - s.islands.link_begin[i]);
     if (kind == IslandSolver::kSoft) {
-      const IslandStiffness stiffness =
-          island_stiffness(std::span(s.islands.bodies)
-                               .subspan(s.islands.body_begin[i],
-                                        s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
-                           std::span(s.islands.links)
-                               .subspan(s.islands.link_begin[i],
-                                        s.islands.link_begin[i + 1] - s.islands.link_begin[i]),
-                           s.links, s.touching, s.dynamic, s.body_of_slot, settings_.gravity, dt,
-                           solver, &s.support_level, &s.level_sums);
+      const IslandStiffness stiffness = island_stiffness(
+          island_bodies, island_links, s.links, s.touching, s.dynamic, s.body_of_slot,
+          settings_.gravity, dt, solver, &s.support_level, &s.level_sums);
       s.reports[i].substeps = stiffness.substeps;
       s.reports[i].contact_hertz = stiffness.contact_hertz;
       s.reports[i].stiffness_capped = stiffness.capped;
     } else if (kind == IslandSolver::kPgs) {
       bool capped = false;
       s.reports[i].pgs_iterations =
-          tall_pgs_iterations(std::span(s.islands.bodies)
-                                  .subspan(s.islands.body_begin[i],
-                                           s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
-                              std::span(s.islands.links)
-                                  .subspan(s.islands.link_begin[i],
-                                           s.islands.link_begin[i + 1] - s.islands.link_begin[i]),
-                              s.links, s.touching, s.dynamic, solver, &s.support_level, &capped);
+          tall_pgs_iterations(island_bodies, island_links, s.links, s.touching, s.dynamic, solver,
+                              &s.support_level, &capped);
       s.reports[i].stiffness_capped = capped;
     }
   }
