@@ -6,13 +6,10 @@
 #include <numbers>
 
 #include "rotation.h"
+#include "wide.h"
 
 namespace tumble {
 namespace {
-
-// The sweep's per-row parts are inlined into the manifold loop, so that a manifold's two bodies'
-// velocities stay in registers across its rows (out of line, they go through memory every call).
-#define TUMBLE_INLINE inline __attribute__((always_inline))
 
 // Relative tangential speeds below this leave the friction basis fixed to the normal, so resting
 // contacts keep one basis from step to step.
@@ -331,47 +328,24 @@ TUMBLE_INLINE double solve_normals(std::span<ContactRow> rows, const ManifoldRow
   return change;
 }
 
-// Solves `Lanes` manifolds that share no moving body: each manifold's friction point by point,
-// then its normals (solve_normals). A manifold's rows form one chain of dependent arithmetic (each
-// row reads the velocities the last one wrote), which leaves the core waiting on latencies; the
-// lanes' chains are independent, so interleaving them stage by stage keeps it busy. Manifolds
-// that share no moving body give the same bits in any order, so one lane or four is the same
-// answer. Returns the largest velocity change it gave a contact (m/s), and each manifold's in
-// `lane_changes` when given.
-template <int Lanes>
-double solve_lanes(std::span<ContactRow> rows, const ManifoldRows* manifolds,
-                   std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                   const SolverSettings& settings, const Softness* soft, double inverse_h,
-                   double* lane_changes = nullptr) {
-  SolverBody* body_a[Lanes];
-  SolverBody* body_b[Lanes];
-  PairVelocities pair[Lanes];
-  double change[Lanes];
-  int most = 0;
-  for (int k = 0; k < Lanes; ++k) {
-    const ContactRow& first = rows[manifolds[k].ids[0]];
-    body_a[k] = &bodies[first.a];
-    body_b[k] = &bodies[first.b];
-    pair[k] = PairVelocities(*body_a[k], *body_b[k]);
-    change[k] = 0;
-    most = std::max(most, manifolds[k].count);
-  }
-  for (int i = 0; i < most; ++i)
-    for (int k = 0; k < Lanes; ++k)
-      if (i < manifolds[k].count)
-        change[k] = std::max(change[k], solve_friction(rows[manifolds[k].ids[i]], pair[k]));
-  NormalTarget targets[Lanes][4];
-  for (int k = 0; k < Lanes; ++k)
-    for (int i = 0; i < manifolds[k].count; ++i)
-      targets[k][i] = normal_target(rows[manifolds[k].ids[i]], settings, soft, inverse_h);
-  double largest = 0;
-  for (int k = 0; k < Lanes; ++k) {
-    change[k] = std::max(change[k], solve_normals(rows, manifolds[k], blocks, pair[k], targets[k]));
-    pair[k].store(*body_a[k], *body_b[k]);
-    largest = std::max(largest, change[k]);
-    if (lane_changes != nullptr) lane_changes[k] = change[k];
-  }
-  return largest;
+// A manifold's rows form one chain of dependent arithmetic (each row reads the velocities the
+// last one wrote); its bodies' velocities stay in registers across them (PairVelocities).
+double solve_one_manifold(std::span<ContactRow> rows, const ManifoldRows& manifold,
+                          std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                          const SolverSettings& settings, const Softness* soft, double inverse_h) {
+  const ContactRow& first = rows[manifold.ids[0]];
+  SolverBody& body_a = bodies[first.a];
+  SolverBody& body_b = bodies[first.b];
+  PairVelocities pair(body_a, body_b);
+  double change = 0;
+  for (int i = 0; i < manifold.count; ++i)
+    change = std::max(change, solve_friction(rows[manifold.ids[i]], pair));
+  NormalTarget targets[4];
+  for (int i = 0; i < manifold.count; ++i)
+    targets[i] = normal_target(rows[manifold.ids[i]], settings, soft, inverse_h);
+  change = std::max(change, solve_normals(rows, manifold, blocks, pair, targets));
+  pair.store(body_a, body_b);
+  return change;
 }
 
 }  // namespace
@@ -387,8 +361,8 @@ double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t>
   if (!backward) {
     for (std::size_t k = 0; k < count;) {
       const ManifoldRows manifold{&ids[k], rows[ids[k]].block_size};
-      change = std::max(change,
-                        solve_lanes<1>(rows, &manifold, blocks, bodies, settings, soft, inverse_h));
+      change = std::max(
+          change, solve_one_manifold(rows, manifold, blocks, bodies, settings, soft, inverse_h));
       k += manifold.count;
     }
   } else {
@@ -396,44 +370,18 @@ double solve_contacts(std::span<ContactRow> rows, std::span<const std::uint32_t>
       const ContactRow& last = rows[ids[end - 1]];
       const std::size_t start = end - 1 - last.block_index;
       const ManifoldRows manifold{&ids[start], last.block_size};
-      change = std::max(change,
-                        solve_lanes<1>(rows, &manifold, blocks, bodies, settings, soft, inverse_h));
+      change = std::max(
+          change, solve_one_manifold(rows, manifold, blocks, bodies, settings, soft, inverse_h));
       end = start;
     }
   }
   return change;
 }
 
-double solve_independent_manifolds(std::span<ContactRow> rows,
-                                   std::span<const ManifoldRows> manifolds,
-                                   std::span<const NormalBlock> blocks,
-                                   std::span<SolverBody> bodies, const SolverSettings& settings,
-                                   const Softness* soft, double h) {
-  const double inverse_h = 1 / h;
-  double change = 0;
-  std::size_t k = 0;
-  for (; k + kSolverLanes <= manifolds.size(); k += kSolverLanes)
-    change = std::max(change, solve_lanes<kSolverLanes>(rows, &manifolds[k], blocks, bodies,
-                                                        settings, soft, inverse_h));
-  for (; k < manifolds.size(); ++k)
-    change = std::max(
-        change, solve_lanes<1>(rows, &manifolds[k], blocks, bodies, settings, soft, inverse_h));
-  return change;
-}
-
-void solve_manifold_group(std::span<ContactRow> rows, std::span<const ManifoldRows> manifolds,
-                          std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                          const SolverSettings& settings, const Softness* soft, double h,
-                          double* changes) {
-  TUMBLE_ASSERT(manifolds.size() <= kSolverLanes);
-  const double inverse_h = 1 / h;
-  // solve_lanes<n> for a group of n, chosen at run time.
-  constexpr decltype(&solve_lanes<1>) by_size[] = {nullptr, &solve_lanes<1>, &solve_lanes<2>,
-                                                   &solve_lanes<3>, &solve_lanes<4>};
-  static_assert(std::size(by_size) == kSolverLanes + 1);
-  if (!manifolds.empty())
-    by_size[manifolds.size()](rows, manifolds.data(), blocks, bodies, settings, soft, inverse_h,
-                              changes);
+double solve_manifold(std::span<ContactRow> rows, const ManifoldRows& manifold,
+                      std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                      const SolverSettings& settings, const Softness* soft, double h) {
+  return solve_one_manifold(rows, manifold, blocks, bodies, settings, soft, 1 / h);
 }
 
 void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,

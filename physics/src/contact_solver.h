@@ -135,24 +135,12 @@ struct ManifoldRows {
   int count = 0;
 };
 
-// How many manifolds solve_independent_manifolds interleaves.
-constexpr std::size_t kSolverLanes = 4;
-
-// One sweep over manifolds that share no moving body (one colour), kSolverLanes at a time: the
-// same bits as solving them one after the other, in any order, and faster (contact_solver.cc
-// says why). Returns the largest velocity change the sweep gave any contact (m/s).
-double solve_independent_manifolds(std::span<ContactRow> rows,
-                                   std::span<const ManifoldRows> manifolds,
-                                   std::span<const NormalBlock> blocks,
-                                   std::span<SolverBody> bodies, const SolverSettings& settings,
-                                   const Softness* soft, double h);
-
-// Solves up to kSolverLanes manifolds that share no moving body (of different islands, or of one
-// colour) interleaved, and writes each one's largest velocity change (m/s) to changes[k].
-void solve_manifold_group(std::span<ContactRow> rows, std::span<const ManifoldRows> manifolds,
-                          std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
-                          const SolverSettings& settings, const Softness* soft, double h,
-                          double* changes);
+// One manifold's part of a sweep: its friction point by point, then its normals as a block
+// (NormalBlock) when that keeps every impulse non-negative, else point by point. Returns the
+// largest velocity change it gave a contact (m/s).
+double solve_manifold(std::span<ContactRow> rows, const ManifoldRows& manifold,
+                      std::span<const NormalBlock> blocks, std::span<SolverBody> bodies,
+                      const SolverSettings& settings, const Softness* soft, double h);
 
 // Gives bouncing contacts their outgoing velocity, e times the approach velocity.
 void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCold> cold,

@@ -169,26 +169,34 @@ IslandContext island_context(StepScratch& s, const WorldSettings& settings, std:
       s, settings, s.body_of_slot};
 }
 
-// advance_with's parts for up to kSolverLanes small islands of the same recipe (soft with the
-// settings' substeps, or pgs) at once, on one thread. A small island's sweep is a chain of
-// dependent arithmetic too short to keep the core busy; islands share no moving body, so their
-// sweeps run interleaved, manifold by manifold (solve_manifold_group), each island visiting its
-// own manifolds in its own order and stopping its sweeps when it alone has converged: the same
-// bits as solving them one after the other.
+// advance_with's parts for up to kWideLanes small islands of the same recipe (soft with the
+// settings' substeps, or pgs) at once, on one thread. A small island is too small to split over
+// lanes; islands share no moving body, so each takes a lane of the packs (contact_packs.h): pack j
+// holds every island's j-th manifold, each island visits its own manifolds in its own order and
+// stops its sweeps when it alone has converged: the same bits as solving them one after the other.
 class IslandLanes {
  public:
   static constexpr bool kSolvesExact = false;
-  IslandLanes(StepScratch& s, const WorldSettings& settings, std::span<const std::uint32_t> islands)
-      : s_(s), settings_(settings), count_(islands.size()) {
-    TUMBLE_ASSERT(count_ <= kSolverLanes);
+  IslandLanes(StepScratch& s, const WorldSettings& settings, std::span<const std::uint32_t> islands,
+              std::span<ContactPack> packs)
+      : s_(s), settings_(settings), count_(islands.size()), packs_(packs) {
+    TUMBLE_ASSERT(count_ <= kWideLanes);
     for (std::size_t k = 0; k < count_; ++k) {
       const std::uint32_t i = islands[k];
       contexts_[k].emplace(island_context(s, settings, i));
       lanes_[k].emplace(*contexts_[k], &s.reports[i]);
       reports_[k] = &s.reports[i];
-      manifolds_[k] = std::span(s.island_manifolds)
-                          .subspan(s.island_manifold_begin[i],
-                                   s.island_manifold_begin[i + 1] - s.island_manifold_begin[i]);
+      manifolds_[k] = s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
+    }
+    for (std::size_t j = 0; j < packs_.size(); ++j) {
+      std::uint32_t lanes[kWideLanes];
+      for (std::size_t k = 0; k < kWideLanes; ++k) {
+        lanes[k] = kNoManifold;
+        if (k >= count_ || j >= manifolds_[k]) continue;
+        const ManifoldRows m = s.island_manifolds[s.island_manifold_begin[islands[k]] + j];
+        lanes[k] = s.rows[m.ids[0]].manifold;
+      }
+      pack_manifolds(lanes, s.row_begin, s.rows, s.blocks, s.bodies, &packs_[j]);
     }
   }
   IslandLanes(const IslandLanes&) = delete;
@@ -203,56 +211,57 @@ class IslandLanes {
   void integrate_positions(double h) {
     for (std::size_t k = 0; k < count_; ++k) {
       lanes_[k]->integrate_positions(h);
-      active_[k] = true;
+      active_[k] = -1;
     }
   }
+  // The packs sweep; the rows, which keep everything else, take their impulses before a warm
+  // start and at the end, and give them the separations a warm start or a move set.
   void refresh_separations() {
     for (std::size_t k = 0; k < count_; ++k)
       lanes_[k]->refresh_separations();
+    for (ContactPack& pack : packs_)
+      load_separations(s_.rows, &pack);
   }
   void warm_start(bool keep_last_substep) {
+    for (const ContactPack& pack : packs_)
+      store_impulses(pack, s_.rows);
     for (std::size_t k = 0; k < count_; ++k) {
       lanes_[k]->warm_start(keep_last_substep);
-      active_[k] = true;
+      active_[k] = -1;
     }
+    for (ContactPack& pack : packs_)
+      load_separations(s_.rows, &pack);
   }
   // Returns the largest change over the islands still sweeping; an island whose own sweep changed
   // nothing beyond the tolerance stops, as it would alone.
   double sweep(const Softness* soft, double h, bool backward) {
     std::size_t most = 0;
-    double change[kSolverLanes] = {};
     for (std::size_t k = 0; k < count_; ++k) {
       if (!active_[k]) continue;
       ++reports_[k]->velocity_iterations;
-      most = std::max(most, manifolds_[k].size());
+      most = std::max<std::size_t>(most, manifolds_[k]);
     }
+    double change[kWideLanes] = {};
     for (std::size_t j = 0; j < most; ++j) {
-      ManifoldRows group[kSolverLanes];
-      std::size_t lane_of[kSolverLanes];
-      std::size_t n = 0;
-      for (std::size_t k = 0; k < count_; ++k) {
-        const std::size_t size = manifolds_[k].size();
-        if (!active_[k] || j >= size) continue;
-        group[n] = manifolds_[k][backward ? size - 1 - j : j];
-        lane_of[n++] = k;
-      }
-      double changes[kSolverLanes];
-      solve_manifold_group(s_.rows, std::span<const ManifoldRows>(group, n), s_.blocks, s_.bodies,
-                           settings_.solver, soft, h, changes);
-      for (std::size_t g = 0; g < n; ++g)
-        change[lane_of[g]] = std::max(change[lane_of[g]], changes[g]);
+      double changes[kWideLanes];
+      solve_pack(packs_[backward ? most - 1 - j : j], active_, s_.bodies, settings_.solver, soft, h,
+                 changes);
+      for (std::size_t k = 0; k < count_; ++k)
+        change[k] = std::max(change[k], changes[k]);
     }
     double largest = 0;
     for (std::size_t k = 0; k < count_; ++k) {
       if (!active_[k]) continue;
       largest = std::max(largest, change[k]);
-      if (change[k] <= settings_.solver.velocity_tolerance) active_[k] = false;
+      if (change[k] <= settings_.solver.velocity_tolerance) active_[k] = 0;
     }
     return largest;
   }
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
+    for (const ContactPack& pack : packs_)
+      store_impulses(pack, s_.rows);
     for (std::size_t k = 0; k < count_; ++k)
       lanes_[k]->record_residual(h);
     move();
@@ -264,11 +273,12 @@ class IslandLanes {
   StepScratch& s_;
   const WorldSettings& settings_;
   std::size_t count_;
-  std::array<std::optional<IslandContext>, kSolverLanes> contexts_;
-  std::array<std::optional<SerialIsland>, kSolverLanes> lanes_;
-  std::array<IslandReport*, kSolverLanes> reports_{};
-  std::array<std::span<const ManifoldRows>, kSolverLanes> manifolds_;
-  std::array<bool, kSolverLanes> active_{};
+  std::span<ContactPack> packs_;
+  std::array<std::optional<IslandContext>, kWideLanes> contexts_;
+  std::array<std::optional<SerialIsland>, kWideLanes> lanes_;
+  std::array<IslandReport*, kWideLanes> reports_{};
+  std::array<std::uint32_t, kWideLanes> manifolds_{};  // each island's count
+  WideMask active_{};                                  // islands still sweeping: their lanes
 };
 
 // --- Islands solved by the whole team, colour by colour. Every function below is called by
@@ -297,11 +307,10 @@ ManifoldRows manifold_rows_of(const StepScratch& s, std::uint32_t manifold) {
   return {ids.data(), static_cast<int>(ids.size())};
 }
 
-// Calls fn(manifolds) for colours [first, last), forwards or backwards, with the manifolds of a
-// colour in groups of up to kSolverLanes. Manifolds of one colour share no moving body, so the
-// team splits the groups; the overflow colour runs on one thread, a manifold at a time and in
-// order. Returns the largest value fn returned, on every thread (0 without `reduce`, which spares
-// the two barriers of the reduction).
+// Calls fn(row ids of a manifold) for the manifolds of colours [first, last), forwards or
+// backwards. Manifolds of one colour share no moving body, so the team splits them; the overflow
+// colour runs on one thread, in order. Returns the largest value fn returned, on every thread (0
+// without `reduce`, which spares the two barriers of the reduction).
 template <class Fn>
 double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
                      Fn&& fn, bool reduce = true) {
@@ -314,34 +323,43 @@ double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
 #pragma omp single
       for (std::int64_t i = begin; i < end; ++i) {
         const std::int64_t at = backward ? begin + end - 1 - i : i;
-        const ManifoldRows manifold = manifold_rows_of(s, colouring.manifolds[at]);
-        local = std::max(local, fn(std::span(&manifold, 1)));
+        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[at])));
       }
     } else {
-      constexpr std::int64_t lanes = kSolverLanes;
-      const std::int64_t groups = (end - begin + lanes - 1) / lanes;
 #pragma omp for schedule(static)
-      for (std::int64_t g = 0; g < groups; ++g) {
-        ManifoldRows group[kSolverLanes];
-        const std::int64_t from = begin + g * lanes, to = std::min(end, from + lanes);
-        for (std::int64_t i = from; i < to; ++i)
-          group[i - from] = manifold_rows_of(s, colouring.manifolds[i]);
-        local = std::max(local, fn(std::span<const ManifoldRows>(group, to - from)));
-      }
+      for (std::int64_t i = begin; i < end; ++i)
+        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[i])));
     }
   }
   return reduce ? team_max(local, s.team_values) : 0.0;
 }
 
-// fn(row ids of one manifold) for each manifold of a group, as sweep_colours calls it.
-template <class Fn>
-auto each_of_group(Fn&& fn) {
-  return [fn = std::forward<Fn>(fn)](std::span<const ManifoldRows> group) {
-    double largest = 0;
-    for (const ManifoldRows& m : group)
-      largest = std::max(largest, fn(std::span<const std::uint32_t>(m.ids, m.count)));
-    return largest;
-  };
+// Calls pack_fn(pack) for the packs of colours [first, last), forwards or backwards, the team
+// splitting each colour's packs, and serial_fn(manifold rows) for the overflow colour's manifolds
+// on one thread, in order (sweep_colours' order, which packs only group). Returns the largest value
+// they returned, on every thread (0 without `reduce`).
+template <class PackFn, class SerialFn>
+double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
+                   PackFn&& pack_fn, SerialFn&& serial_fn, bool reduce = true) {
+  const Colouring& colouring = s.colouring;
+  double local = 0;
+  for (std::uint32_t k = first; k < last; ++k) {
+    const std::uint32_t c = backward ? first + last - 1 - k : k;
+    if (colouring.serial[c]) {
+      const std::int64_t begin = colouring.colour_begin[c], end = colouring.colour_begin[c + 1];
+#pragma omp single
+      for (std::int64_t i = begin; i < end; ++i) {
+        const std::int64_t at = backward ? begin + end - 1 - i : i;
+        local = std::max(local, serial_fn(manifold_rows_of(s, colouring.manifolds[at])));
+      }
+    } else {
+      const std::int64_t begin = s.colour_pack_begin[c], end = s.colour_pack_begin[c + 1];
+#pragma omp for schedule(static)
+      for (std::int64_t p = begin; p < end; ++p)
+        local = std::max(local, pack_fn(s.packs[p]));
+    }
+  }
+  return reduce ? team_max(local, s.team_values) : 0.0;
 }
 
 std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
@@ -377,30 +395,47 @@ class TeamIsland {
   bool has_rows() const { return true; }  // coloured islands have many
   void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
   void integrate_positions(double h) { team_integrate_positions(c_, h); }
+  // The packs sweep; the rows, which keep everything else, take their impulses before a warm
+  // start and at the end, and give them the separations a warm start or a move set.
   void refresh_separations() {
-    each_manifold(
-        [&](std::span<const std::uint32_t> ids) { update_separations(s_.rows, ids, s_.bodies); });
+    each_manifold_or_pack(
+        [&](std::span<const std::uint32_t> ids) { update_separations(s_.rows, ids, s_.bodies); },
+        [&](ContactPack& pack) { load_separations(s_.rows, &pack); });
   }
-
   void warm_start(bool keep_last_substep) {
-    each_manifold([&](std::span<const std::uint32_t> ids) {
-      tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies, keep_last_substep);
-    });
+    each_manifold_or_pack(
+        [&](std::span<const std::uint32_t> ids) {
+          tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies, keep_last_substep);
+        },
+        [&](ContactPack& pack) { load_separations(s_.rows, &pack); },
+        [&](const ContactPack& pack) { store_impulses(pack, s_.rows); });
   }
   double sweep(const Softness* soft, double h, bool backward) {
     ++iterations_;
-    return sweep_colours(s_, first_, last_, backward, [&](std::span<const ManifoldRows> group) {
-      return solve_independent_manifolds(s_.rows, group, s_.blocks, s_.bodies, c_.settings.solver,
-                                         soft, h);
-    });
+    return sweep_packs(
+        s_, first_, last_, backward,
+        [&](ContactPack& pack) {
+          return solve_pack(pack, kAllLanes, s_.bodies, c_.settings.solver, soft, h);
+        },
+        [&](const ManifoldRows& manifold) {
+          return solve_manifold(s_.rows, manifold, s_.blocks, s_.bodies, c_.settings.solver, soft,
+                                h);
+        });
   }
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    const double residual = sweep_colours(s_, first_, last_, false,
-                                          each_of_group([&](std::span<const std::uint32_t> ids) {
-                                            return normal_residual(s_.rows, ids, s_.bodies, h);
-                                          }));
+    sweep_packs(
+        s_, first_, last_, false,
+        [&](const ContactPack& pack) {
+          store_impulses(pack, s_.rows);
+          return 0.0;
+        },
+        [](const ManifoldRows&) { return 0.0; }, false);
+    const double residual =
+        sweep_colours(s_, first_, last_, false, [&](std::span<const std::uint32_t> ids) {
+          return normal_residual(s_.rows, ids, s_.bodies, h);
+        });
     move();
     each_manifold([&](std::span<const std::uint32_t> ids) {
       apply_restitution(s_.rows, s_.cold_rows, ids, s_.blocks, s_.bodies, c_.settings.solver);
@@ -416,11 +451,35 @@ class TeamIsland {
  private:
   template <class Fn>
   void each_manifold(Fn&& fn) {
-    sweep_colours(s_, first_, last_, false, each_of_group([&](std::span<const std::uint32_t> ids) {
-                    fn(ids);
-                    return 0.0;
-                  }),
-                  false);
+    sweep_colours(
+        s_, first_, last_, false,
+        [&](std::span<const std::uint32_t> ids) {
+          fn(ids);
+          return 0.0;
+        },
+        false);
+  }
+  // fn(row ids) for every manifold, colour by colour; for a packed manifold, between `before` and
+  // `after` of its pack.
+  template <class Fn, class After, class Before = void (*)(const ContactPack&)>
+  void each_manifold_or_pack(
+      Fn&& fn, After&& after, Before&& before = [](const ContactPack&) {}) {
+    sweep_packs(
+        s_, first_, last_, false,
+        [&](ContactPack& pack) {
+          before(pack);
+          for (int k = 0; k < kWideLanes; ++k) {
+            const ManifoldRows lane = lane_rows(pack, k, s_.row_ids);
+            fn(std::span<const std::uint32_t>(lane.ids, lane.count));
+          }
+          after(pack);
+          return 0.0;
+        },
+        [&](const ManifoldRows& manifold) {
+          fn(std::span<const std::uint32_t>(manifold.ids, manifold.count));
+          return 0.0;
+        },
+        false);
   }
   const IslandContext& c_;
   StepScratch& s_;
@@ -642,6 +701,27 @@ void World::prepare_contacts(double dt) {
     s.island_colour_begin.push_back(static_cast<std::uint32_t>(s.colouring.colour_count()));
   }
 
+  s.pack_manifolds.clear();
+  s.colour_pack_begin.assign(1, 0);
+  for (std::size_t c = 0; c < s.colouring.colour_count(); ++c) {
+    const std::uint32_t end = s.colouring.colour_begin[c + 1];
+    if (!s.colouring.serial[c]) {
+      for (std::uint32_t first = s.colouring.colour_begin[c]; first < end; first += kWideLanes)
+        s.pack_manifolds.push_back({first, std::min<std::uint32_t>(kWideLanes, end - first)});
+    }
+    s.colour_pack_begin.push_back(static_cast<std::uint32_t>(s.pack_manifolds.size()));
+  }
+  s.packs.resize(s.pack_manifolds.size());
+  const std::int64_t packs = static_cast<std::int64_t>(s.packs.size());
+  for_indices(threads, packs > 16, packs, [&](std::int64_t k) {
+    std::uint32_t lanes[kWideLanes];
+    for (std::uint32_t lane = 0; lane < kWideLanes; ++lane)
+      lanes[lane] = lane < s.pack_manifolds[k].count
+                        ? s.colouring.manifolds[s.pack_manifolds[k].first + lane]
+                        : kNoManifold;
+    pack_manifolds(lanes, s.row_begin, s.rows, s.blocks, s.bodies, &s.packs[k]);
+  });
+
   stats_.pairs = static_cast<std::uint32_t>(pairs_.size());
   stats_.manifolds = static_cast<std::uint32_t>(contacts_.size());
   stats_.contact_points = static_cast<std::uint32_t>(s.rows.size());
@@ -660,7 +740,7 @@ void World::solve_islands(double dt) {
   const int threads = team_size(settings_.threads);
   if (s.team_values.size() < static_cast<std::size_t>(threads)) s.team_values.resize(threads);
   // The small islands as work: soft (with the settings' substeps) and pgs islands with rows in
-  // groups of kSolverLanes (IslandLanes), every other one alone (SerialIsland).
+  // groups of kWideLanes (IslandLanes), every other one alone (SerialIsland).
   s.work_islands.clear();
   s.work_begin.assign(1, 0);
   auto lane_kind = [&](std::uint32_t i) -> int {
@@ -673,7 +753,7 @@ void World::solve_islands(double dt) {
   for (int kind = 0; kind < 2; ++kind) {
     for (std::uint32_t i : s.single_islands) {
       if (lane_kind(i) != kind) continue;
-      if (s.work_islands.size() - s.work_begin.back() == kSolverLanes)
+      if (s.work_islands.size() - s.work_begin.back() == kWideLanes)
         s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
       s.work_islands.push_back(i);
     }
@@ -686,6 +766,19 @@ void World::solve_islands(double dt) {
     s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
   }
   const std::int64_t work = static_cast<std::int64_t>(s.work_begin.size()) - 1;
+  // Room for the packs of islands solved together, which each item fills itself.
+  s.lane_pack_begin.assign(1, 0);
+  for (std::int64_t k = 0; k < work; ++k) {
+    std::uint32_t most = 0;
+    if (s.work_begin[k + 1] - s.work_begin[k] > 1) {
+      for (std::uint32_t w = s.work_begin[k]; w < s.work_begin[k + 1]; ++w) {
+        const std::uint32_t i = s.work_islands[w];
+        most = std::max(most, s.island_manifold_begin[i + 1] - s.island_manifold_begin[i]);
+      }
+    }
+    s.lane_pack_begin.push_back(s.lane_pack_begin.back() + most);
+  }
+  s.lane_packs.resize(s.lane_pack_begin.back());
   const bool parallel = threads > 1 && (work > 1 || !s.team_islands.empty());
   // Large islands one after the other with the whole team, then the rest one island per thread:
   // islands share no body and no row, and colours share no moving body, so any thread count gives
@@ -705,7 +798,10 @@ void World::solve_islands(double dt) {
         SerialIsland island(context, &s.reports[islands[0]]);
         advance_with(island, &s.reports[islands[0]], settings_.solver, dt);
       } else {
-        IslandLanes lanes(s, settings_, islands);
+        IslandLanes lanes(
+            s, settings_, islands,
+            std::span(s.lane_packs)
+                .subspan(s.lane_pack_begin[k], s.lane_pack_begin[k + 1] - s.lane_pack_begin[k]));
         advance_with(lanes, &s.reports[islands[0]], settings_.solver, dt);
       }
     });
@@ -747,13 +843,13 @@ void World::correct_positions() {
     for (std::uint32_t i : s.team_islands) {
       if (!needs_correction(i)) continue;
       for (int k = 0; k < solver.position_iterations; ++k)
-        sweep_colours(s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
-                      each_of_group([&](std::span<const std::uint32_t> ids) {
-                        tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses,
-                                                  solver);
-                        return 0.0;
-                      }),
-                      false);
+        sweep_colours(
+            s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
+            [&](std::span<const std::uint32_t> ids) {
+              tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses, solver);
+              return 0.0;
+            },
+            false);
     }
     team_for_dynamic(singles, [&](std::int64_t k) {
       const std::uint32_t i = s.single_islands[k];

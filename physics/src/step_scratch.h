@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "colouring.h"
+#include "contact_packs.h"
 #include "contact_solver.h"
 #include "continuous.h"
 #include "islands.h"
@@ -56,12 +57,26 @@ struct StepScratch {
   // The small islands' work: item k is islands work_islands[work_begin[k] .. work_begin[k+1]),
   // several only when they are solved together (IslandLanes).
   std::vector<std::uint32_t> work_islands, work_begin;
+  // Islands solved together sweep packs (contact_packs.h), lane k for the item's k-th island:
+  // item k's are lane_packs[lane_pack_begin[k] .. [k+1]), pack j holding each island's j-th
+  // manifold.
+  std::vector<ContactPack> lane_packs;
+  std::vector<std::uint32_t> lane_pack_begin;
   // Islands with at least kColouredIsland manifolds are solved by the whole team, colour by
   // colour: island i has colours [island_colour_begin[i], island_colour_begin[i+1]).
   Colouring colouring;
   ColouringScratch colouring_scratch;
   std::vector<std::uint32_t> island_colour_begin;
   std::vector<std::uint32_t> team_islands, single_islands;
+  // Their parallel colours' manifolds in packs for the sweeps (contact_packs.h): colour c's packs
+  // are packs[colour_pack_begin[c] .. [c+1]), none for the overflow colour. Pack k holds the
+  // manifolds colouring.manifolds[pack_manifolds[k].first ..][.. count).
+  struct PackedManifolds {
+    std::uint32_t first = 0, count = 0;
+  };
+  std::vector<ContactPack> packs;
+  std::vector<PackedManifolds> pack_manifolds;
+  std::vector<std::uint32_t> colour_pack_begin;
   std::vector<double> team_values;  // one per thread, for reductions inside a team
   // Continuous collision: pairs with a fast body, their results, and each slot's first impact.
   std::vector<std::uint32_t> swept_pairs;

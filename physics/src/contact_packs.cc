@@ -1,0 +1,327 @@
+#include "contact_packs.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tumble {
+namespace {
+
+void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
+  wide_vector->x[k] = v.x();
+  wide_vector->y[k] = v.y();
+  wide_vector->z[k] = v.z();
+}
+
+Vec3 lane_of(const WideVec3& wide_vector, int k) {
+  return {wide_vector.x[k], wide_vector.y[k], wide_vector.z[k]};
+}
+
+// Which lanes `on` selects, as a mask.
+WideMask mask_of(const bool (&on)[kWideLanes]) {
+  return WideMask{on[0] ? -1 : 0, on[1] ? -1 : 0, on[2] ? -1 : 0, on[3] ? -1 : 0};
+}
+
+void pack_point(const ContactRow& row, int k, PackPoint* p) {
+  set_lane(&p->tangent1, k, row.tangent1);
+  set_lane(&p->tangent2, k, row.tangent2);
+  set_lane(&p->ra_cross_n, k, row.ra_cross_n);
+  set_lane(&p->rb_cross_n, k, row.rb_cross_n);
+  set_lane(&p->angular_a, k, row.angular_a);
+  set_lane(&p->angular_b, k, row.angular_b);
+  set_lane(&p->ra_cross_t1, k, row.ra_cross_t1);
+  set_lane(&p->rb_cross_t1, k, row.rb_cross_t1);
+  set_lane(&p->ra_cross_t2, k, row.ra_cross_t2);
+  set_lane(&p->rb_cross_t2, k, row.rb_cross_t2);
+  set_lane(&p->angular_a_t1, k, row.angular_a_t1);
+  set_lane(&p->angular_b_t1, k, row.angular_b_t1);
+  set_lane(&p->angular_a_t2, k, row.angular_a_t2);
+  set_lane(&p->angular_b_t2, k, row.angular_b_t2);
+  p->substep_separation[k] = row.substep_separation;
+  p->normal_mass[k] = row.normal_mass;
+  p->tangent_mass1[k] = row.tangent_mass1;
+  p->tangent_mass2[k] = row.tangent_mass2;
+  p->normal_response[k] = row.normal_response;
+  p->tangent_response1[k] = row.tangent_response1;
+  p->tangent_response2[k] = row.tangent_response2;
+  p->normal_impulse[k] = row.normal_impulse;
+  p->tangent_impulse1[k] = row.tangent_impulse1;
+  p->tangent_impulse2[k] = row.tangent_impulse2;
+  p->max_normal_impulse[k] = row.max_normal_impulse;
+}
+
+}  // namespace
+
+void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
+                    std::span<const std::uint32_t> row_begin, std::span<const ContactRow> rows,
+                    std::span<const NormalBlock> blocks, std::span<const SolverBody> bodies,
+                    ContactPack* pack) {
+  // Zero everywhere first: a lane without a manifold, or a point its manifold lacks, computes on
+  // zeros and writes nothing.
+  *pack = ContactPack{};
+  const std::uint32_t* any_manifold = std::find_if(
+      std::begin(manifolds), std::end(manifolds), [](std::uint32_t m) { return m != kNoManifold; });
+  TUMBLE_ASSERT(any_manifold != std::end(manifolds));
+  bool moves_a[kWideLanes] = {}, moves_b[kWideLanes] = {};
+  bool alone[kWideLanes] = {}, in_block[kWideLanes] = {};
+  bool present[4][kWideLanes] = {}, rubs[4][kWideLanes] = {};
+  for (int k = 0; k < kWideLanes; ++k) {
+    // Lanes without a manifold read another lane's bodies (any valid memory), never write.
+    const std::uint32_t m = manifolds[k] != kNoManifold ? manifolds[k] : *any_manifold;
+    const ContactRow& first = rows[row_begin[m]];
+    pack->a[k] = first.a;
+    pack->b[k] = first.b;
+    if (manifolds[k] == kNoManifold) continue;
+    const int count = static_cast<int>(row_begin[m + 1] - row_begin[m]);
+    pack->first_row[k] = row_begin[m];
+    pack->points[k] = static_cast<std::uint8_t>(count);
+    pack->most_points = std::max(pack->most_points, pack->points[k]);
+    set_lane(&pack->normal, k, first.normal);
+    pack->friction[k] = first.friction;
+    pack->inverse_mass_a[k] = bodies[first.a].inverse_mass;
+    pack->inverse_mass_b[k] = bodies[first.b].inverse_mass;
+    moves_a[k] = bodies[first.a].inverse_mass > 0;
+    moves_b[k] = bodies[first.b].inverse_mass > 0;
+    alone[k] = count == 1;
+    in_block[k] = count > 1;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        pack->block_inverse[i][j][k] = blocks[m].inverse(i, j);
+    for (int p = 0; p < count; ++p) {
+      const ContactRow& row = rows[row_begin[m] + p];
+      pack_point(row, k, &pack->point[p]);
+      present[p][k] = true;
+      rubs[p][k] = row.friction > 0;
+    }
+  }
+  pack->moves_a = mask_of(moves_a);
+  pack->moves_b = mask_of(moves_b);
+  pack->alone = mask_of(alone);
+  pack->in_block = mask_of(in_block);
+  for (int p = 0; p < 4; ++p) {
+    pack->point[p].present = mask_of(present[p]);
+    pack->point[p].rubs = mask_of(rubs[p]);
+  }
+}
+
+void store_impulses(const ContactPack& pack, std::span<ContactRow> rows) {
+  for (int k = 0; k < kWideLanes; ++k) {
+    for (int p = 0; p < pack.points[k]; ++p) {
+      const PackPoint& point = pack.point[p];
+      ContactRow& row = rows[pack.first_row[k] + p];
+      row.normal_impulse = point.normal_impulse[k];
+      row.tangent_impulse1 = point.tangent_impulse1[k];
+      row.tangent_impulse2 = point.tangent_impulse2[k];
+      row.max_normal_impulse = point.max_normal_impulse[k];
+    }
+  }
+}
+
+void load_separations(std::span<const ContactRow> rows, ContactPack* pack) {
+  for (int k = 0; k < kWideLanes; ++k)
+    for (int p = 0; p < pack->points[k]; ++p)
+      pack->point[p].substep_separation[k] = rows[pack->first_row[k] + p].substep_separation;
+}
+
+namespace {
+
+// The velocities of each lane's two bodies, held while the pack is solved (PairVelocities, four
+// at a time).
+struct WidePair {
+  WideVec3 va, wa, vb, wb;
+};
+
+TUMBLE_INLINE WidePair gather(const ContactPack& pack, std::span<const SolverBody> bodies) {
+  WidePair pair;
+  for (int k = 0; k < kWideLanes; ++k) {
+    const SolverBody& a = bodies[pack.a[k]];
+    const SolverBody& b = bodies[pack.b[k]];
+    set_lane(&pair.va, k, a.v);
+    set_lane(&pair.wa, k, a.w);
+    set_lane(&pair.vb, k, b.v);
+    set_lane(&pair.wb, k, b.w);
+  }
+  return pair;
+}
+
+TUMBLE_INLINE void scatter(const ContactPack& pack, WideMask lanes, const WidePair& pair,
+                           std::span<SolverBody> bodies) {
+  const WideMask moves_a = lanes & pack.moves_a, moves_b = lanes & pack.moves_b;
+  for (int k = 0; k < kWideLanes; ++k) {
+    if (moves_a[k]) {
+      bodies[pack.a[k]].v = lane_of(pair.va, k);
+      bodies[pack.a[k]].w = lane_of(pair.wa, k);
+    }
+    if (moves_b[k]) {
+      bodies[pack.b[k]].v = lane_of(pair.vb, k);
+      bodies[pack.b[k]].w = lane_of(pair.wb, k);
+    }
+  }
+}
+
+// normal_target's bias, mass scale and impulse scale, lane by lane.
+struct WideTarget {
+  Wide bias, mass_scale, impulse_scale;
+};
+
+TUMBLE_INLINE WideTarget wide_target(const PackPoint& point, const SolverSettings& settings,
+                                     const Softness* soft, double inverse_h) {
+  const Wide separation = point.substep_separation;
+  const WideMask gap = separation > 0;
+  WideTarget target{select(gap, separation * inverse_h, wide(0)), wide(1), wide(0)};
+  if (soft != nullptr) {
+    const Wide beyond_slop = separation + settings.slop;
+    const WideMask pushes = ~gap & (beyond_slop < 0);
+    target.bias =
+        select(pushes, wide_max(soft->bias_rate * beyond_slop, wide(-settings.max_push_velocity)),
+               target.bias);
+    target.mass_scale = select(pushes, wide(soft->mass_scale), target.mass_scale);
+    target.impulse_scale = select(pushes, wide(soft->impulse_scale), target.impulse_scale);
+  }
+  return target;
+}
+
+TUMBLE_INLINE Wide normal_velocity(const ContactPack& pack, const PackPoint& point,
+                                   const WidePair& pair) {
+  return dot(pack.normal, pair.vb - pair.va) + dot(pair.wb, point.rb_cross_n) -
+         dot(pair.wa, point.ra_cross_n);
+}
+
+// Applies a normal impulse change in the lanes of `mask` (PairVelocities::apply_normal).
+TUMBLE_INLINE void apply_normal(const ContactPack& pack, const PackPoint& point, WideMask mask,
+                                Wide impulse, WidePair& pair) {
+  const WideMask on_a = mask & pack.moves_a, on_b = mask & pack.moves_b;
+  pair.va =
+      select(on_a, minus_scaled(pair.va, pack.inverse_mass_a * impulse, pack.normal), pair.va);
+  pair.wa = select(on_a, minus_scaled(pair.wa, impulse, point.angular_a), pair.wa);
+  pair.vb = select(on_b, plus_scaled(pair.vb, pack.inverse_mass_b * impulse, pack.normal), pair.vb);
+  pair.wb = select(on_b, plus_scaled(pair.wb, impulse, point.angular_b), pair.wb);
+}
+
+// solve_friction for a point in the lanes of `mask`. Returns the velocity change per lane.
+TUMBLE_INLINE Wide solve_friction(const ContactPack& pack, PackPoint& point, WideMask mask,
+                                  WidePair& pair) {
+  const WideVec3 dv = pair.vb - pair.va;
+  const Wide v1 =
+      dot(point.tangent1, dv) + dot(pair.wb, point.rb_cross_t1) - dot(pair.wa, point.ra_cross_t1);
+  const Wide v2 =
+      dot(point.tangent2, dv) + dot(pair.wb, point.rb_cross_t2) - dot(pair.wa, point.ra_cross_t2);
+  const Wide limit = pack.friction * point.normal_impulse;
+  const Wide old1 = point.tangent_impulse1, old2 = point.tangent_impulse2;
+  Wide new1 = old1 - point.tangent_mass1 * v1;
+  Wide new2 = old2 - point.tangent_mass2 * v2;
+  const Wide squared = new1 * new1 + new2 * new2;
+  const WideMask outside_cone = mask & (squared > limit * limit);
+  if (any(outside_cone)) {
+    for (int k = 0; k < kWideLanes; ++k) {
+      if (!outside_cone[k]) continue;
+      const double scale = limit[k] / std::sqrt(squared[k]);
+      new1[k] *= scale;
+      new2[k] *= scale;
+    }
+  }
+  point.tangent_impulse1 = select(mask, new1, old1);
+  point.tangent_impulse2 = select(mask, new2, old2);
+  const Wide d1 = new1 - old1, d2 = new2 - old2;
+  const WideVec3 linear = {d1 * point.tangent1.x + d2 * point.tangent2.x,
+                           d1 * point.tangent1.y + d2 * point.tangent2.y,
+                           d1 * point.tangent1.z + d2 * point.tangent2.z};
+  const WideVec3 angular_a = {d1 * point.angular_a_t1.x + d2 * point.angular_a_t2.x,
+                              d1 * point.angular_a_t1.y + d2 * point.angular_a_t2.y,
+                              d1 * point.angular_a_t1.z + d2 * point.angular_a_t2.z};
+  const WideVec3 angular_b = {d1 * point.angular_b_t1.x + d2 * point.angular_b_t2.x,
+                              d1 * point.angular_b_t1.y + d2 * point.angular_b_t2.y,
+                              d1 * point.angular_b_t1.z + d2 * point.angular_b_t2.z};
+  const WideMask on_a = mask & pack.moves_a, on_b = mask & pack.moves_b;
+  pair.va = select(on_a, minus_scaled(pair.va, pack.inverse_mass_a, linear), pair.va);
+  pair.wa = select(on_a, pair.wa - angular_a, pair.wa);
+  pair.vb = select(on_b, plus_scaled(pair.vb, pack.inverse_mass_b, linear), pair.vb);
+  pair.wb = select(on_b, pair.wb + angular_b, pair.wb);
+  const Wide change =
+      wide_max(wide_abs(d1) * point.tangent_response1, wide_abs(d2) * point.tangent_response2);
+  return select(mask, change, wide(0));
+}
+
+// solve_normal for point p in the lanes of `mask`.
+TUMBLE_INLINE Wide solve_normal(const ContactPack& pack, PackPoint& point, WideMask mask,
+                                const WideTarget& target, WidePair& pair) {
+  const Wide vn = normal_velocity(pack, point, pair);
+  const Wide delta = -point.normal_mass * target.mass_scale * (vn + target.bias) -
+                     target.impulse_scale * point.normal_impulse;
+  const Wide updated = wide_max(point.normal_impulse + delta, wide(0));
+  const Wide change = wide_abs(updated - point.normal_impulse) * point.normal_response;
+  apply_normal(pack, point, mask, updated - point.normal_impulse, pair);
+  point.normal_impulse = select(mask, updated, point.normal_impulse);
+  point.max_normal_impulse =
+      select(mask, wide_max(point.max_normal_impulse, updated), point.max_normal_impulse);
+  return select(mask, change, wide(0));
+}
+
+}  // namespace
+
+// Compiled twice, for AVX2 (one register a vector) and for any x86-64 (two), and chosen when the
+// program loads: the same operations lane by lane, so the same bits on either.
+// (Vectors cross its boundary by reference: GCC gives the clones one calling convention only
+// that way.)
+__attribute__((target_clones("avx2", "default"))) double solve_pack(
+    ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
+    const SolverSettings& settings, const Softness* soft, double h, double* lane_changes) {
+  const double inverse_h = 1 / h;
+  const int most = pack.most_points;
+  WidePair pair = gather(pack, bodies);
+  Wide change = wide(0);
+  for (int p = 0; p < most; ++p)
+    change =
+        wide_max(change, solve_friction(pack, pack.point[p], pack.point[p].rubs & lanes, pair));
+
+  WideTarget targets[4];
+  for (int p = 0; p < most; ++p)
+    targets[p] = wide_target(pack.point[p], settings, soft, inverse_h);
+
+  // The block solve of manifolds with several points, taken where it keeps every impulse
+  // non-negative (solve_normals); elsewhere, and for single points, point by point.
+  WideMask one_by_one = pack.alone & lanes;
+  const WideMask in_block = pack.in_block & lanes;
+  if (any(in_block)) {
+    Wide error[4];
+    for (int p = 0; p < 4; ++p) {
+      error[p] = p < most
+                     ? select(pack.point[p].present,
+                              normal_velocity(pack, pack.point[p], pair) + targets[p].bias, wide(0))
+                     : wide(0);
+    }
+    Wide updated[4];
+    WideMask feasible = in_block;
+    for (int i = 0; i < most; ++i) {
+      const PackPoint& point = pack.point[i];
+      const Wide step = pack.block_inverse[i][0] * error[0] + pack.block_inverse[i][1] * error[1] +
+                        pack.block_inverse[i][2] * error[2] + pack.block_inverse[i][3] * error[3];
+      updated[i] = point.normal_impulse - targets[i].mass_scale * step -
+                   targets[i].impulse_scale * point.normal_impulse;
+      feasible &= ~point.present | (updated[i] >= 0);
+    }
+    for (int i = 0; i < most; ++i) {
+      PackPoint& point = pack.point[i];
+      const WideMask mask = feasible & point.present;
+      change = wide_max(
+          change, select(mask, wide_abs(updated[i] - point.normal_impulse) * point.normal_response,
+                         wide(0)));
+      apply_normal(pack, point, mask, updated[i] - point.normal_impulse, pair);
+      point.normal_impulse = select(mask, updated[i], point.normal_impulse);
+      point.max_normal_impulse =
+          select(mask, wide_max(point.max_normal_impulse, updated[i]), point.max_normal_impulse);
+    }
+    one_by_one |= in_block & ~feasible;
+  }
+  if (any(one_by_one)) {
+    for (int p = 0; p < most; ++p)
+      change = wide_max(change, solve_normal(pack, pack.point[p],
+                                             one_by_one & pack.point[p].present, targets[p], pair));
+  }
+  scatter(pack, lanes, pair, bodies);
+  if (lane_changes != nullptr)
+    for (int k = 0; k < kWideLanes; ++k)
+      lane_changes[k] = change[k];
+  return largest_lane(change);
+}
+
+}  // namespace tumble

@@ -1,0 +1,82 @@
+// The contact constraints of a coloured island, stored for its sweeps: four manifolds of one
+// colour to a pack, one lane each, every quantity of a point as four doubles side by side
+// (structure of arrays), so that one sweep solves four manifolds with each operation (wide.h).
+//
+// Box2D v3 stores its graph colours' contacts this way (Catto, "SIMD Matters", 2024), as Jolt
+// does its own; ours keeps the four-point block solve of a face (NormalBlock) lane by lane, and
+// each lane computes exactly what the scalar solver (contact_solver.h) computes for its manifold,
+// so that packing changes the speed and not one bit of the answer.
+//
+// The rows (ContactRow) stay the record of a contact: a pack is a copy of its rows for the
+// sweeps, holding the impulses only while they sweep. The parts a step runs once a substep (warm
+// start, separations, restitution, residual) stay with the rows and go through them.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "contact_solver.h"
+#include "wide.h"
+
+namespace tumble {
+
+// Point p of every lane: ContactRow's hot part, lane by lane.
+struct PackPoint {
+  WideVec3 tangent1, tangent2;
+  WideVec3 ra_cross_n, rb_cross_n, angular_a, angular_b;
+  WideVec3 ra_cross_t1, rb_cross_t1, ra_cross_t2, rb_cross_t2;
+  WideVec3 angular_a_t1, angular_b_t1, angular_a_t2, angular_b_t2;
+  Wide substep_separation;
+  Wide normal_mass, tangent_mass1, tangent_mass2;
+  Wide normal_response, tangent_response1, tangent_response2;
+  Wide normal_impulse, tangent_impulse1, tangent_impulse2, max_normal_impulse;
+  WideMask present;  // the lane's manifold has a point p
+  WideMask rubs;     // present, with friction
+};
+
+struct ContactPack {
+  WideVec3 normal;
+  Wide friction;
+  Wide inverse_mass_a, inverse_mass_b;
+  WideMask moves_a, moves_b;  // a moving body, which the lane writes back; statics are shared
+  WideMask alone;             // one point: solved without its block
+  WideMask in_block;          // several points: NormalBlock's solve first
+  Wide block_inverse[4][4];   // NormalBlock::inverse(i, j), lane by lane
+  std::uint32_t a[kWideLanes] = {}, b[kWideLanes] = {};  // body slots
+  std::uint32_t first_row[kWideLanes] = {};              // the lane's manifold's rows follow it
+  std::uint8_t points[kWideLanes] = {};                  // 0 in lanes without a manifold
+  std::uint8_t most_points = 0;
+  PackPoint point[4];
+};
+
+// A lane without a manifold.
+constexpr std::uint32_t kNoManifold = UINT32_MAX;
+
+// Fills `pack` with the manifolds manifolds[k] (ids, or kNoManifold) in lanes k, which share no
+// moving body, from their rows and blocks as prepare_rows left them.
+void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
+                    std::span<const std::uint32_t> row_begin, std::span<const ContactRow> rows,
+                    std::span<const NormalBlock> blocks, std::span<const SolverBody> bodies,
+                    ContactPack* pack);
+
+// The rows of lane k (ids into the step's rows; a manifold's rows are consecutive).
+inline ManifoldRows lane_rows(const ContactPack& pack, int k,
+                              std::span<const std::uint32_t> row_ids) {
+  return {&row_ids[pack.first_row[k]], pack.points[k]};
+}
+
+// The impulses a pack's sweeps gave, back to its rows; and the separations the rows were given
+// (warm_start, update_separations), into the pack.
+void store_impulses(const ContactPack& pack, std::span<ContactRow> rows);
+void load_separations(std::span<const ContactRow> rows, ContactPack* pack);
+
+// One Gauss-Seidel sweep over the manifolds of a pack's lanes in `lanes` (solve_lanes' bits).
+// Returns the largest velocity change it gave a contact (m/s), and each lane's in
+// lane_changes[k] when given.
+double solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
+                  const SolverSettings& settings, const Softness* soft, double h,
+                  double* lane_changes = nullptr);
+
+constexpr WideMask kAllLanes = {-1, -1, -1, -1};
+
+}  // namespace tumble
