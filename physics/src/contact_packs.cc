@@ -1,6 +1,7 @@
 #include "contact_packs.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace tumble {
@@ -258,13 +259,38 @@ TUMBLE_INLINE Wide solve_normal(const ContactPack& pack, PackPoint& point, WideM
 
 }  // namespace
 
+namespace {
+
+bool machine_has_wide_vectors() {
+#if defined(__x86_64__)
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+std::atomic<bool> sweep_packs{machine_has_wide_vectors()};
+
+}  // namespace
+
+bool packed_sweeps() {
+  return sweep_packs.load(std::memory_order_relaxed);
+}
+
+void set_packed_sweeps(bool on) {
+  sweep_packs.store(on, std::memory_order_relaxed);
+}
+
 // Compiled twice, for AVX2 (one register a vector) and for any x86-64 (two), and chosen when the
 // program loads: the same operations lane by lane, so the same bits on either.
 // (Vectors cross its boundary by reference: GCC gives the clones one calling convention only
 // that way.)
-__attribute__((target_clones("avx2", "default"))) double solve_pack(
-    ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
-    const SolverSettings& settings, const Softness* soft, double h, double* lane_changes) {
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+double
+solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
+           const SolverSettings& settings, const Softness* soft, double h, double* lane_changes) {
   const double inverse_h = 1 / h;
   const int most = pack.most_points;
   WidePair pair = gather(pack, bodies);

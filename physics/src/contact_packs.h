@@ -79,4 +79,10 @@ double solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody
 
 constexpr WideMask kAllLanes = {-1, -1, -1, -1};
 
+// Whether the step sweeps packs (else it sweeps the rows, manifold by manifold: the same bits).
+// Packs pay where a vector holds four doubles (AVX2); with two (plain x86-64, ARM's NEON), GCC
+// spills them and the sweeps take twice as long as the rows'. The test of their equality sets it.
+bool packed_sweeps();
+void set_packed_sweeps(bool on);
+
 }  // namespace tumble

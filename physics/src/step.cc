@@ -335,23 +335,28 @@ double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
 }
 
 // Calls pack_fn(pack) for the packs of colours [first, last), forwards or backwards, the team
-// splitting each colour's packs, and serial_fn(manifold rows) for the overflow colour's manifolds
-// on one thread, in order (sweep_colours' order, which packs only group). Returns the largest value
-// they returned, on every thread (0 without `reduce`).
-template <class PackFn, class SerialFn>
+// splitting each colour's packs, and manifold_fn(manifold rows) for the manifolds not packed: the
+// overflow colour's on one thread, in order, and every colour's, split, where the step sweeps no
+// packs (sweep_colours' order, which packs only group). Returns the largest value they returned,
+// on every thread (0 without `reduce`).
+template <class PackFn, class ManifoldFn>
 double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                   PackFn&& pack_fn, SerialFn&& serial_fn, bool reduce = true) {
+                   PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce = true) {
   const Colouring& colouring = s.colouring;
   double local = 0;
   for (std::uint32_t k = first; k < last; ++k) {
     const std::uint32_t c = backward ? first + last - 1 - k : k;
+    const std::int64_t begin = colouring.colour_begin[c], end = colouring.colour_begin[c + 1];
     if (colouring.serial[c]) {
-      const std::int64_t begin = colouring.colour_begin[c], end = colouring.colour_begin[c + 1];
 #pragma omp single
       for (std::int64_t i = begin; i < end; ++i) {
         const std::int64_t at = backward ? begin + end - 1 - i : i;
-        local = std::max(local, serial_fn(manifold_rows_of(s, colouring.manifolds[at])));
+        local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[at])));
       }
+    } else if (!s.packed) {
+#pragma omp for schedule(static)
+      for (std::int64_t i = begin; i < end; ++i)
+        local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[i])));
     } else {
       const std::int64_t begin = s.colour_pack_begin[c], end = s.colour_pack_begin[c + 1];
 #pragma omp for schedule(static)
@@ -701,11 +706,12 @@ void World::prepare_contacts(double dt) {
     s.island_colour_begin.push_back(static_cast<std::uint32_t>(s.colouring.colour_count()));
   }
 
+  s.packed = packed_sweeps();
   s.pack_manifolds.clear();
   s.colour_pack_begin.assign(1, 0);
   for (std::size_t c = 0; c < s.colouring.colour_count(); ++c) {
     const std::uint32_t end = s.colouring.colour_begin[c + 1];
-    if (!s.colouring.serial[c]) {
+    if (s.packed && !s.colouring.serial[c]) {
       for (std::uint32_t first = s.colouring.colour_begin[c]; first < end; first += kWideLanes)
         s.pack_manifolds.push_back({first, std::min<std::uint32_t>(kWideLanes, end - first)});
     }
@@ -740,12 +746,14 @@ void World::solve_islands(double dt) {
   const int threads = team_size(settings_.threads);
   if (s.team_values.size() < static_cast<std::size_t>(threads)) s.team_values.resize(threads);
   // The small islands as work: soft (with the settings' substeps) and pgs islands with rows in
-  // groups of kWideLanes (IslandLanes), every other one alone (SerialIsland).
+  // groups of kWideLanes (IslandLanes) where the step sweeps packs, every other one alone
+  // (SerialIsland).
   s.work_islands.clear();
   s.work_begin.assign(1, 0);
   auto lane_kind = [&](std::uint32_t i) -> int {
     const IslandReport& report = s.reports[i];
     if (s.island_row_begin[i + 1] == s.island_row_begin[i]) return -1;
+    if (!s.packed) return -1;
     if (report.solver == IslandSolver::kSoft && report.substeps == 0) return 0;
     if (report.solver == IslandSolver::kPgs && report.pgs_iterations == 0) return 1;
     return -1;
@@ -779,6 +787,15 @@ void World::solve_islands(double dt) {
     s.lane_pack_begin.push_back(s.lane_pack_begin.back() + most);
   }
   s.lane_packs.resize(s.lane_pack_begin.back());
+  for (std::int64_t k = 0; k < work; ++k) {
+    if (s.work_begin[k + 1] - s.work_begin[k] < 2) continue;
+    for (std::uint32_t w = s.work_begin[k]; w < s.work_begin[k + 1]; ++w) {
+      const std::uint32_t i = s.work_islands[w];
+      stats_.packed_manifolds += s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
+    }
+  }
+  for (const StepScratch::PackedManifolds& pack : s.pack_manifolds)
+    stats_.packed_manifolds += pack.count;
   const bool parallel = threads > 1 && (work > 1 || !s.team_islands.empty());
   // Large islands one after the other with the whole team, then the rest one island per thread:
   // islands share no body and no row, and colours share no moving body, so any thread count gives

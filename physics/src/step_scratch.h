@@ -74,6 +74,7 @@ struct StepScratch {
   struct PackedManifolds {
     std::uint32_t first = 0, count = 0;
   };
+  bool packed = false;  // this step sweeps packs (packed_sweeps())
   std::vector<ContactPack> packs;
   std::vector<PackedManifolds> pack_manifolds;
   std::vector<std::uint32_t> colour_pack_begin;

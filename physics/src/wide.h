@@ -30,16 +30,18 @@ TUMBLE_INLINE Wide wide(double value) {
   return Wide{value, value, value, value};
 }
 
+// Bitwise: GCC lowers a vector `?:` to scalar code where the vector is wider than the machine's.
+TUMBLE_INLINE Wide select(WideMask mask, Wide yes, Wide no) {
+  return reinterpret_cast<Wide>((mask & reinterpret_cast<WideMask>(yes)) |
+                                (~mask & reinterpret_cast<WideMask>(no)));
+}
 // std::max's and std::abs's results lane by lane, including which operand a tie or a signed zero
 // returns (max(a, b) is b only when a < b).
 TUMBLE_INLINE Wide wide_max(Wide a, Wide b) {
-  return a < b ? b : a;
+  return select(a < b, b, a);
 }
 TUMBLE_INLINE Wide wide_abs(Wide a) {
   return reinterpret_cast<Wide>(reinterpret_cast<WideMask>(a) & INT64_MAX);
-}
-TUMBLE_INLINE Wide select(WideMask mask, Wide yes, Wide no) {
-  return mask ? yes : no;
 }
 TUMBLE_INLINE bool any(WideMask mask) {
   return (mask[0] | mask[1] | mask[2] | mask[3]) != 0;
@@ -74,7 +76,7 @@ TUMBLE_INLINE WideVec3 plus_scaled(const WideVec3& a, Wide s, const WideVec3& b)
   return {a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
 }
 TUMBLE_INLINE WideVec3 select(WideMask mask, const WideVec3& yes, const WideVec3& no) {
-  return {mask ? yes.x : no.x, mask ? yes.y : no.y, mask ? yes.z : no.z};
+  return {select(mask, yes.x, no.x), select(mask, yes.y, no.y), select(mask, yes.z, no.z)};
 }
 
 }  // namespace tumble

@@ -83,6 +83,8 @@ struct StepStats {
   // Large islands split over the team by graph colouring: how many, their colours in all, and
   // the manifolds left to the serial overflow colour.
   std::uint32_t coloured_islands = 0, colours = 0, overflow_manifolds = 0;
+  // Manifolds swept four at a time in SIMD lanes (a colour's, or small islands' side by side).
+  std::uint32_t packed_manifolds = 0;
   // Islands the exact solver could not finish (pivot bound, ray termination, an answer off by
   // more than exact_velocity_tolerance): solved by pgs.
   std::uint32_t exact_fallbacks = 0;
