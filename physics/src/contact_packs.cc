@@ -37,6 +37,7 @@ void pack_point(const ContactRow& row, int k, PackPoint* p) {
   set_lane(&p->angular_b_t1, k, row.angular_b_t1);
   set_lane(&p->angular_a_t2, k, row.angular_a_t2);
   set_lane(&p->angular_b_t2, k, row.angular_b_t2);
+  p->separation[k] = row.separation;
   p->substep_separation[k] = row.substep_separation;
   p->normal_mass[k] = row.normal_mass;
   p->tangent_mass1[k] = row.tangent_mass1;
@@ -104,23 +105,21 @@ void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
   }
 }
 
-void store_impulses(const ContactPack& pack, std::span<ContactRow> rows) {
+void store_impulses(const ContactPack& pack, std::span<ContactRow> rows,
+                    std::span<ContactRowCold> cold) {
   for (int k = 0; k < kWideLanes; ++k) {
     for (int p = 0; p < pack.points[k]; ++p) {
       const PackPoint& point = pack.point[p];
-      ContactRow& row = rows[pack.first_row[k] + p];
+      const std::uint32_t id = pack.first_row[k] + p;
+      ContactRow& row = rows[id];
       row.normal_impulse = point.normal_impulse[k];
       row.tangent_impulse1 = point.tangent_impulse1[k];
       row.tangent_impulse2 = point.tangent_impulse2[k];
       row.max_normal_impulse = point.max_normal_impulse[k];
+      row.substep_separation = point.substep_separation[k];
+      cold[id].earlier_substeps_impulse = point.earlier_substeps_impulse[k];
     }
   }
-}
-
-void load_separations(std::span<const ContactRow> rows, ContactPack* pack) {
-  for (int k = 0; k < kWideLanes; ++k)
-    for (int p = 0; p < pack->points[k]; ++p)
-      pack->point[p].substep_separation[k] = rows[pack->first_row[k] + p].substep_separation;
 }
 
 namespace {
@@ -157,6 +156,35 @@ TUMBLE_INLINE void scatter(const ContactPack& pack, WideMask lanes, const WidePa
       bodies[pack.b[k]].w = lane_of(pair.wb, k);
     }
   }
+}
+
+// Each lane's two bodies' motion since the step start (SolverBody::delta_position and
+// delta_angle), for the separations of moving anchors.
+struct WideMotion {
+  WideVec3 position_a, angle_a, position_b, angle_b;
+};
+
+TUMBLE_INLINE WideMotion gather_motion(const ContactPack& pack,
+                                       std::span<const SolverBody> bodies) {
+  WideMotion motion;
+  for (int k = 0; k < kWideLanes; ++k) {
+    const SolverBody& a = bodies[pack.a[k]];
+    const SolverBody& b = bodies[pack.b[k]];
+    set_lane(&motion.position_a, k, a.delta_position);
+    set_lane(&motion.angle_a, k, a.delta_angle);
+    set_lane(&motion.position_b, k, b.delta_position);
+    set_lane(&motion.angle_b, k, b.delta_angle);
+  }
+  return motion;
+}
+
+// current_separation, lane by lane, set in the lanes where the point is present.
+TUMBLE_INLINE void set_substep_separation(const ContactPack& pack, const WideMotion& motion,
+                                          PackPoint& point) {
+  const Wide separation =
+      point.separation + dot(pack.normal, motion.position_b - motion.position_a) +
+      dot(motion.angle_b, point.rb_cross_n) - dot(motion.angle_a, point.ra_cross_n);
+  point.substep_separation = select(point.present, separation, point.substep_separation);
 }
 
 // normal_target's bias, mass scale and impulse scale, lane by lane.
@@ -198,6 +226,26 @@ TUMBLE_INLINE void apply_normal(const ContactPack& pack, const PackPoint& point,
   pair.wb = select(on_b, plus_scaled(pair.wb, impulse, point.angular_b), pair.wb);
 }
 
+// Applies impulses d1 and d2 along a point's tangents in the lanes of `mask`
+// (apply_tangent_impulses).
+TUMBLE_INLINE void apply_tangents(const ContactPack& pack, const PackPoint& point, WideMask mask,
+                                  Wide d1, Wide d2, WidePair& pair) {
+  const WideVec3 linear = {d1 * point.tangent1.x + d2 * point.tangent2.x,
+                           d1 * point.tangent1.y + d2 * point.tangent2.y,
+                           d1 * point.tangent1.z + d2 * point.tangent2.z};
+  const WideVec3 angular_a = {d1 * point.angular_a_t1.x + d2 * point.angular_a_t2.x,
+                              d1 * point.angular_a_t1.y + d2 * point.angular_a_t2.y,
+                              d1 * point.angular_a_t1.z + d2 * point.angular_a_t2.z};
+  const WideVec3 angular_b = {d1 * point.angular_b_t1.x + d2 * point.angular_b_t2.x,
+                              d1 * point.angular_b_t1.y + d2 * point.angular_b_t2.y,
+                              d1 * point.angular_b_t1.z + d2 * point.angular_b_t2.z};
+  const WideMask on_a = mask & pack.moves_a, on_b = mask & pack.moves_b;
+  pair.va = select(on_a, minus_scaled(pair.va, pack.inverse_mass_a, linear), pair.va);
+  pair.wa = select(on_a, pair.wa - angular_a, pair.wa);
+  pair.vb = select(on_b, plus_scaled(pair.vb, pack.inverse_mass_b, linear), pair.vb);
+  pair.wb = select(on_b, pair.wb + angular_b, pair.wb);
+}
+
 // solve_friction for a point in the lanes of `mask`. Returns the velocity change per lane.
 TUMBLE_INLINE Wide solve_friction(const ContactPack& pack, PackPoint& point, WideMask mask,
                                   WidePair& pair) {
@@ -223,20 +271,7 @@ TUMBLE_INLINE Wide solve_friction(const ContactPack& pack, PackPoint& point, Wid
   point.tangent_impulse1 = select(mask, new1, old1);
   point.tangent_impulse2 = select(mask, new2, old2);
   const Wide d1 = new1 - old1, d2 = new2 - old2;
-  const WideVec3 linear = {d1 * point.tangent1.x + d2 * point.tangent2.x,
-                           d1 * point.tangent1.y + d2 * point.tangent2.y,
-                           d1 * point.tangent1.z + d2 * point.tangent2.z};
-  const WideVec3 angular_a = {d1 * point.angular_a_t1.x + d2 * point.angular_a_t2.x,
-                              d1 * point.angular_a_t1.y + d2 * point.angular_a_t2.y,
-                              d1 * point.angular_a_t1.z + d2 * point.angular_a_t2.z};
-  const WideVec3 angular_b = {d1 * point.angular_b_t1.x + d2 * point.angular_b_t2.x,
-                              d1 * point.angular_b_t1.y + d2 * point.angular_b_t2.y,
-                              d1 * point.angular_b_t1.z + d2 * point.angular_b_t2.z};
-  const WideMask on_a = mask & pack.moves_a, on_b = mask & pack.moves_b;
-  pair.va = select(on_a, minus_scaled(pair.va, pack.inverse_mass_a, linear), pair.va);
-  pair.wa = select(on_a, pair.wa - angular_a, pair.wa);
-  pair.vb = select(on_b, plus_scaled(pair.vb, pack.inverse_mass_b, linear), pair.vb);
-  pair.wb = select(on_b, pair.wb + angular_b, pair.wb);
+  apply_tangents(pack, point, mask, d1, d2, pair);
   const Wide change =
       wide_max(wide_abs(d1) * point.tangent_response1, wide_abs(d2) * point.tangent_response2);
   return select(mask, change, wide(0));
@@ -279,6 +314,36 @@ bool packed_sweeps() {
 
 void set_packed_sweeps(bool on) {
   sweep_packs.store(on, std::memory_order_relaxed);
+}
+
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep) {
+  WidePair pair = gather(pack, bodies);
+  const WideMotion motion = gather_motion(pack, bodies);
+  for (int p = 0; p < pack.most_points; ++p) {
+    PackPoint& point = pack.point[p];
+    set_substep_separation(pack, motion, point);
+    if (keep_last_substep)
+      point.earlier_substeps_impulse =
+          select(point.present, point.earlier_substeps_impulse + point.normal_impulse,
+                 point.earlier_substeps_impulse);
+    apply_normal(pack, point, point.present, point.normal_impulse, pair);
+    const WideMask rubbing =
+        point.present & ((point.tangent_impulse1 != 0) | (point.tangent_impulse2 != 0));
+    apply_tangents(pack, point, rubbing, point.tangent_impulse1, point.tangent_impulse2, pair);
+  }
+  scatter(pack, kAllLanes, pair, bodies);
+}
+
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void update_separations(ContactPack& pack, std::span<const SolverBody> bodies) {
+  const WideMotion motion = gather_motion(pack, bodies);
+  for (int p = 0; p < pack.most_points; ++p)
+    set_substep_separation(pack, motion, pack.point[p]);
 }
 
 // Compiled twice, for AVX2 (one register a vector) and for any x86-64 (two), and chosen when the

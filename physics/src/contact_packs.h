@@ -8,8 +8,8 @@
 // so that packing changes the speed and not one bit of the answer.
 //
 // The rows (ContactRow) stay the record of a contact: a pack is a copy of its rows for the
-// sweeps, holding the impulses only while they sweep. The parts a step runs once a substep (warm
-// start, separations, restitution, residual) stay with the rows and go through them.
+// solve (warm starts, separations, sweeps), and gives the impulses back before the residual and
+// restitution, which go through the rows.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +26,8 @@ struct PackPoint {
   WideVec3 ra_cross_n, rb_cross_n, angular_a, angular_b;
   WideVec3 ra_cross_t1, rb_cross_t1, ra_cross_t2, rb_cross_t2;
   WideVec3 angular_a_t1, angular_b_t1, angular_a_t2, angular_b_t2;
-  Wide substep_separation;
+  Wide separation, substep_separation;
+  Wide earlier_substeps_impulse;  // ContactRowCold's
   Wide normal_mass, tangent_mass1, tangent_mass2;
   Wide normal_response, tangent_response1, tangent_response2;
   Wide normal_impulse, tangent_impulse1, tangent_impulse2, max_normal_impulse;
@@ -65,10 +66,13 @@ inline ManifoldRows lane_rows(const ContactPack& pack, int k,
   return {&row_ids[pack.first_row[k]], pack.points[k]};
 }
 
-// The impulses a pack's sweeps gave, back to its rows; and the separations the rows were given
-// (warm_start, update_separations), into the pack.
-void store_impulses(const ContactPack& pack, std::span<ContactRow> rows);
-void load_separations(std::span<const ContactRow> rows, ContactPack* pack);
+// The impulses the pack's solve gave, back to its rows.
+void store_impulses(const ContactPack& pack, std::span<ContactRow> rows,
+                    std::span<ContactRowCold> cold);
+
+// warm_start's and update_separations' bits for a pack's manifolds.
+void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep);
+void update_separations(ContactPack& pack, std::span<const SolverBody> bodies);
 
 // One Gauss-Seidel sweep over the manifolds of a pack's lanes in `lanes` (solve_lanes' bits).
 // Returns the largest velocity change it gave a contact (m/s), and each lane's in

@@ -180,9 +180,7 @@ void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,
     if (keep_last_substep) cold[id].earlier_substeps_impulse += row.normal_impulse;
     apply_normal_impulse(row, row.normal_impulse, bodies);
     if (row.tangent_impulse1 != 0 || row.tangent_impulse2 != 0)
-      apply_impulse(row, cold[id],
-                    row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2,
-                    bodies);
+      apply_tangent_impulses(row, row.tangent_impulse1, row.tangent_impulse2, bodies);
   }
 }
 

@@ -165,20 +165,6 @@ inline double normal_velocity(const ContactRow& row, std::span<const SolverBody>
 
 // Static bodies (inverse mass 0) are never written: islands and colours solved in parallel
 // share them.
-inline void apply_impulse(const ContactRow& row, const ContactRowCold& cold, const Vec3& impulse,
-                          std::span<SolverBody> bodies) {
-  SolverBody& a = bodies[row.a];
-  SolverBody& b = bodies[row.b];
-  if (a.inverse_mass > 0) {
-    a.v -= a.inverse_mass * impulse;
-    a.w -= a.inverse_inertia * cold.ra.cross(impulse);
-  }
-  if (b.inverse_mass > 0) {
-    b.v += b.inverse_mass * impulse;
-    b.w += b.inverse_inertia * cold.rb.cross(impulse);
-  }
-}
-
 inline void apply_normal_impulse(const ContactRow& row, double impulse,
                                  std::span<SolverBody> bodies) {
   SolverBody& a = bodies[row.a];
@@ -190,6 +176,23 @@ inline void apply_normal_impulse(const ContactRow& row, double impulse,
   if (b.inverse_mass > 0) {
     b.v += (b.inverse_mass * impulse) * row.normal;
     b.w += impulse * row.angular_b;
+  }
+}
+
+// Impulses t1 and t2 along the row's tangents, through their angular parts (as the sweeps apply
+// friction).
+inline void apply_tangent_impulses(const ContactRow& row, double t1, double t2,
+                                   std::span<SolverBody> bodies) {
+  SolverBody& a = bodies[row.a];
+  SolverBody& b = bodies[row.b];
+  const Vec3 linear = t1 * row.tangent1 + t2 * row.tangent2;
+  if (a.inverse_mass > 0) {
+    a.v -= a.inverse_mass * linear;
+    a.w -= t1 * row.angular_a_t1 + t2 * row.angular_a_t2;
+  }
+  if (b.inverse_mass > 0) {
+    b.v += b.inverse_mass * linear;
+    b.w += t1 * row.angular_b_t1 + t2 * row.angular_b_t2;
   }
 }
 

@@ -214,23 +214,16 @@ class IslandLanes {
       active_[k] = -1;
     }
   }
-  // The packs sweep; the rows, which keep everything else, take their impulses before a warm
-  // start and at the end, and give them the separations a warm start or a move set.
+  // The packs solve; the rows take their impulses at the end, for the residual and restitution.
   void refresh_separations() {
-    for (std::size_t k = 0; k < count_; ++k)
-      lanes_[k]->refresh_separations();
     for (ContactPack& pack : packs_)
-      load_separations(s_.rows, &pack);
+      update_separations(pack, s_.bodies);
   }
   void warm_start(bool keep_last_substep) {
-    for (const ContactPack& pack : packs_)
-      store_impulses(pack, s_.rows);
-    for (std::size_t k = 0; k < count_; ++k) {
-      lanes_[k]->warm_start(keep_last_substep);
-      active_[k] = -1;
-    }
     for (ContactPack& pack : packs_)
-      load_separations(s_.rows, &pack);
+      tumble::warm_start(pack, s_.bodies, keep_last_substep);
+    for (std::size_t k = 0; k < count_; ++k)
+      active_[k] = -1;
   }
   // Returns the largest change over the islands still sweeping; an island whose own sweep changed
   // nothing beyond the tolerance stops, as it would alone.
@@ -261,7 +254,7 @@ class IslandLanes {
   void finish(
       double h, Move move = [] {}) {
     for (const ContactPack& pack : packs_)
-      store_impulses(pack, s_.rows);
+      store_impulses(pack, s_.rows, s_.cold_rows);
     for (std::size_t k = 0; k < count_; ++k)
       lanes_[k]->record_residual(h);
     move();
@@ -400,20 +393,33 @@ class TeamIsland {
   bool has_rows() const { return true; }  // coloured islands have many
   void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
   void integrate_positions(double h) { team_integrate_positions(c_, h); }
-  // The packs sweep; the rows, which keep everything else, take their impulses before a warm
-  // start and at the end, and give them the separations a warm start or a move set.
+  // The packs solve; the rows take their impulses at the end, for the residual and restitution.
   void refresh_separations() {
-    each_manifold_or_pack(
-        [&](std::span<const std::uint32_t> ids) { update_separations(s_.rows, ids, s_.bodies); },
-        [&](ContactPack& pack) { load_separations(s_.rows, &pack); });
+    sweep_packs(
+        s_, first_, last_, false,
+        [&](ContactPack& pack) {
+          update_separations(pack, s_.bodies);
+          return 0.0;
+        },
+        [&](const ManifoldRows& manifold) {
+          update_separations(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies);
+          return 0.0;
+        },
+        false);
   }
   void warm_start(bool keep_last_substep) {
-    each_manifold_or_pack(
-        [&](std::span<const std::uint32_t> ids) {
-          tumble::warm_start(s_.rows, s_.cold_rows, ids, s_.bodies, keep_last_substep);
+    sweep_packs(
+        s_, first_, last_, false,
+        [&](ContactPack& pack) {
+          tumble::warm_start(pack, s_.bodies, keep_last_substep);
+          return 0.0;
         },
-        [&](ContactPack& pack) { load_separations(s_.rows, &pack); },
-        [&](const ContactPack& pack) { store_impulses(pack, s_.rows); });
+        [&](const ManifoldRows& manifold) {
+          tumble::warm_start(s_.rows, s_.cold_rows, std::span(manifold.ids, manifold.count),
+                             s_.bodies, keep_last_substep);
+          return 0.0;
+        },
+        false);
   }
   double sweep(const Softness* soft, double h, bool backward) {
     ++iterations_;
@@ -433,7 +439,7 @@ class TeamIsland {
     sweep_packs(
         s_, first_, last_, false,
         [&](const ContactPack& pack) {
-          store_impulses(pack, s_.rows);
+          store_impulses(pack, s_.rows, s_.cold_rows);
           return 0.0;
         },
         [](const ManifoldRows&) { return 0.0; }, false);
@@ -460,28 +466,6 @@ class TeamIsland {
         s_, first_, last_, false,
         [&](std::span<const std::uint32_t> ids) {
           fn(ids);
-          return 0.0;
-        },
-        false);
-  }
-  // fn(row ids) for every manifold, colour by colour; for a packed manifold, between `before` and
-  // `after` of its pack.
-  template <class Fn, class After, class Before = void (*)(const ContactPack&)>
-  void each_manifold_or_pack(
-      Fn&& fn, After&& after, Before&& before = [](const ContactPack&) {}) {
-    sweep_packs(
-        s_, first_, last_, false,
-        [&](ContactPack& pack) {
-          before(pack);
-          for (int k = 0; k < kWideLanes; ++k) {
-            const ManifoldRows lane = lane_rows(pack, k, s_.row_ids);
-            fn(std::span<const std::uint32_t>(lane.ids, lane.count));
-          }
-          after(pack);
-          return 0.0;
-        },
-        [&](const ManifoldRows& manifold) {
-          fn(std::span<const std::uint32_t>(manifold.ids, manifold.count));
           return 0.0;
         },
         false);
