@@ -742,9 +742,22 @@ void World::solve_islands(double dt) {
     if (report.solver == IslandSolver::kPgs && report.pgs_iterations == 0) return 1;
     return -1;
   };
+  auto manifold_count = [&](std::uint32_t i) {
+    return s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
+  };
   for (int kind = 0; kind < 2; ++kind) {
-    for (std::uint32_t i : s.single_islands) {
-      if (lane_kind(i) != kind) continue;
+    // Islands of like sizes side by side, largest first: a pack's lanes then run out of
+    // manifolds together (four islands of 30, 5, 5 and 2 manifolds would fill 30 packs, 42
+    // lanes of 120), and the largest items are handed out first.
+    s.lane_candidates.clear();
+    for (std::uint32_t i : s.single_islands)
+      if (lane_kind(i) == kind) s.lane_candidates.push_back(i);
+    std::sort(
+        s.lane_candidates.begin(), s.lane_candidates.end(), [&](std::uint32_t x, std::uint32_t y) {
+          return manifold_count(x) != manifold_count(y) ? manifold_count(x) > manifold_count(y)
+                                                        : x < y;
+        });
+    for (std::uint32_t i : s.lane_candidates) {
       if (s.work_islands.size() - s.work_begin.back() == kWideLanes)
         s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
       s.work_islands.push_back(i);

@@ -57,6 +57,7 @@ struct StepScratch {
   // The small islands' work: item k is islands work_islands[work_begin[k] .. work_begin[k+1]),
   // several only when they are solved together (IslandLanes).
   std::vector<std::uint32_t> work_islands, work_begin;
+  std::vector<std::uint32_t> lane_candidates;  // islands of one recipe, to be grouped
   // Islands solved together sweep packs (contact_packs.h), lane k for the item's k-th island:
   // item k's are lane_packs[lane_pack_begin[k] .. [k+1]), pack j holding each island's j-th
   // manifold.
