@@ -30,10 +30,9 @@ TUMBLE_INLINE Wide wide(double value) {
   return Wide{value, value, value, value};
 }
 
-// Bitwise: GCC lowers a vector `?:` to scalar code where the vector is wider than the machine's.
+// One blend instruction with AVX (packs are swept only there: packed_sweeps()).
 TUMBLE_INLINE Wide select(WideMask mask, Wide yes, Wide no) {
-  return reinterpret_cast<Wide>((mask & reinterpret_cast<WideMask>(yes)) |
-                                (~mask & reinterpret_cast<WideMask>(no)));
+  return mask ? yes : no;
 }
 // std::max's and std::abs's results lane by lane, including which operand a tie or a signed zero
 // returns (max(a, b) is b only when a < b).
