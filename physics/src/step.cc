@@ -179,7 +179,13 @@ class IslandLanes {
   static constexpr bool kSolvesExact = false;
   IslandLanes(StepScratch& s, const WorldSettings& settings, std::span<const std::uint32_t> islands,
               std::span<ContactPack> packs)
-      : s_(s), settings_(settings), count_(islands.size()), packs_(packs) {
+      : s_(s),
+        settings_(settings),
+        count_(islands.size()),
+        packs_(packs),
+        // A tall pgs island sweeps to the end (advance_with): none of the item stops early.
+        tolerance_(s.reports[islands[0]].pgs_iterations > 0 ? 0.0
+                                                            : settings.solver.velocity_tolerance) {
     TUMBLE_ASSERT(count_ <= kWideLanes);
     for (std::size_t k = 0; k < count_; ++k) {
       const std::uint32_t i = islands[k];
@@ -246,7 +252,7 @@ class IslandLanes {
     for (std::size_t k = 0; k < count_; ++k) {
       if (!active_[k]) continue;
       largest = std::max(largest, change[k]);
-      if (change[k] <= settings_.solver.velocity_tolerance) active_[k] = 0;
+      if (change[k] <= tolerance_) active_[k] = 0;
     }
     return largest;
   }
@@ -267,6 +273,7 @@ class IslandLanes {
   const WorldSettings& settings_;
   std::size_t count_;
   std::span<ContactPack> packs_;
+  double tolerance_;  // an island whose sweep changed no more stops sweeping
   std::array<std::optional<IslandContext>, kWideLanes> contexts_;
   std::array<std::optional<SerialIsland>, kWideLanes> lanes_;
   std::array<IslandReport*, kWideLanes> reports_{};
@@ -730,8 +737,8 @@ void World::solve_islands(double dt) {
   const int threads = team_size(settings_.threads);
   if (s.team_values.size() < static_cast<std::size_t>(threads)) s.team_values.resize(threads);
   // The small islands as work: soft (with the settings' substeps) and pgs islands with rows in
-  // groups of kWideLanes (IslandLanes) where the step sweeps packs, every other one alone
-  // (SerialIsland).
+  // groups of kWideLanes (IslandLanes) where the step sweeps packs (tall pgs islands with those
+  // of their sweep count), every other one alone (SerialIsland).
   s.work_islands.clear();
   s.work_begin.assign(1, 0);
   auto lane_kind = [&](std::uint32_t i) -> int {
@@ -739,12 +746,15 @@ void World::solve_islands(double dt) {
     if (s.island_row_begin[i + 1] == s.island_row_begin[i]) return -1;
     if (!s.packed) return -1;
     if (report.solver == IslandSolver::kSoft && report.substeps == 0) return 0;
-    if (report.solver == IslandSolver::kPgs && report.pgs_iterations == 0) return 1;
+    if (report.solver == IslandSolver::kPgs) return 1;
     return -1;
   };
   auto manifold_count = [&](std::uint32_t i) {
     return s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
   };
+  // Tall pgs islands sweep their own count to the end (tall_stacks.h): only islands with the same
+  // count share an item.
+  auto sweeps = [&](std::uint32_t i) { return s.reports[i].pgs_iterations; };
   for (int kind = 0; kind < 2; ++kind) {
     // Islands of like sizes side by side, largest first: a pack's lanes then run out of
     // manifolds together (four islands of 30, 5, 5 and 2 manifolds would fill 30 packs, 42
@@ -752,13 +762,18 @@ void World::solve_islands(double dt) {
     s.lane_candidates.clear();
     for (std::uint32_t i : s.single_islands)
       if (lane_kind(i) == kind) s.lane_candidates.push_back(i);
-    std::sort(
-        s.lane_candidates.begin(), s.lane_candidates.end(), [&](std::uint32_t x, std::uint32_t y) {
-          return manifold_count(x) != manifold_count(y) ? manifold_count(x) > manifold_count(y)
-                                                        : x < y;
-        });
+    std::sort(s.lane_candidates.begin(), s.lane_candidates.end(),
+              [&](std::uint32_t x, std::uint32_t y) {
+                if (sweeps(x) != sweeps(y)) return sweeps(x) < sweeps(y);
+                if (manifold_count(x) != manifold_count(y))
+                  return manifold_count(x) > manifold_count(y);
+                return x < y;
+              });
     for (std::uint32_t i : s.lane_candidates) {
-      if (s.work_islands.size() - s.work_begin.back() == kWideLanes)
+      const std::uint32_t item_size =
+          static_cast<std::uint32_t>(s.work_islands.size()) - s.work_begin.back();
+      if (item_size == kWideLanes ||
+          (item_size > 0 && sweeps(s.work_islands[s.work_begin.back()]) != sweeps(i)))
         s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
       s.work_islands.push_back(i);
     }
