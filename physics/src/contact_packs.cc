@@ -404,7 +404,11 @@ solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodie
     one_by_one |= in_block & ~feasible;
   }
   if (any(one_by_one)) {
-    for (int p = 0; p < most; ++p)
+    // Only as many points as those lanes have (single points are the usual reason).
+    int points = 0;
+    for (int k = 0; k < kWideLanes; ++k)
+      if (one_by_one[k]) points = std::max(points, static_cast<int>(pack.points[k]));
+    for (int p = 0; p < points; ++p)
       change = wide_max(change, solve_normal(pack, pack.point[p],
                                              one_by_one & pack.point[p].present, targets[p], pair));
   }
