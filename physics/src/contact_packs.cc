@@ -124,21 +124,24 @@ void store_impulses(const ContactPack& pack, std::span<ContactRow> rows,
 
 namespace {
 
-// The velocities of each lane's two bodies, held while the pack is solved (PairVelocities, four
-// at a time).
+// A vector of each lane's two bodies, twice: their velocities, held while the pack is solved
+// (PairVelocities, four at a time), or their motion since the step start.
 struct WidePair {
   WideVec3 va, wa, vb, wb;
 };
 
+// Two vectors of each lane's two bodies: their velocities (v, w), or their motion since the step
+// start (delta_position, delta_angle) for the separations of moving anchors.
+template <Vec3 SolverBody::*Linear, Vec3 SolverBody::*Angular>
 TUMBLE_INLINE WidePair gather(const ContactPack& pack, std::span<const SolverBody> bodies) {
   WidePair pair;
   for (int k = 0; k < kWideLanes; ++k) {
     const SolverBody& a = bodies[pack.a[k]];
     const SolverBody& b = bodies[pack.b[k]];
-    set_lane(&pair.va, k, a.v);
-    set_lane(&pair.wa, k, a.w);
-    set_lane(&pair.vb, k, b.v);
-    set_lane(&pair.wb, k, b.w);
+    set_lane(&pair.va, k, a.*Linear);
+    set_lane(&pair.wa, k, a.*Angular);
+    set_lane(&pair.vb, k, b.*Linear);
+    set_lane(&pair.wb, k, b.*Angular);
   }
   return pair;
 }
@@ -158,32 +161,11 @@ TUMBLE_INLINE void scatter(const ContactPack& pack, WideMask lanes, const WidePa
   }
 }
 
-// Each lane's two bodies' motion since the step start (SolverBody::delta_position and
-// delta_angle), for the separations of moving anchors.
-struct WideMotion {
-  WideVec3 position_a, angle_a, position_b, angle_b;
-};
-
-TUMBLE_INLINE WideMotion gather_motion(const ContactPack& pack,
-                                       std::span<const SolverBody> bodies) {
-  WideMotion motion;
-  for (int k = 0; k < kWideLanes; ++k) {
-    const SolverBody& a = bodies[pack.a[k]];
-    const SolverBody& b = bodies[pack.b[k]];
-    set_lane(&motion.position_a, k, a.delta_position);
-    set_lane(&motion.angle_a, k, a.delta_angle);
-    set_lane(&motion.position_b, k, b.delta_position);
-    set_lane(&motion.angle_b, k, b.delta_angle);
-  }
-  return motion;
-}
-
 // current_separation, lane by lane, set in the lanes where the point is present.
-TUMBLE_INLINE void set_substep_separation(const ContactPack& pack, const WideMotion& motion,
+TUMBLE_INLINE void set_substep_separation(const ContactPack& pack, const WidePair& motion,
                                           PackPoint& point) {
-  const Wide separation =
-      point.separation + dot(pack.normal, motion.position_b - motion.position_a) +
-      dot(motion.angle_b, point.rb_cross_n) - dot(motion.angle_a, point.ra_cross_n);
+  const Wide separation = point.separation + dot(pack.normal, motion.vb - motion.va) +
+                          dot(motion.wb, point.rb_cross_n) - dot(motion.wa, point.ra_cross_n);
   point.substep_separation = select(point.present, separation, point.substep_separation);
 }
 
@@ -320,8 +302,9 @@ void set_packed_sweeps(bool on) {
 __attribute__((target_clones("avx2", "default")))
 #endif
 void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep) {
-  WidePair pair = gather(pack, bodies);
-  const WideMotion motion = gather_motion(pack, bodies);
+  WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);
+  const WidePair motion =
+      gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
   for (int p = 0; p < pack.most_points; ++p) {
     PackPoint& point = pack.point[p];
     set_substep_separation(pack, motion, point);
@@ -341,7 +324,8 @@ void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_
 __attribute__((target_clones("avx2", "default")))
 #endif
 void update_separations(ContactPack& pack, std::span<const SolverBody> bodies) {
-  const WideMotion motion = gather_motion(pack, bodies);
+  const WidePair motion =
+      gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
   for (int p = 0; p < pack.most_points; ++p)
     set_substep_separation(pack, motion, pack.point[p]);
 }
@@ -358,7 +342,7 @@ solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodie
            const SolverSettings& settings, const Softness* soft, double h, double* lane_changes) {
   const double inverse_h = 1 / h;
   const int most = pack.most_points;
-  WidePair pair = gather(pack, bodies);
+  WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);
   Wide change = wide(0);
   for (int p = 0; p < most; ++p)
     change =

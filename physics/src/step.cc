@@ -307,41 +307,15 @@ ManifoldRows manifold_rows_of(const StepScratch& s, std::uint32_t manifold) {
   return {ids.data(), static_cast<int>(ids.size())};
 }
 
-// Calls fn(row ids of a manifold) for the manifolds of colours [first, last), forwards or
-// backwards. Manifolds of one colour share no moving body, so the team splits them; the overflow
-// colour runs on one thread, in order. Returns the largest value fn returned, on every thread (0
-// without `reduce`, which spares the two barriers of the reduction).
-template <class Fn>
-double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                     Fn&& fn, bool reduce = true) {
-  const Colouring& colouring = s.colouring;
-  double local = 0;
-  for (std::uint32_t k = first; k < last; ++k) {
-    const std::uint32_t c = backward ? first + last - 1 - k : k;
-    const std::int64_t begin = colouring.colour_begin[c], end = colouring.colour_begin[c + 1];
-    if (colouring.serial[c]) {
-#pragma omp single
-      for (std::int64_t i = begin; i < end; ++i) {
-        const std::int64_t at = backward ? begin + end - 1 - i : i;
-        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[at])));
-      }
-    } else {
-#pragma omp for schedule(static)
-      for (std::int64_t i = begin; i < end; ++i)
-        local = std::max(local, fn(manifold_rows(s, colouring.manifolds[i])));
-    }
-  }
-  return reduce ? team_max(local, s.team_values) : 0.0;
-}
-
-// Calls pack_fn(pack) for the packs of colours [first, last), forwards or backwards, the team
-// splitting each colour's packs, and manifold_fn(manifold rows) for the manifolds not packed: the
-// overflow colour's on one thread, in order, and every colour's, split, where the step sweeps no
-// packs (sweep_colours' order, which packs only group). Returns the largest value they returned,
-// on every thread (0 without `reduce`).
+// Calls pack_fn(pack) for the packs of colours [first, last), forwards or backwards, where
+// `packed`, the team splitting each colour's packs, and manifold_fn(manifold rows) for the
+// manifolds not packed: the overflow colour's on one thread, in order, and every colour's, split,
+// without `packed` (the same order: packs only group a colour's manifolds, which share no moving
+// body). Returns the largest value they returned, on every thread (0 without `reduce`, which
+// spares the two barriers of the reduction).
 template <class PackFn, class ManifoldFn>
-double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                   PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce = true) {
+double visit_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
+                     bool packed, PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce) {
   const Colouring& colouring = s.colouring;
   double local = 0;
   for (std::uint32_t k = first; k < last; ++k) {
@@ -353,18 +327,36 @@ double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool
         const std::int64_t at = backward ? begin + end - 1 - i : i;
         local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[at])));
       }
-    } else if (!s.packed) {
+    } else if (!packed) {
 #pragma omp for schedule(static)
       for (std::int64_t i = begin; i < end; ++i)
         local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[i])));
     } else {
-      const std::int64_t begin = s.colour_pack_begin[c], end = s.colour_pack_begin[c + 1];
+      const std::int64_t packs_begin = s.colour_pack_begin[c],
+                         packs_end = s.colour_pack_begin[c + 1];
 #pragma omp for schedule(static)
-      for (std::int64_t p = begin; p < end; ++p)
+      for (std::int64_t p = packs_begin; p < packs_end; ++p)
         local = std::max(local, pack_fn(s.packs[p]));
     }
   }
   return reduce ? team_max(local, s.team_values) : 0.0;
+}
+
+// The step's packs where it sweeps them, else the rows.
+template <class PackFn, class ManifoldFn>
+double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
+                   PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce = true) {
+  return visit_colours(s, first, last, backward, s.packed, pack_fn, manifold_fn, reduce);
+}
+
+// fn(row ids of a manifold) for every manifold, through the rows.
+template <class Fn>
+double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
+                     Fn&& fn, bool reduce = true) {
+  return visit_colours(
+      s, first, last, backward, false, [](const ContactPack&) { return 0.0; },
+      [&](const ManifoldRows& m) { return fn(std::span<const std::uint32_t>(m.ids, m.count)); },
+      reduce);
 }
 
 std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
