@@ -280,6 +280,8 @@ namespace {
 
 bool machine_has_wide_vectors() {
 #if defined(__x86_64__)
+  // This runs as a static initialiser, possibly before libgcc's own has read the CPU's features.
+  __builtin_cpu_init();
   return __builtin_cpu_supports("avx2");
 #else
   return false;
