@@ -96,6 +96,8 @@ int main(int argc, char** argv) {
   std::uint64_t stiffened = 0, stiffness_capped = 0;
   // The world's limits held by the step (body-steps).
   std::uint64_t non_finite = 0, slowed = 0, at_edge = 0;
+  // Manifold-steps, and those swept in SIMD lanes (contact packs; none without AVX2).
+  std::uint64_t manifolds = 0, packed = 0;
   double window_seconds = 0;
   int window_steps = 0;
   const auto start = std::chrono::steady_clock::now();
@@ -114,6 +116,8 @@ int main(int argc, char** argv) {
     non_finite += world.last_step().non_finite_bodies;
     slowed += world.last_step().slowed_bodies;
     at_edge += world.last_step().bodies_at_edge;
+    manifolds += world.last_step().manifolds;
+    packed += world.last_step().packed_manifolds;
     window_seconds += times.total;
     stage_sums.broad_phase += times.broad_phase;
     stage_sums.narrow_phase += times.narrow_phase;
@@ -148,6 +152,10 @@ int main(int argc, char** argv) {
       per_step * (stage_sums.total - stage_sums.broad_phase - stage_sums.narrow_phase -
                   stage_sums.prepare - stage_sums.solve - stage_sums.correct_positions -
                   stage_sums.continuous));
+  std::printf(
+      "contact manifolds swept in SIMD lanes (packs): %.1f%% of %llu manifold-steps\n",
+      manifolds > 0 ? 100.0 * static_cast<double>(packed) / static_cast<double>(manifolds) : 0.0,
+      static_cast<unsigned long long>(manifolds));
   std::printf(
       "bounds hit over the run: exact islands solved by pgs instead %llu, exact islands too large "
       "(soft) %llu, gyroscopic steps kept as spin %llu, swept pairs stopped at the bound %llu\n",
