@@ -1,6 +1,7 @@
-// The contact constraints of a coloured island, stored for its sweeps: four manifolds of one
-// colour to a pack, one lane each, every quantity of a point as four doubles side by side
-// (structure of arrays), so that one sweep solves four manifolds with each operation (wide.h).
+// The contact constraints of the iterative solvers, stored for their sweeps: four manifolds that
+// share no moving body to a pack (four of a colour, or the j-th manifolds of four small islands),
+// one lane each, every quantity of a point as four doubles side by side (structure of arrays), so
+// that one sweep solves four manifolds with each operation (wide.h).
 //
 // Box2D v3 stores its graph colours' contacts this way (Catto, "SIMD Matters", 2024), as Jolt
 // does its own; ours keeps the four-point block solve of a face (NormalBlock) lane by lane, and
@@ -60,12 +61,6 @@ void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
                     std::span<const NormalBlock> blocks, std::span<const SolverBody> bodies,
                     ContactPack* pack);
 
-// The rows of lane k (ids into the step's rows; a manifold's rows are consecutive).
-inline ManifoldRows lane_rows(const ContactPack& pack, int k,
-                              std::span<const std::uint32_t> row_ids) {
-  return {&row_ids[pack.first_row[k]], pack.points[k]};
-}
-
 // The impulses the pack's solve gave, back to its rows.
 void store_impulses(const ContactPack& pack, std::span<ContactRow> rows,
                     std::span<ContactRowCold> cold);
@@ -74,7 +69,8 @@ void store_impulses(const ContactPack& pack, std::span<ContactRow> rows,
 void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep);
 void update_separations(ContactPack& pack, std::span<const SolverBody> bodies);
 
-// One Gauss-Seidel sweep over the manifolds of a pack's lanes in `lanes` (solve_lanes' bits).
+// One Gauss-Seidel sweep over the manifolds of a pack's lanes in `lanes` (solve_manifold's
+// bits, lane by lane).
 // Returns the largest velocity change it gave a contact (m/s), and each lane's in
 // lane_changes[k] when given.
 double solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
