@@ -784,20 +784,13 @@ void World::solve_islands(double dt) {
     std::uint32_t most = 0;
     if (s.work_begin[k + 1] - s.work_begin[k] > 1) {
       for (std::uint32_t w = s.work_begin[k]; w < s.work_begin[k + 1]; ++w) {
-        const std::uint32_t i = s.work_islands[w];
-        most = std::max(most, s.island_manifold_begin[i + 1] - s.island_manifold_begin[i]);
+        most = std::max(most, manifold_count(s.work_islands[w]));
+        stats_.packed_manifolds += manifold_count(s.work_islands[w]);
       }
     }
     s.lane_pack_begin.push_back(s.lane_pack_begin.back() + most);
   }
   s.lane_packs.resize(s.lane_pack_begin.back());
-  for (std::int64_t k = 0; k < work; ++k) {
-    if (s.work_begin[k + 1] - s.work_begin[k] < 2) continue;
-    for (std::uint32_t w = s.work_begin[k]; w < s.work_begin[k + 1]; ++w) {
-      const std::uint32_t i = s.work_islands[w];
-      stats_.packed_manifolds += s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
-    }
-  }
   for (const StepScratch::PackedManifolds& pack : s.pack_manifolds)
     stats_.packed_manifolds += pack.count;
   const bool parallel = threads > 1 && (work > 1 || !s.team_islands.empty());
