@@ -72,6 +72,7 @@ void put_settings(const WorldSettings& s, pb::WorldSettings* out) {
   o->set_slop(v.slop);
   o->set_speculative_distance(v.speculative_distance);
   o->set_restitution_threshold(v.restitution_threshold);
+  o->set_manifold_reuse(v.manifold_reuse);
   o->set_continuous(v.continuous);
   o->set_continuous_fraction(v.continuous_fraction);
   o->set_continuous_iterations(v.continuous_iterations);
@@ -141,6 +142,7 @@ Result<WorldSettings> take_settings(const pb::WorldSettings& in) {
   v.slop = o.slop();
   v.speculative_distance = o.speculative_distance();
   v.restitution_threshold = o.restitution_threshold();
+  if (o.has_manifold_reuse()) v.manifold_reuse = o.manifold_reuse();
   take_limits(in.limits(), &s.limits);
   v.continuous = o.continuous();
   v.continuous_fraction = o.continuous_fraction();
@@ -269,6 +271,101 @@ Status take_body(const pb::Body& in, BodySlotState* slot) {
   return Status::ok();  // World::from_state checks the values
 }
 
+void put_contact_pairs(const std::vector<ContactPairRecord>& pairs, pb::ContactPairs* out) {
+  for (const ContactPairRecord& r : pairs) {
+    out->add_body_a(r.a.index);
+    out->add_body_b(r.b.index);
+    out->add_generation_a(r.a.generation);
+    out->add_generation_b(r.b.generation);
+    put(r.relative_position, out->mutable_relative_position());
+    const Quat& q = r.relative_orientation;
+    for (double value : {q.w(), q.x(), q.y(), q.z()})
+      out->add_relative_orientation(value);
+    put(r.local_normal, out->mutable_local_normal());
+    out->add_depth_excess(r.depth_excess);
+    out->add_margin(r.margin);
+    out->add_reusable(r.reusable);
+    out->add_count(static_cast<std::uint32_t>(r.count));
+    for (int i = 0; i < r.count; ++i) {
+      const ContactPointRecord& p = r.points[i];
+      out->add_feature(p.feature);
+      put(p.local_a, out->mutable_local_a());
+      put(p.local_b, out->mutable_local_b());
+      out->add_normal_impulse(p.normal_impulse);
+      put(p.friction_impulse, out->mutable_friction_impulse());
+    }
+  }
+}
+
+Vec3 vec3_at(const RepeatedField<double>& values, int i) {
+  return Vec3(values[3 * i], values[3 * i + 1], values[3 * i + 2]);
+}
+
+// The engine checks the values (World::from_state); here only the arrays' shapes.
+Result<std::vector<ContactPairRecord>> take_contact_pairs(const pb::ContactPairs& in) {
+  const int n = in.body_a_size();
+  if (in.body_b_size() != n || in.generation_a_size() != n || in.generation_b_size() != n ||
+      in.relative_position_size() != 3 * n || in.relative_orientation_size() != 4 * n ||
+      in.local_normal_size() != 3 * n || in.depth_excess_size() != n || in.margin_size() != n ||
+      in.reusable_size() != n || in.count_size() != n)
+    return Status::error("array lengths do not match");
+  std::int64_t points = 0;
+  for (int k = 0; k < n; ++k) {
+    if (in.count(k) < 1 || in.count(k) > 4)
+      return Status::error("count[" + std::to_string(k) + "]: must be 1 to 4");
+    points += in.count(k);
+  }
+  if (in.feature_size() != points || in.local_a_size() != 3 * points ||
+      in.local_b_size() != 3 * points || in.normal_impulse_size() != points ||
+      in.friction_impulse_size() != 3 * points)
+    return Status::error("point arrays: lengths do not match the counts");
+  std::vector<ContactPairRecord> pairs(n);
+  int point = 0;
+  for (int k = 0; k < n; ++k) {
+    ContactPairRecord& r = pairs[k];
+    r.a = {in.body_a(k), in.generation_a(k)};
+    r.b = {in.body_b(k), in.generation_b(k)};
+    r.relative_position = vec3_at(in.relative_position(), k);
+    r.relative_orientation =
+        Quat(in.relative_orientation(4 * k), in.relative_orientation(4 * k + 1),
+             in.relative_orientation(4 * k + 2), in.relative_orientation(4 * k + 3));
+    r.local_normal = vec3_at(in.local_normal(), k);
+    r.depth_excess = in.depth_excess(k);
+    r.margin = in.margin(k);
+    r.reusable = in.reusable(k);
+    r.count = static_cast<int>(in.count(k));
+    for (int i = 0; i < r.count; ++i, ++point)
+      r.points[i] = {in.feature(point), vec3_at(in.local_a(), point), vec3_at(in.local_b(), point),
+                     in.normal_impulse(point), vec3_at(in.friction_impulse(), point)};
+  }
+  return pairs;
+}
+
+// An older snapshot's impulses, point by point: grouped into records by body pair (at most four
+// points each, the rest dropped) that the narrow phase does not reuse, only matches points to.
+Result<std::vector<ContactPairRecord>> take_warm_start(const pb::WarmStart& w) {
+  const int n = w.body_a_size();
+  if (w.body_b_size() != n || w.generation_a_size() != n || w.generation_b_size() != n ||
+      w.feature_size() != n || w.local_a_size() != 3 * n || w.normal_size() != n ||
+      w.friction_size() != 3 * n)
+    return Status::error("array lengths do not match");
+  std::vector<ContactPairRecord> pairs;
+  for (int i = 0; i < n; ++i) {
+    const BodyId a{w.body_a(i), w.generation_a(i)}, b{w.body_b(i), w.generation_b(i)};
+    if (pairs.empty() || pairs.back().a != a || pairs.back().b != b) {
+      pairs.emplace_back();
+      pairs.back().a = a;
+      pairs.back().b = b;
+      pairs.back().reusable = false;
+    }
+    ContactPairRecord& r = pairs.back();
+    if (r.count == 4) continue;
+    r.points[r.count++] = {w.feature(i), vec3_at(w.local_a(), i), Vec3::Zero(), w.normal(i),
+                           vec3_at(w.friction(), i)};
+  }
+  return pairs;
+}
+
 }  // namespace
 
 std::string encode_snapshot(const SavedWorld& saved) {
@@ -287,17 +384,7 @@ std::string encode_snapshot(const SavedWorld& saved) {
   out.set_step(state.step);
   out.set_server_instance(saved.server_instance);
   out.set_next_id(saved.next_id);
-  pb::WarmStart* w = out.mutable_warm_start();
-  for (const WarmStartImpulse& c : state.warm_start) {
-    w->add_body_a(c.a.index);
-    w->add_body_b(c.b.index);
-    w->add_generation_a(c.a.generation);
-    w->add_generation_b(c.b.generation);
-    w->add_feature(c.feature);
-    put(c.local_a, w->mutable_local_a());
-    w->add_normal(c.normal);
-    put(c.friction, w->mutable_friction());
-  }
+  put_contact_pairs(state.contact_pairs, out.mutable_contact_pairs());
   return out.SerializeAsString();
 }
 
@@ -339,21 +426,14 @@ Result<SavedWorld> decode_snapshot(std::string_view bytes) {
   state.free_slots.assign(in.free_slots().begin(), in.free_slots().end());
   state.time = in.time();
   state.step = in.step();
-  const pb::WarmStart& w = in.warm_start();
-  const int n = w.body_a_size();
-  if (w.body_b_size() != n || w.generation_a_size() != n || w.generation_b_size() != n ||
-      w.feature_size() != n || w.local_a_size() != 3 * n || w.normal_size() != n ||
-      w.friction_size() != 3 * n)
-    return Status::error("warm_start: array lengths do not match");
-  state.warm_start.resize(n);
-  for (int i = 0; i < n; ++i) {
-    WarmStartImpulse& c = state.warm_start[i];
-    c.a = {w.body_a(i), w.generation_a(i)};
-    c.b = {w.body_b(i), w.generation_b(i)};
-    c.feature = w.feature(i);
-    c.local_a = Vec3(w.local_a(3 * i), w.local_a(3 * i + 1), w.local_a(3 * i + 2));
-    c.normal = w.normal(i);
-    c.friction = Vec3(w.friction(3 * i), w.friction(3 * i + 1), w.friction(3 * i + 2));
+  if (in.contact_pairs().body_a_size() > 0) {
+    Result<std::vector<ContactPairRecord>> pairs = take_contact_pairs(in.contact_pairs());
+    if (!pairs) return pairs.status().within("contact_pairs.");
+    state.contact_pairs = std::move(pairs).value();
+  } else {
+    Result<std::vector<ContactPairRecord>> pairs = take_warm_start(in.warm_start());
+    if (!pairs) return pairs.status().within("warm_start.");
+    state.contact_pairs = std::move(pairs).value();
   }
   return saved;
 }

@@ -420,7 +420,7 @@ TEST_F(SnapshotTest, RestoreContinuesTheRunBitForBit) {
   EXPECT_EQ(saved.step(), 50u);
   v1::snapshot::WorldSnapshot parsed;
   ASSERT_TRUE(parsed.ParseFromString(saved.state()));
-  ASSERT_GT(parsed.warm_start().normal_size(), 0);
+  ASSERT_GT(parsed.contact_pairs().normal_impulse_size(), 0);
   run_steps(60);
   const v1::GetBodiesResponse straight = bodies();
 

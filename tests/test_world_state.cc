@@ -28,7 +28,7 @@ constexpr double kDt = 1.0 / 60;
 TEST(WorldState, RestoredWorldStepsOnBitForBit) {
   World original = busy_world();
   const WorldStateData saved = original.save_state();
-  ASSERT_FALSE(saved.warm_start.empty());
+  ASSERT_FALSE(saved.contact_pairs.empty());
   Result<World> restored = World::from_state(original.settings(), saved);
   ASSERT_TRUE(restored) << restored.error();
   EXPECT_EQ(restored.value().step_count(), original.step_count());
@@ -47,11 +47,12 @@ TEST(WorldState, RestoredWorldStepsOnBitForBit) {
   EXPECT_EQ(restored.value().step_count(), original.step_count());
 }
 
-// Shows the test above would catch a lost warm-start cache: without it the run differs.
+// Shows the test above would catch lost contact pair records (impulses, reused manifolds):
+// without them the run differs.
 TEST(WorldState, WarmStartCacheChangesTheRun) {
   World original = busy_world();
   WorldStateData saved = original.save_state();
-  saved.warm_start.clear();
+  saved.contact_pairs.clear();
   World cold = World::from_state(original.settings(), std::move(saved)).value();
   run(original, kDt, 30);
   run(cold, kDt, 30);
@@ -85,11 +86,17 @@ TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   s.free_slots.push_back(1);  // alive
   refused(s, "free_slots[2]");
   s = good;
-  std::swap(s.warm_start.front(), s.warm_start.back());
+  std::swap(s.contact_pairs.front(), s.contact_pairs.back());
   refused(s, "not sorted");
   s = good;
-  s.warm_start[0].b.index = 1u << 30;
-  refused(s, "warm_start[0]");
+  s.contact_pairs[0].b.index = 1u << 30;
+  refused(s, "contact_pairs[0]");
+  s = good;
+  s.contact_pairs[1].points[0].local_b.x() = 1e6;  // far off the body
+  refused(s, "contact_pairs[1].points[0]");
+  s = good;
+  s.contact_pairs[1].count = 5;
+  refused(s, "contact_pairs[1].count");
   s = good;
   s.time = -1;
   refused(s, "time");

@@ -32,22 +32,17 @@ Vec3 any_perpendicular(const Vec3& n) {
   return n.cross(axis).normalized();
 }
 
-bool less_pair(const CachedImpulse& c, BodyId a, BodyId b) {
-  return c.a.index != a.index ? c.a.index < a.index : c.b.index < b.index;
-}
-
 }  // namespace
 
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
-                  const Body& b, std::span<const CachedImpulse> cache, std::uint32_t block_index,
-                  ContactRow* rows, ContactRowCold* cold, NormalBlock* block) {
+                  const Body& b, const ContactPairRecord* previous, bool reused,
+                  std::uint32_t block_index, ContactRow* rows, ContactRowCold* cold,
+                  NormalBlock* block) {
   TUMBLE_ASSERT(manifold.count >= 1 && manifold.count <= 4);
   const Vec3& n = manifold.normal;
   const double friction = std::sqrt(a.friction * b.friction);
   const double restitution = std::max(a.restitution, b.restitution);
-  auto first = std::lower_bound(cache.begin(), cache.end(), 0, [&](const CachedImpulse& c, int) {
-    return less_pair(c, id_a, id_b);
-  });
+  TUMBLE_ASSERT(!reused || (previous != nullptr && previous->count == manifold.count));
   const Mat3 ra_to_local = a.orientation.conjugate().toRotationMatrix();
   const Mat3 rb_to_local = b.orientation.conjugate().toRotationMatrix();
   const double match_distance = 0.05 * std::min(a.shape.size(), b.shape.size());
@@ -102,26 +97,32 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     row.tangent_mass1 = mass_of(row.tangent_response1);
     row.tangent_mass2 = mass_of(row.tangent_response2);
 
-    // Feature ids change when a vertex of a face resting on an equal face moves across the
-    // other's edge by a nanometre; the point has not moved, so its impulse still applies
-    // (Jolt matches all points this way).
-    const CachedImpulse* match = nullptr;
-    double nearest = match_distance * match_distance;
-    for (auto it = first; it != cache.end() && it->a == id_a && it->b == id_b; ++it) {
-      if (it->feature == far.feature) {
-        match = &*it;
-        break;
-      }
-      const double d2 = (it->local_a - far.local_a).squaredNorm();
-      if (d2 < nearest) {
-        nearest = d2;
-        match = &*it;
+    // A reused manifold has the record's points, in order. Otherwise feature ids may have
+    // changed when a vertex of a face resting on an equal face moved across the other's edge by
+    // a nanometre; the point has not moved, so its impulse still applies (Jolt matches all
+    // points this way).
+    const ContactPointRecord* match = nullptr;
+    if (reused) {
+      match = &previous->points[i];
+    } else if (previous != nullptr) {
+      double nearest = match_distance * match_distance;
+      for (int k = 0; k < previous->count; ++k) {
+        const ContactPointRecord& kept = previous->points[k];
+        if (kept.feature == far.feature) {
+          match = &kept;
+          break;
+        }
+        const double d2 = (kept.local_a - far.local_a).squaredNorm();
+        if (d2 < nearest) {
+          nearest = d2;
+          match = &kept;
+        }
       }
     }
     if (match != nullptr) {
-      row.normal_impulse = match->normal;
-      row.tangent_impulse1 = match->friction.dot(row.tangent1);
-      row.tangent_impulse2 = match->friction.dot(row.tangent2);
+      row.normal_impulse = match->normal_impulse;
+      row.tangent_impulse1 = match->friction_impulse.dot(row.tangent1);
+      row.tangent_impulse2 = match->friction_impulse.dot(row.tangent2);
     }
     rows[i] = row;
     cold[i] = far;

@@ -570,6 +570,7 @@ void World::prepare_contacts(double dt) {
     s.row_begin[m + 1] = s.row_begin[m] + static_cast<std::uint32_t>(contact.manifold.count);
     s.links[m] = {contact.a.index, contact.b.index};
     s.touching[m] = contact.manifold.depth > -settings_.solver.slop;
+    stats_.reused_manifolds += s.reused[m];
     deepest = std::max(deepest, contact.manifold.depth);
   }
   s.rows.resize(s.row_begin[manifolds]);
@@ -584,9 +585,12 @@ void World::prepare_contacts(double dt) {
   const std::int64_t count = static_cast<std::int64_t>(manifolds);
   for_indices(threads, count > 64, count, [&](std::int64_t m) {
     const Contact& contact = contacts_[m];
+    const std::uint32_t previous = s.previous_pair[m];
     prepare_rows(contact.manifold, contact.a, bodies_[contact.a.index].body, contact.b,
-                 bodies_[contact.b.index].body, s.cache, static_cast<std::uint32_t>(m),
-                 &s.rows[s.row_begin[m]], &s.cold_rows[s.row_begin[m]], &s.blocks[m]);
+                 bodies_[contact.b.index].body,
+                 previous == kNoRecord ? nullptr : &s.pairs[previous], s.reused[m] != 0,
+                 static_cast<std::uint32_t>(m), &s.rows[s.row_begin[m]],
+                 &s.cold_rows[s.row_begin[m]], &s.blocks[m]);
   });
   build_islands(s.dynamic, s.links, &s.islands);
   s.body_of_slot.resize(slots);  // reused: no allocation once warmed up
@@ -919,8 +923,7 @@ void World::finish_step(double dt) {
   const std::int64_t manifolds = static_cast<std::int64_t>(contacts_.size());
   TUMBLE_ASSERT(s.cold_rows.size() == s.rows.size() && s.row_begin.size() == contacts_.size() + 1 &&
                 s.row_begin.back() == s.rows.size());
-  // Impulses for the next step's warm start, sorted by body pair as the contacts are.
-  s.cache.resize(s.rows.size());
+  TUMBLE_ASSERT(s.next_pairs.size() == contacts_.size());
   impulses_.resize(s.rows.size());
   std::uint32_t non_finite = 0, slowed = 0, stopped = 0;
   run_region(threads, slots > 256, [&] {
@@ -945,20 +948,19 @@ void World::finish_step(double dt) {
     for (std::int64_t m = 0; m < manifolds; ++m) {
       for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r) {
         const ContactRow& row = s.rows[r];
-        const ContactRowCold& cold = s.cold_rows[r];
-        s.cache[r] = {contacts_[m].a,
-                      contacts_[m].b,
-                      cold.feature,
-                      cold.local_a,
-                      row.normal_impulse,
-                      row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2};
-        impulses_[r] = cold.earlier_substeps_impulse + row.normal_impulse;
+        // The impulses stay with the pair's record for the next step's warm start.
+        ContactPointRecord& point = s.next_pairs[m].points[row.block_index];
+        point.normal_impulse = row.normal_impulse;
+        point.friction_impulse =
+            row.tangent_impulse1 * row.tangent1 + row.tangent_impulse2 * row.tangent2;
+        impulses_[r] = s.cold_rows[r].earlier_substeps_impulse + row.normal_impulse;
       }
     }
   });
   stats_.non_finite_bodies = non_finite;
   stats_.slowed_bodies = slowed;
   stats_.bodies_at_edge = stopped;
+  std::swap(s.pairs, s.next_pairs);
   time_ += dt;
 }
 

@@ -5,6 +5,7 @@
 
 #include "colouring.h"
 #include "contact_packs.h"
+#include "contact_pairs.h"
 #include "contact_solver.h"
 #include "continuous.h"
 #include "islands.h"
@@ -87,7 +88,12 @@ struct StepScratch {
   std::vector<const Body*> body_of_slot;
   std::vector<std::uint32_t> support_level;  // by slot, for tall_stacks.h
   std::vector<LevelSums> level_sums;
-  std::vector<CachedImpulse> cache;  // last step's impulses, sorted by body pair
+  // The touching pairs as the last step left them, with their impulses (contact_pairs.h), sorted
+  // by body pair; and this step's, contact for contact, with the index of each one's record in
+  // `pairs` (kNoRecord: none) and whether its manifold was taken from there.
+  std::vector<ContactPairRecord> pairs, next_pairs;
+  std::vector<std::uint32_t> previous_pair;
+  std::vector<std::uint8_t> reused;
 };
 
 }  // namespace tumble

@@ -88,6 +88,8 @@ Status validate(const WorldSettings& s) {
     return Status::error("solver.speculative_distance: must be finite and >= 0");
   if (!non_negative(v.restitution_threshold))
     return Status::error("solver.restitution_threshold: must be finite and >= 0");
+  if (!(v.manifold_reuse >= 0 && v.manifold_reuse <= 0.01))
+    return Status::error("solver.manifold_reuse: must be in [0, 0.01]");
   if (!(v.contact_hertz > 0) || !std::isfinite(v.contact_hertz))
     return Status::error("solver.contact_hertz: must be finite and > 0");
   if (!non_negative(v.contact_damping_ratio))
@@ -348,10 +350,15 @@ std::span<const Contact> World::find_contacts() {
 }
 
 void World::find_contacts(double dt) {
+  StepScratch& s = *scratch_;
   const std::int64_t n = static_cast<std::int64_t>(pairs_.size());
   // Every pair writes its own slot, then the touching ones are packed in pair order: the same
   // result for any thread count.
   contacts_.resize(pairs_.size());
+  s.next_pairs.resize(pairs_.size());
+  s.previous_pair.resize(pairs_.size());
+  s.reused.resize(pairs_.size());
+  const double reuse = dt > 0 ? settings_.solver.manifold_reuse : 0.0;
   const std::uint32_t flags = or_over_indices(
       thread_count(settings_.threads), n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
         const Body& a = bodies_[pairs_[i].a].body;
@@ -359,7 +366,12 @@ void World::find_contacts(double dt) {
         Contact& contact = contacts_[i];
         contact.a = {pairs_[i].a, bodies_[pairs_[i].a].generation};
         contact.b = {pairs_[i].b, bodies_[pairs_[i].b].generation};
+        const std::uint32_t previous = find_pair_record(s.pairs, contact.a, contact.b);
+        s.previous_pair[i] = previous;
+        s.reused[i] = 0;
+        const Pose pose_a = a.pose(), pose_b = b.pose();
         CollisionSettings settings = settings_.collision;
+        const bool fast = fast_[pairs_[i].a] || fast_[pairs_[i].b];
         if (dt > 0) {
           settings.margin += settings_.solver.speculative_distance + speculative_[pairs_[i].a] +
                              speculative_[pairs_[i].b];
@@ -368,23 +380,49 @@ void World::find_contacts(double dt) {
           settings.feature_slack_relative = std::max(settings.feature_slack_relative, 0.05);
           settings.face_angle = std::max(settings.face_angle, 0.02);
         }
+        const double tolerance = reuse * std::min(a.shape.size(), b.shape.size());
+        if (tolerance > 0 && !fast && previous != kNoRecord) {
+          const ContactPairRecord& record = s.pairs[previous];
+          const double motion = relative_motion(record, pose_a, pose_b, a.shape.outer_radius(),
+                                                b.shape.outer_radius());
+          if (may_reuse(record, motion, tolerance, settings.margin)) {
+            manifold_from_record(record, pose_a, pose_b, &contact.manifold);
+            s.next_pairs[i] = record;
+            s.reused[i] = 1;
+            return 0;
+          }
+        }
+        // Room for the motion later steps may reuse this manifold over (may_reuse).
+        settings.margin += 2 * tolerance;
         std::uint32_t pair_flags =
-            collide(a.shape, a.pose(), b.shape, b.pose(), settings, &contact.manifold);
+            collide(a.shape, pose_a, b.shape, pose_b, settings, &contact.manifold);
         // A fast body already touching something is not swept against it (there is no first
         // impact to find), so the solver must see every feature that can reach it in the step: the
         // far edge of a plate falling flat, for one. Its speculative contacts cover the whole
         // motion.
-        if (dt > 0 && contact.manifold.count > 0 && (fast_[pairs_[i].a] || fast_[pairs_[i].b])) {
+        if (dt > 0 && contact.manifold.count > 0 && fast) {
           settings.margin = settings_.collision.margin + settings_.solver.speculative_distance +
                             motion_[pairs_[i].a] + motion_[pairs_[i].b];
-          pair_flags |= collide(a.shape, a.pose(), b.shape, b.pose(), settings, &contact.manifold);
+          pair_flags |= collide(a.shape, pose_a, b.shape, pose_b, settings, &contact.manifold);
         }
+        if (contact.manifold.count > 0)
+          record_manifold(contact.manifold, contact.a, pose_a, contact.b, pose_b, settings.margin,
+                          &s.next_pairs[i]);
         return pair_flags;
       });
   std::size_t kept = 0;
-  for (std::size_t i = 0; i < contacts_.size(); ++i)
-    if (contacts_[i].manifold.count > 0) contacts_[kept++] = contacts_[i];
+  for (std::size_t i = 0; i < contacts_.size(); ++i) {
+    if (contacts_[i].manifold.count == 0) continue;
+    contacts_[kept] = contacts_[i];
+    s.next_pairs[kept] = s.next_pairs[i];
+    s.previous_pair[kept] = s.previous_pair[i];
+    s.reused[kept] = s.reused[i];
+    ++kept;
+  }
   contacts_.resize(kept);
+  s.next_pairs.resize(kept);
+  s.previous_pair.resize(kept);
+  s.reused.resize(kept);
   collision_flags_ = flags;
 }
 

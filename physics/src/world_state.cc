@@ -3,6 +3,8 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <string>
 
 #include "physics/world.h"
@@ -54,6 +56,46 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
   return Status::ok();
 }
 
+// A record's points take part in the next step's solve when it is reused, so they must lie on
+// the bodies (within the margin they were found with). A record of a body removed since is kept
+// until the next step and never matched (the slot's generation moves on).
+Status check_contact_pair(const ContactPairRecord& record, std::span<const BodySlotState> slots) {
+  if (record.a.index >= slots.size() || record.b.index >= slots.size())
+    return Status::error("a, b: body out of range");
+  if (record.a.index >= record.b.index) return Status::error("a: must be below b");
+  const auto current = [&](const BodyId& id) {
+    return slots[id.index].alive && slots[id.index].generation == id.generation;
+  };
+  // Records without geometry (an older snapshot's) only match points by feature and distance.
+  const bool may_be_used = record.reusable && current(record.a) && current(record.b);
+  if (record.count < 1 || record.count > 4) return Status::error("count: must be 1 to 4");
+  if (!(record.margin >= 0) || !std::isfinite(record.margin))
+    return Status::error("margin: must be finite and >= 0");
+  if (!(record.depth_excess >= 0) || !std::isfinite(record.depth_excess))
+    return Status::error("depth_excess: must be finite and >= 0");
+  if (!is_finite(record.relative_position) ||
+      !(std::abs(record.relative_orientation.norm() - 1) <= 1e-6) ||
+      !(std::abs(record.local_normal.norm() - 1) <= 1e-6))
+    return Status::error("relative pose and normal: must be finite, unit quaternion and normal");
+  // A corner lies at the outer radius, give or take rounding.
+  const auto reach = [&](const BodyId& id) {
+    return may_be_used ? 1.001 * slots[id.index].body.shape.outer_radius() + record.margin
+                       : std::numeric_limits<double>::infinity();
+  };
+  const double reach_a = reach(record.a), reach_b = reach(record.b);
+  for (int i = 0; i < record.count; ++i) {
+    const ContactPointRecord& point = record.points[i];
+    const std::string field = "points[" + std::to_string(i) + "].";
+    if (!is_finite(point.local_a) || !is_finite(point.local_b) ||
+        !std::isfinite(point.normal_impulse) || !is_finite(point.friction_impulse))
+      return Status::error(field + "values: must be finite");
+    // A half-space's reach is infinite; its point must only be finite.
+    if (!(point.local_a.norm() <= reach_a) || !(point.local_b.norm() <= reach_b))
+      return Status::error(field + "local_a, local_b: must lie within the body's reach");
+  }
+  return Status::ok();
+}
+
 }  // namespace
 
 WorldStateData World::save_state() const {
@@ -64,7 +106,7 @@ WorldStateData World::save_state() const {
   state.free_slots = free_slots_;
   state.time = time_;
   state.step = stats_.step;
-  state.warm_start = scratch_->cache;
+  state.contact_pairs = scratch_->pairs;
   return state;
 }
 
@@ -94,17 +136,15 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
   }
   if (state.free_slots.size() != slot_count - live)
     return Status::error("free_slots: must list every dead slot");
-  for (std::size_t k = 0; k < state.warm_start.size(); ++k) {
-    const WarmStartImpulse& w = state.warm_start[k];
-    const std::string field = "warm_start[" + std::to_string(k) + "]";
-    if (w.a.index >= slot_count || w.b.index >= slot_count)
-      return Status::error(field + ": body out of range");
-    if (!is_finite(w.local_a) || !std::isfinite(w.normal) || !is_finite(w.friction))
-      return Status::error(field + ": must be finite");
+  for (std::size_t k = 0; k < state.contact_pairs.size(); ++k) {
+    if (Status s = check_contact_pair(state.contact_pairs[k], state.slots); !s)
+      return s.within("contact_pairs[" + std::to_string(k) + "].");
     if (k > 0) {
-      const WarmStartImpulse& p = state.warm_start[k - 1];
-      if (p.a.index != w.a.index ? p.a.index > w.a.index : p.b.index > w.b.index)
-        return Status::error(field + ": not sorted by body pair");
+      const ContactPairRecord& p = state.contact_pairs[k - 1];
+      const ContactPairRecord& r = state.contact_pairs[k];
+      if (p.a.index != r.a.index ? p.a.index > r.a.index : p.b.index >= r.b.index)
+        return Status::error("contact_pairs[" + std::to_string(k) +
+                             "]: not sorted by body pair, or repeated");
     }
   }
 
@@ -116,7 +156,7 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
   world.live_count_ = live;
   world.time_ = state.time;
   world.stats_.step = state.step;
-  world.scratch_->cache = std::move(state.warm_start);
+  world.scratch_->pairs = std::move(state.contact_pairs);
   return world;
 }
 

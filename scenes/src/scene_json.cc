@@ -211,6 +211,7 @@ SceneDef read_scene(const Json& json) {
   solver.slop = r.number("slop", solver.slop);
   solver.speculative_distance = r.number("speculative_distance", solver.speculative_distance);
   solver.restitution_threshold = r.number("restitution_threshold", solver.restitution_threshold);
+  solver.manifold_reuse = r.number("manifold_reuse", solver.manifold_reuse);
   solver.contact_hertz = r.number("contact_hertz", solver.contact_hertz);
   solver.continuous = r.boolean("continuous", solver.continuous);
   solver.continuous_fraction = r.number("continuous_fraction", solver.continuous_fraction);
@@ -326,6 +327,7 @@ std::string scene_to_json(const SceneDef& scene) {
               {"slop", s.slop},
               {"speculative_distance", s.speculative_distance},
               {"restitution_threshold", s.restitution_threshold},
+              {"manifold_reuse", s.manifold_reuse},
               {"contact_hertz", s.contact_hertz},
               {"continuous", s.continuous},
               {"continuous_fraction", s.continuous_fraction},

@@ -1,0 +1,86 @@
+#include "contact_pairs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tumble {
+namespace {
+
+// A shift plus a turn about the centre: the farthest a point within `radius` can move.
+double moved_at_most(double shift, double angle, double radius) {
+  return std::isinf(radius) ? std::numeric_limits<double>::infinity() : shift + angle * radius;
+}
+
+}  // namespace
+
+std::uint32_t find_pair_record(std::span<const ContactPairRecord> records, BodyId a, BodyId b) {
+  const auto found =
+      std::lower_bound(records.begin(), records.end(), 0, [&](const ContactPairRecord& r, int) {
+        return r.a.index != a.index ? r.a.index < a.index : r.b.index < b.index;
+      });
+  if (found == records.end() || found->a != a || found->b != b) return kNoRecord;
+  return static_cast<std::uint32_t>(found - records.begin());
+}
+
+double relative_motion(const ContactPairRecord& record, const Pose& pose_a, const Pose& pose_b,
+                       double outer_radius_a, double outer_radius_b) {
+  const Vec3 position = pose_a.inverse_transform(pose_b.position);
+  const Quat orientation = pose_a.orientation.conjugate() * pose_b.orientation;
+  const Quat turn = record.relative_orientation.conjugate() * orientation;
+  const double angle = 2 * std::asin(std::min(1.0, turn.vec().norm()));
+  const double shift_in_a = (position - record.relative_position).norm();
+  // A's centre seen from B: -(B's orientation in A)^-1 times B's position in A.
+  const double shift_in_b = (orientation.conjugate() * position -
+                             record.relative_orientation.conjugate() * record.relative_position)
+                                .norm();
+  return std::min(moved_at_most(shift_in_a, angle, outer_radius_b),
+                  moved_at_most(shift_in_b, angle, outer_radius_a));
+}
+
+bool may_reuse(const ContactPairRecord& record, double motion, double tolerance, double margin) {
+  // A feature outside the record was farther than record.margin then, so it is farther than
+  // record.margin - motion now.
+  return record.reusable && motion <= tolerance && margin + motion <= record.margin;
+}
+
+void manifold_from_record(const ContactPairRecord& record, const Pose& pose_a, const Pose& pose_b,
+                          ContactManifold* out) {
+  const Mat3 rotation_a = pose_a.orientation.toRotationMatrix();
+  const Mat3 rotation_b = pose_b.orientation.toRotationMatrix();
+  out->normal = rotation_a * record.local_normal;
+  out->count = record.count;
+  double deepest = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < record.count; ++i) {
+    const ContactPointRecord& kept = record.points[i];
+    ContactPoint& point = out->points[i];
+    point.point_a = rotation_a * kept.local_a + pose_a.position;
+    point.point_b = rotation_b * kept.local_b + pose_b.position;
+    point.depth = (point.point_a - point.point_b).dot(out->normal);
+    point.feature_id = kept.feature;
+    deepest = std::max(deepest, point.depth);
+  }
+  out->depth = deepest + record.depth_excess;
+}
+
+void record_manifold(const ContactManifold& manifold, BodyId a, const Pose& pose_a, BodyId b,
+                     const Pose& pose_b, double margin, ContactPairRecord* out) {
+  out->a = a;
+  out->b = b;
+  out->relative_position = pose_a.inverse_transform(pose_b.position);
+  out->relative_orientation = pose_a.orientation.conjugate() * pose_b.orientation;
+  out->local_normal = pose_a.orientation.conjugate() * manifold.normal;
+  out->margin = margin;
+  out->reusable = true;
+  out->count = manifold.count;
+  double deepest = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < manifold.count; ++i) {
+    const ContactPoint& point = manifold.points[i];
+    out->points[i] = {point.feature_id, pose_a.inverse_transform(point.point_a),
+                      pose_b.inverse_transform(point.point_b), 0.0, Vec3::Zero()};
+    deepest = std::max(deepest, point.depth);
+  }
+  out->depth_excess = std::max(0.0, manifold.depth - deepest);
+}
+
+}  // namespace tumble
