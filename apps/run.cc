@@ -157,8 +157,8 @@ int main(int argc, char** argv) {
     return manifolds > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(manifolds) : 0.0;
   };
   std::printf(
-      "contact manifolds swept in SIMD lanes (packs): %.1f%% of %llu manifold-steps; taken from "
-      "the last narrow phase (barely moved): %.1f%%\n",
+      "contact manifolds swept in SIMD lanes (packs): %.1f%% of %llu manifold-steps; clipped on "
+      "a kept feature (the pair barely moved): %.1f%%\n",
       share(packed), static_cast<unsigned long long>(manifolds), share(reused));
   std::printf(
       "bounds hit over the run: exact islands solved by pgs instead %llu, exact islands too large "

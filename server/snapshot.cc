@@ -281,16 +281,14 @@ void put_contact_pairs(const std::vector<ContactPairRecord>& pairs, pb::ContactP
     const Quat& q = r.relative_orientation;
     for (double value : {q.w(), q.x(), q.y(), q.z()})
       out->add_relative_orientation(value);
-    put(r.local_normal, out->mutable_local_normal());
-    out->add_depth_excess(r.depth_excess);
-    out->add_margin(r.margin);
-    out->add_reusable(r.reusable);
+    out->add_feature_kind(r.feature_kind);
+    out->add_feature_first(r.feature_first);
+    out->add_feature_second(r.feature_second);
     out->add_count(static_cast<std::uint32_t>(r.count));
     for (int i = 0; i < r.count; ++i) {
       const ContactPointRecord& p = r.points[i];
       out->add_feature(p.feature);
       put(p.local_a, out->mutable_local_a());
-      put(p.local_b, out->mutable_local_b());
       out->add_normal_impulse(p.normal_impulse);
       put(p.friction_impulse, out->mutable_friction_impulse());
     }
@@ -306,18 +304,19 @@ Result<std::vector<ContactPairRecord>> take_contact_pairs(const pb::ContactPairs
   const int n = in.body_a_size();
   if (in.body_b_size() != n || in.generation_a_size() != n || in.generation_b_size() != n ||
       in.relative_position_size() != 3 * n || in.relative_orientation_size() != 4 * n ||
-      in.local_normal_size() != 3 * n || in.depth_excess_size() != n || in.margin_size() != n ||
-      in.reusable_size() != n || in.count_size() != n)
+      in.feature_kind_size() != n || in.feature_first_size() != n ||
+      in.feature_second_size() != n || in.count_size() != n)
     return Status::error("array lengths do not match");
   std::int64_t points = 0;
   for (int k = 0; k < n; ++k) {
     if (in.count(k) < 1 || in.count(k) > 4)
       return Status::error("count[" + std::to_string(k) + "]: must be 1 to 4");
+    if (in.feature_kind(k) > 3)
+      return Status::error("feature_kind[" + std::to_string(k) + "]: must be 0 to 3");
     points += in.count(k);
   }
   if (in.feature_size() != points || in.local_a_size() != 3 * points ||
-      in.local_b_size() != 3 * points || in.normal_impulse_size() != points ||
-      in.friction_impulse_size() != 3 * points)
+      in.normal_impulse_size() != points || in.friction_impulse_size() != 3 * points)
     return Status::error("point arrays: lengths do not match the counts");
   std::vector<ContactPairRecord> pairs(n);
   int point = 0;
@@ -329,20 +328,19 @@ Result<std::vector<ContactPairRecord>> take_contact_pairs(const pb::ContactPairs
     r.relative_orientation =
         Quat(in.relative_orientation(4 * k), in.relative_orientation(4 * k + 1),
              in.relative_orientation(4 * k + 2), in.relative_orientation(4 * k + 3));
-    r.local_normal = vec3_at(in.local_normal(), k);
-    r.depth_excess = in.depth_excess(k);
-    r.margin = in.margin(k);
-    r.reusable = in.reusable(k);
+    r.feature_kind = static_cast<std::uint8_t>(in.feature_kind(k));
+    r.feature_first = in.feature_first(k);
+    r.feature_second = in.feature_second(k);
     r.count = static_cast<int>(in.count(k));
     for (int i = 0; i < r.count; ++i, ++point)
-      r.points[i] = {in.feature(point), vec3_at(in.local_a(), point), vec3_at(in.local_b(), point),
-                     in.normal_impulse(point), vec3_at(in.friction_impulse(), point)};
+      r.points[i] = {in.feature(point), vec3_at(in.local_a(), point), in.normal_impulse(point),
+                     vec3_at(in.friction_impulse(), point)};
   }
   return pairs;
 }
 
 // An older snapshot's impulses, point by point: grouped into records by body pair (at most four
-// points each, the rest dropped) that the narrow phase does not reuse, only matches points to.
+// points each, the rest dropped) without a feature, so the narrow phase searches again.
 Result<std::vector<ContactPairRecord>> take_warm_start(const pb::WarmStart& w) {
   const int n = w.body_a_size();
   if (w.body_b_size() != n || w.generation_a_size() != n || w.generation_b_size() != n ||
@@ -356,11 +354,10 @@ Result<std::vector<ContactPairRecord>> take_warm_start(const pb::WarmStart& w) {
       pairs.emplace_back();
       pairs.back().a = a;
       pairs.back().b = b;
-      pairs.back().reusable = false;
     }
     ContactPairRecord& r = pairs.back();
     if (r.count == 4) continue;
-    r.points[r.count++] = {w.feature(i), vec3_at(w.local_a(), i), Vec3::Zero(), w.normal(i),
+    r.points[r.count++] = {w.feature(i), vec3_at(w.local_a(), i), w.normal(i),
                            vec3_at(w.friction(), i)};
   }
   return pairs;

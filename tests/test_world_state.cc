@@ -92,8 +92,9 @@ TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   s.contact_pairs[0].b.index = 1u << 30;
   refused(s, "contact_pairs[0]");
   s = good;
-  s.contact_pairs[1].points[0].local_b.x() = 1e6;  // far off the body
-  refused(s, "contact_pairs[1].points[0]");
+  s.contact_pairs[1].feature_kind = 1;
+  s.contact_pairs[1].feature_first = 1000;  // a box has 6 faces
+  refused(s, "contact_pairs[1].feature");
   s = good;
   s.contact_pairs[1].count = 5;
   refused(s, "contact_pairs[1].count");

@@ -10,6 +10,7 @@ namespace {
 
 std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b,
                               const Pose& pose_b, const CollisionSettings& settings,
+                              const PolytopeFeature* known, PolytopeFeature* chosen,
                               ContactManifold* out) {
   const Mat3 ra = pose_a.orientation.toRotationMatrix();
   const Mat3 rb = pose_b.orientation.toRotationMatrix();
@@ -45,7 +46,7 @@ std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b
         in_b_frame = true;
       } else {
         flags = collide_polytopes(*a.polyhedron(), *b.polyhedron(), b_in_a, b_at,
-                                  std::max(a.size(), b.size()), settings, out);
+                                  std::max(a.size(), b.size()), settings, known, chosen, out);
       }
       break;
   }
@@ -59,15 +60,41 @@ std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b
 }  // namespace
 
 std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
-                      const CollisionSettings& settings, ContactManifold* out) {
+                      const CollisionSettings& settings, const PolytopeFeature* known,
+                      PolytopeFeature* chosen, ContactManifold* out) {
   out->count = 0;
+  if (chosen != nullptr) *chosen = PolytopeFeature{};
   if (a.type() == ShapeType::kHalfSpace && b.type() == ShapeType::kHalfSpace) return kCollisionOk;
-  if (a.type() <= b.type()) return collide_ordered(a, pose_a, b, pose_b, settings, out);
-  const std::uint32_t flags = collide_ordered(b, pose_b, a, pose_a, settings, out);
+  if (a.type() <= b.type())
+    return collide_ordered(a, pose_a, b, pose_b, settings, known, chosen, out);
+  const std::uint32_t flags = collide_ordered(b, pose_b, a, pose_a, settings, known, chosen, out);
   out->normal = -out->normal;
   for (int i = 0; i < out->count; ++i)
     std::swap(out->points[i].point_a, out->points[i].point_b);
   return flags;
+}
+
+std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                      const CollisionSettings& settings, ContactManifold* out) {
+  return collide(a, pose_a, b, pose_b, settings, nullptr, nullptr, out);
+}
+
+bool feature_fits(const Shape& a, const Shape& b, const PolytopeFeature& feature) {
+  if (feature.kind == PolytopeFeature::kNone) return true;
+  const ConvexPolyhedron* first = a.type() <= b.type() ? a.polyhedron() : b.polyhedron();
+  const ConvexPolyhedron* second = a.type() <= b.type() ? b.polyhedron() : a.polyhedron();
+  if (first == nullptr || second == nullptr) return false;
+  switch (feature.kind) {
+    case PolytopeFeature::kFaceA:
+      return feature.first < first->faces.size();
+    case PolytopeFeature::kFaceB:
+      return feature.first < second->faces.size();
+    case PolytopeFeature::kEdges:
+      return feature.first < first->edges.size() && feature.second < second->edges.size();
+    case PolytopeFeature::kNone:
+      break;
+  }
+  return true;
 }
 
 }  // namespace tumble

@@ -2,6 +2,7 @@
 // request; either way the contact normal becomes a manifold by face clipping.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "epa.h"
 #include "manifold.h"
@@ -89,11 +90,52 @@ void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, 
                  b.polyhedron->support_index(b.rotation.transpose() * -normal), 0);
 }
 
+// The manifold of a feature found before, measured again at the present poses: the contact is
+// exact for that feature, and the pair's depth is that feature's. False for a pair of edges that
+// has turned parallel: the full search decides.
+bool take_known_feature(const PlacedPolyhedron& a, const PlacedPolyhedron& b,
+                        const PolytopeFeature& known, double margin, ContactManifold* out) {
+  double separation = 0;
+  switch (known.kind) {
+    case PolytopeFeature::kFaceA: {
+      TUMBLE_ASSERT(known.first < a.polyhedron->faces.size());
+      separation = query_face(a, known.first, b).separation;
+      if (separation > margin) return true;  // a separating axis: no contact
+      const Vec3 n = a.face_normal(known.first);
+      clip_face_contact(a, known.first, b, most_opposed_face(b, n), true, margin, out);
+      break;
+    }
+    case PolytopeFeature::kFaceB: {
+      TUMBLE_ASSERT(known.first < b.polyhedron->faces.size());
+      separation = query_face(b, known.first, a).separation;
+      if (separation > margin) return true;
+      const Vec3 n = b.face_normal(known.first);
+      clip_face_contact(b, known.first, a, most_opposed_face(a, n), false, margin, out);
+      break;
+    }
+    case PolytopeFeature::kEdges: {
+      TUMBLE_ASSERT(known.first < a.polyhedron->edges.size() &&
+                    known.second < b.polyhedron->edges.size());
+      const EdgeQuery edges = query_edge_pair(a, known.first, b, known.second);
+      if (edges.separation == -std::numeric_limits<double>::infinity()) return false;
+      separation = edges.separation;
+      if (separation > margin) return true;
+      edge_contact(a, b, edges, out);
+      break;
+    }
+    case PolytopeFeature::kNone:
+      return false;
+  }
+  if (out->count > 0) out->depth = -separation;
+  return true;
+}
+
 }  // namespace
 
 std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedron& b,
                                 const Mat3& rotation, const Vec3& translation, double scale,
-                                const CollisionSettings& settings, ContactManifold* out) {
+                                const CollisionSettings& settings, const PolytopeFeature* known,
+                                PolytopeFeature* chosen, ContactManifold* out) {
   out->count = 0;
   const PlacedPolyhedron pa{&a, Mat3::Identity(), Vec3::Zero()};
   const PlacedPolyhedron pb{&b, rotation, translation};
@@ -131,6 +173,15 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
     return flags;
   }
 
+  if (known != nullptr && known->kind != PolytopeFeature::kNone &&
+      take_known_feature(pa, pb, *known, margin, out)) {
+    if (chosen != nullptr) {
+      *chosen = *known;
+      chosen->searched = false;
+    }
+    return kCollisionOk;
+  }
+
   const FaceQuery face_a = query_faces(pa, pb);
   if (face_a.separation > margin) return kCollisionOk;
   const FaceQuery face_b = query_faces(pb, pa);
@@ -142,16 +193,20 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
   const double tolerance = feature_tolerance(settings, scale, deepest);
   const bool use_a = face_a.separation >= face_b.separation - tolerance;
   const double chosen_face = use_a ? face_a.separation : face_b.separation;
+  PolytopeFeature feature{PolytopeFeature::kFaceA, face_a.face, 0};
   if (edges.separation > chosen_face + tolerance) {
     edge_contact(pa, pb, edges, out);
+    feature = {PolytopeFeature::kEdges, edges.edge_a, edges.edge_b};
   } else if (use_a) {
     const Vec3 n = pa.face_normal(face_a.face);
     clip_face_contact(pa, face_a.face, pb, most_opposed_face(pb, n), true, margin, out);
   } else {
     const Vec3 n = pb.face_normal(face_b.face);
     clip_face_contact(pb, face_b.face, pa, most_opposed_face(pa, n), false, margin, out);
+    feature = {PolytopeFeature::kFaceB, face_b.face, 0};
   }
   if (out->count > 0) out->depth = -deepest;  // the exact pair penetration, whatever the feature
+  if (chosen != nullptr) *chosen = feature;
   return kCollisionOk;
 }
 

@@ -38,49 +38,25 @@ double relative_motion(const ContactPairRecord& record, const Pose& pose_a, cons
                   moved_at_most(shift_in_b, angle, outer_radius_a));
 }
 
-bool may_reuse(const ContactPairRecord& record, double motion, double tolerance, double margin) {
-  // A feature outside the record was farther than record.margin then, so it is farther than
-  // record.margin - motion now.
-  return record.reusable && motion <= tolerance && margin + motion <= record.margin;
+PolytopeFeature recorded_feature(const ContactPairRecord& record) {
+  return {static_cast<PolytopeFeature::Kind>(record.feature_kind), record.feature_first,
+          record.feature_second, false};
 }
 
-void manifold_from_record(const ContactPairRecord& record, const Pose& pose_a, const Pose& pose_b,
-                          ContactManifold* out) {
-  const Mat3 rotation_a = pose_a.orientation.toRotationMatrix();
-  const Mat3 rotation_b = pose_b.orientation.toRotationMatrix();
-  out->normal = rotation_a * record.local_normal;
-  out->count = record.count;
-  double deepest = -std::numeric_limits<double>::infinity();
-  for (int i = 0; i < record.count; ++i) {
-    const ContactPointRecord& kept = record.points[i];
-    ContactPoint& point = out->points[i];
-    point.point_a = rotation_a * kept.local_a + pose_a.position;
-    point.point_b = rotation_b * kept.local_b + pose_b.position;
-    point.depth = (point.point_a - point.point_b).dot(out->normal);
-    point.feature_id = kept.feature;
-    deepest = std::max(deepest, point.depth);
-  }
-  out->depth = deepest + record.depth_excess;
-}
-
-void record_manifold(const ContactManifold& manifold, BodyId a, const Pose& pose_a, BodyId b,
-                     const Pose& pose_b, double margin, ContactPairRecord* out) {
+void record_manifold(const ContactManifold& manifold, const PolytopeFeature& feature, BodyId a,
+                     const Pose& pose_a, BodyId b, const Pose& pose_b, ContactPairRecord* out) {
   out->a = a;
   out->b = b;
   out->relative_position = pose_a.inverse_transform(pose_b.position);
   out->relative_orientation = pose_a.orientation.conjugate() * pose_b.orientation;
-  out->local_normal = pose_a.orientation.conjugate() * manifold.normal;
-  out->margin = margin;
-  out->reusable = true;
+  out->feature_kind = feature.kind;
+  out->feature_first = feature.first;
+  out->feature_second = feature.second;
   out->count = manifold.count;
-  double deepest = -std::numeric_limits<double>::infinity();
   for (int i = 0; i < manifold.count; ++i) {
     const ContactPoint& point = manifold.points[i];
-    out->points[i] = {point.feature_id, pose_a.inverse_transform(point.point_a),
-                      pose_b.inverse_transform(point.point_b), 0.0, Vec3::Zero()};
-    deepest = std::max(deepest, point.depth);
+    out->points[i] = {point.feature_id, pose_a.inverse_transform(point.point_a), 0.0, Vec3::Zero()};
   }
-  out->depth_excess = std::max(0.0, manifold.depth - deepest);
 }
 
 }  // namespace tumble

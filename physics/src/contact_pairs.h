@@ -1,12 +1,11 @@
 // Touching pairs kept from step to step (ContactPairRecord, world_state.h): finding last step's
-// record of a pair, taking its manifold again while the pair has barely moved, and recording a
-// manifold the narrow phase found.
+// record of a pair, how far the pair has moved since, and recording a manifold.
 #pragma once
 
 #include <cstdint>
 #include <span>
 
-#include "physics/collision.h"
+#include "narrow_phase.h"
 #include "physics/world_state.h"
 
 namespace tumble {
@@ -17,24 +16,18 @@ constexpr std::uint32_t kNoRecord = UINT32_MAX;
 // when there is none.
 std::uint32_t find_pair_record(std::span<const ContactPairRecord> records, BodyId a, BodyId b);
 
-// How far any point of either body can have moved relative to the other since the record was
-// made (m): B's motion in A's axes bounded by its centre's shift plus the turn times its outer
-// radius, or the same from B's side, whichever is smaller (a half-space's radius is infinite).
+// How far a point where the bodies can touch (inside both outer spheres) can have moved relative
+// to the other body since the record's pose (m): B's centre's shift in A's axes plus the turn
+// times B's outer radius, or the same from B's side, whichever is smaller (the two coincident
+// points of A and B move apart by the same amount seen from either; a half-space's radius is
+// infinite).
 double relative_motion(const ContactPairRecord& record, const Pose& pose_a, const Pose& pose_b,
                        double outer_radius_a, double outer_radius_b);
 
-// Whether the record's manifold still stands for the pair: nothing moved by more than
-// `tolerance`, and no feature the record left out can have come within `margin` (the margin it
-// was found with covers today's plus the motion).
-bool may_reuse(const ContactPairRecord& record, double motion, double tolerance, double margin);
+PolytopeFeature recorded_feature(const ContactPairRecord& record);
 
-// The record's manifold at the bodies' present poses: its points move with the bodies, each
-// depth measured along the normal, which turns with A.
-void manifold_from_record(const ContactPairRecord& record, const Pose& pose_a, const Pose& pose_b,
-                          ContactManifold* out);
-
-// A record of `manifold`, found at these poses with this margin; impulses zero.
-void record_manifold(const ContactManifold& manifold, BodyId a, const Pose& pose_a, BodyId b,
-                     const Pose& pose_b, double margin, ContactPairRecord* out);
+// A record of `manifold`, from `feature`, with the bodies at these poses; impulses zero.
+void record_manifold(const ContactManifold& manifold, const PolytopeFeature& feature, BodyId a,
+                     const Pose& pose_a, BodyId b, const Pose& pose_b, ContactPairRecord* out);
 
 }  // namespace tumble

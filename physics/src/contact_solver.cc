@@ -35,14 +35,12 @@ Vec3 any_perpendicular(const Vec3& n) {
 }  // namespace
 
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
-                  const Body& b, const ContactPairRecord* previous, bool reused,
-                  std::uint32_t block_index, ContactRow* rows, ContactRowCold* cold,
-                  NormalBlock* block) {
+                  const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
+                  ContactRow* rows, ContactRowCold* cold, NormalBlock* block) {
   TUMBLE_ASSERT(manifold.count >= 1 && manifold.count <= 4);
   const Vec3& n = manifold.normal;
   const double friction = std::sqrt(a.friction * b.friction);
   const double restitution = std::max(a.restitution, b.restitution);
-  TUMBLE_ASSERT(!reused || (previous != nullptr && previous->count == manifold.count));
   const Mat3 ra_to_local = a.orientation.conjugate().toRotationMatrix();
   const Mat3 rb_to_local = b.orientation.conjugate().toRotationMatrix();
   const double match_distance = 0.05 * std::min(a.shape.size(), b.shape.size());
@@ -97,14 +95,11 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     row.tangent_mass1 = mass_of(row.tangent_response1);
     row.tangent_mass2 = mass_of(row.tangent_response2);
 
-    // A reused manifold has the record's points, in order. Otherwise feature ids may have
-    // changed when a vertex of a face resting on an equal face moved across the other's edge by
-    // a nanometre; the point has not moved, so its impulse still applies (Jolt matches all
-    // points this way).
+    // Feature ids change when a vertex of a face resting on an equal face moves across the
+    // other's edge by a nanometre; the point has not moved, so its impulse still applies (Jolt
+    // matches all points this way).
     const ContactPointRecord* match = nullptr;
-    if (reused) {
-      match = &previous->points[i];
-    } else if (previous != nullptr) {
+    if (previous != nullptr) {
       double nearest = match_distance * match_distance;
       for (int k = 0; k < previous->count; ++k) {
         const ContactPointRecord& kept = previous->points[k];

@@ -91,13 +91,12 @@ struct NormalBlock {
 };
 
 // Writes the manifold.count rows of one manifold to `rows` and `cold` and its block to `block`,
-// which is blocks[block_index]. Each row starts from the impulse of its point in `previous`, the
-// pair's record of the last step (null: none): the same point when the manifold was `reused`
-// from it, else the point with its feature id, or else the nearest close enough.
+// which is blocks[block_index]. A row starts from the impulse of the point in `previous` (the
+// pair's record of the last step; null: none) with its feature id, or else of the nearest one
+// close enough.
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
-                  const Body& b, const ContactPairRecord* previous, bool reused,
-                  std::uint32_t block_index, ContactRow* rows, ContactRowCold* cold,
-                  NormalBlock* block);
+                  const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
+                  ContactRow* rows, ContactRowCold* cold, NormalBlock* block);
 
 // Spring parameters of a soft contact over a substep h (Catto 2011, "Soft constraints").
 struct Softness {

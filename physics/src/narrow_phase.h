@@ -6,10 +6,30 @@
 
 namespace tumble {
 
+// The separating-axis feature a pair of polytopes' manifold came from (indices into the pair's
+// polyhedra as collide() orders them), so that a later query of a pair that has barely moved can
+// measure that feature alone instead of searching all of them.
+struct PolytopeFeature {
+  enum Kind : std::uint8_t { kNone, kFaceA, kFaceB, kEdges };
+  Kind kind = kNone;
+  std::uint32_t first = 0, second = 0;  // the face, or A's edge and B's edge
+  bool searched = true;                 // false: the feature was given (`known`) and measured again
+};
+
+// collide() with the feature: with `known` (null: none) a pair of polytopes takes that feature
+// without searching; `chosen` (null: not wanted) receives the feature its manifold came from
+// (kNone for other shapes and for GJK/EPA).
+std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                      const CollisionSettings& settings, const PolytopeFeature* known,
+                      PolytopeFeature* chosen, ContactManifold* out);
+// Whether `feature` names faces or edges that the pair (a, b) has.
+bool feature_fits(const Shape& a, const Shape& b, const PolytopeFeature& feature);
+
 // B placed in A's frame by (rotation, translation). Result in A's frame.
 std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedron& b,
                                 const Mat3& rotation, const Vec3& translation, double scale,
-                                const CollisionSettings& settings, ContactManifold* out);
+                                const CollisionSettings& settings, const PolytopeFeature* known,
+                                PolytopeFeature* chosen, ContactManifold* out);
 // Sphere A (centre at the origin of A's frame) against sphere or capsule B placed in A's frame.
 std::uint32_t collide_sphere_sphere(double radius_a, double radius_b, const Vec3& centre_b,
                                     double margin, ContactManifold* out);

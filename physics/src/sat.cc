@@ -2,23 +2,77 @@
 
 namespace tumble {
 
+namespace {
+
+// Faces are measured in `other`'s local frame: the support query is then a plain loop over its
+// vertices.
+struct FacesInOther {
+  Mat3 to_other;
+  Vec3 origin;
+  FacesInOther(const PlacedPolyhedron& faces, const PlacedPolyhedron& other)
+      : to_other(other.rotation.transpose() * faces.rotation),
+        origin(other.rotation.transpose() * (faces.translation - other.translation)) {}
+  double separation(const ConvexPolyhedron::Face& face, const ConvexPolyhedron& other) const {
+    const Vec3 n = to_other * face.normal;
+    const double offset = face.offset + n.dot(origin);
+    return n.dot(other.support(-n)) - offset;
+  }
+};
+
+// The axis of one pair of edges in A's frame (B placed there by rotation, translation), from A
+// towards B, and the separation along it; false for parallel edges, which make no axis.
+bool edge_pair_axis(const ConvexPolyhedron& pa, std::uint32_t i, const Vec3& tail_b,
+                    const Vec3& dir_b, Vec3* axis, double* separation) {
+  const auto& ea = pa.edges[i];
+  const Vec3 tail_a = pa.vertices[ea.tail];
+  const Vec3 dir_a = pa.vertices[ea.head] - tail_a;
+  *axis = dir_a.cross(dir_b);
+  const double length = axis->norm();
+  if (length <= 1e-10 * dir_a.norm() * dir_b.norm()) return false;
+  *axis /= length;
+  if (axis->dot(tail_a - pa.centroid) < 0) *axis = -*axis;
+  *separation = axis->dot(tail_b - tail_a);
+  return true;
+}
+
+}  // namespace
+
 FaceQuery query_faces(const PlacedPolyhedron& faces, const PlacedPolyhedron& other) {
-  // Work in `other`'s local frame: the support query is then a plain loop over its vertices.
-  const Mat3 to_other = other.rotation.transpose() * faces.rotation;
-  const Vec3 origin = other.rotation.transpose() * (faces.translation - other.translation);
+  const FacesInOther frame(faces, other);
   FaceQuery best;
   const auto& list = faces.polyhedron->faces;
   for (std::uint32_t f = 0; f < list.size(); ++f) {
-    const Vec3 n = to_other * list[f].normal;
-    const double offset = list[f].offset + n.dot(origin);
-    const Vec3 deepest = other.polyhedron->support(-n);
-    const double separation = n.dot(deepest) - offset;
+    const double separation = frame.separation(list[f], *other.polyhedron);
     if (separation > best.separation) {
       best.separation = separation;
       best.face = f;
     }
   }
   return best;
+}
+
+FaceQuery query_face(const PlacedPolyhedron& faces, std::uint32_t face,
+                     const PlacedPolyhedron& other) {
+  return {face,
+          FacesInOther(faces, other).separation(faces.polyhedron->faces[face], *other.polyhedron)};
+}
+
+EdgeQuery query_edge_pair(const PlacedPolyhedron& a, std::uint32_t edge_a,
+                          const PlacedPolyhedron& b, std::uint32_t edge_b) {
+  const Mat3 rotation = a.rotation.transpose() * b.rotation;
+  const Vec3 translation = a.rotation.transpose() * (b.translation - a.translation);
+  const auto& eb = b.polyhedron->edges[edge_b];
+  const Vec3 tail_b = rotation * b.polyhedron->vertices[eb.tail] + translation;
+  const Vec3 dir_b = (rotation * b.polyhedron->vertices[eb.head] + translation) - tail_b;
+  EdgeQuery query;
+  Vec3 axis;
+  double separation = 0;
+  if (!edge_pair_axis(*a.polyhedron, edge_a, tail_b, dir_b, &axis, &separation)) return query;
+  query.edge_a = edge_a;
+  query.edge_b = edge_b;
+  query.separation = separation;
+  query.axis = a.rotation * axis;
+  return query;
 }
 
 EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) {
@@ -70,8 +124,6 @@ EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) {
   EdgeQuery best;
   for (std::uint32_t i = 0; i < a_edge_count; ++i) {
     const auto& ea = pa.edges[i];
-    const Vec3 tail_a = pa.vertices[ea.tail];
-    const Vec3 dir_a = pa.vertices[ea.head] - tail_a;
     const double* u1_side = &a_side[ea.left * b_edge_count];
     const double* u2_side = &a_side[ea.right * b_edge_count];
     const double* arc_side = &b_side[i * b_face_count];
@@ -86,13 +138,10 @@ EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) {
       const auto& eb = pb.edges[j];
       const Vec3 tail_b = b_vertices[eb.tail];
       const Vec3 dir_b = b_vertices[eb.head] - tail_b;
-      Vec3 axis = dir_a.cross(dir_b);
-      const double length = axis.norm();
+      Vec3 axis;
+      double separation = 0;
       // Parallel edges make no new axis: the face normals next to them already cover it.
-      if (length <= 1e-10 * dir_a.norm() * dir_b.norm()) continue;
-      axis /= length;
-      if (axis.dot(tail_a - pa.centroid) < 0) axis = -axis;
-      const double separation = axis.dot(tail_b - tail_a);
+      if (!edge_pair_axis(pa, i, tail_b, dir_b, &axis, &separation)) continue;
       if (separation > best.separation) {
         best.separation = separation;
         best.edge_a = i;

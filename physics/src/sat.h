@@ -28,5 +28,11 @@ struct EdgeQuery {
 // Faces of `faces` (placed) against the vertices of `other` (placed), all in one frame.
 FaceQuery query_faces(const PlacedPolyhedron& faces, const PlacedPolyhedron& other);
 EdgeQuery query_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b);
+// The same for one face, or one pair of edges (separation -infinity when they are parallel),
+// with the same arithmetic: a feature found before, measured again.
+FaceQuery query_face(const PlacedPolyhedron& faces, std::uint32_t face,
+                     const PlacedPolyhedron& other);
+EdgeQuery query_edge_pair(const PlacedPolyhedron& a, std::uint32_t edge_a,
+                          const PlacedPolyhedron& b, std::uint32_t edge_b);
 
 }  // namespace tumble

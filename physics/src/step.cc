@@ -588,7 +588,7 @@ void World::prepare_contacts(double dt) {
     const std::uint32_t previous = s.previous_pair[m];
     prepare_rows(contact.manifold, contact.a, bodies_[contact.a.index].body, contact.b,
                  bodies_[contact.b.index].body,
-                 previous == kNoRecord ? nullptr : &s.pairs[previous], s.reused[m] != 0,
+                 previous == kNoRecord ? nullptr : &s.pairs[previous],
                  static_cast<std::uint32_t>(m), &s.rows[s.row_begin[m]],
                  &s.cold_rows[s.row_begin[m]], &s.blocks[m]);
   });

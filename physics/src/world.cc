@@ -380,22 +380,23 @@ void World::find_contacts(double dt) {
           settings.feature_slack_relative = std::max(settings.feature_slack_relative, 0.05);
           settings.face_angle = std::max(settings.face_angle, 0.02);
         }
-        const double tolerance = reuse * std::min(a.shape.size(), b.shape.size());
-        if (tolerance > 0 && !fast && previous != kNoRecord) {
+        // A pair of polytopes that has barely moved since its feature was searched for clips
+        // that feature again (ContactPairRecord).
+        PolytopeFeature known;
+        const bool take_known = [&] {
+          if (reuse <= 0 || fast || previous == kNoRecord) return false;
           const ContactPairRecord& record = s.pairs[previous];
+          if (record.feature_kind == PolytopeFeature::kNone) return false;
           const double motion = relative_motion(record, pose_a, pose_b, a.shape.outer_radius(),
                                                 b.shape.outer_radius());
-          if (may_reuse(record, motion, tolerance, settings.margin)) {
-            manifold_from_record(record, pose_a, pose_b, &contact.manifold);
-            s.next_pairs[i] = record;
-            s.reused[i] = 1;
-            return 0;
-          }
-        }
-        // Room for the motion later steps may reuse this manifold over (may_reuse).
-        settings.margin += 2 * tolerance;
+          if (motion > reuse * std::min(a.shape.size(), b.shape.size())) return false;
+          known = recorded_feature(record);
+          return true;
+        }();
+        PolytopeFeature chosen;
         std::uint32_t pair_flags =
-            collide(a.shape, pose_a, b.shape, pose_b, settings, &contact.manifold);
+            collide(a.shape, pose_a, b.shape, pose_b, settings, take_known ? &known : nullptr,
+                    &chosen, &contact.manifold);
         // A fast body already touching something is not swept against it (there is no first
         // impact to find), so the solver must see every feature that can reach it in the step: the
         // far edge of a plate falling flat, for one. Its speculative contacts cover the whole
@@ -403,11 +404,19 @@ void World::find_contacts(double dt) {
         if (dt > 0 && contact.manifold.count > 0 && fast) {
           settings.margin = settings_.collision.margin + settings_.solver.speculative_distance +
                             motion_[pairs_[i].a] + motion_[pairs_[i].b];
-          pair_flags |= collide(a.shape, pose_a, b.shape, pose_b, settings, &contact.manifold);
+          pair_flags |= collide(a.shape, pose_a, b.shape, pose_b, settings, nullptr, &chosen,
+                                &contact.manifold);
         }
-        if (contact.manifold.count > 0)
-          record_manifold(contact.manifold, contact.a, pose_a, contact.b, pose_b, settings.margin,
-                          &s.next_pairs[i]);
+        if (contact.manifold.count > 0) {
+          ContactPairRecord& record = s.next_pairs[i];
+          record_manifold(contact.manifold, chosen, contact.a, pose_a, contact.b, pose_b, &record);
+          // The motion allowed is counted from where the feature was searched for.
+          if (!chosen.searched) {
+            s.reused[i] = 1;
+            record.relative_position = s.pairs[previous].relative_position;
+            record.relative_orientation = s.pairs[previous].relative_orientation;
+          }
+        }
         return pair_flags;
       });
   std::size_t kept = 0;

@@ -3,10 +3,10 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <span>
 #include <string>
 
+#include "contact_pairs.h"
 #include "physics/world.h"
 #include "step_scratch.h"
 
@@ -56,42 +56,30 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
   return Status::ok();
 }
 
-// A record's points take part in the next step's solve when it is reused, so they must lie on
-// the bodies (within the margin they were found with). A record of a body removed since is kept
-// until the next step and never matched (the slot's generation moves on).
+// A record names the feature its pair is clipped on while it barely moves, so the feature must
+// be one the two shapes have. A record of a body removed since is kept until the next step and
+// never matched (the slot's generation moves on).
 Status check_contact_pair(const ContactPairRecord& record, std::span<const BodySlotState> slots) {
   if (record.a.index >= slots.size() || record.b.index >= slots.size())
     return Status::error("a, b: body out of range");
   if (record.a.index >= record.b.index) return Status::error("a: must be below b");
-  const auto current = [&](const BodyId& id) {
-    return slots[id.index].alive && slots[id.index].generation == id.generation;
-  };
-  // Records without geometry (an older snapshot's) only match points by feature and distance.
-  const bool may_be_used = record.reusable && current(record.a) && current(record.b);
   if (record.count < 1 || record.count > 4) return Status::error("count: must be 1 to 4");
-  if (!(record.margin >= 0) || !std::isfinite(record.margin))
-    return Status::error("margin: must be finite and >= 0");
-  if (!(record.depth_excess >= 0) || !std::isfinite(record.depth_excess))
-    return Status::error("depth_excess: must be finite and >= 0");
   if (!is_finite(record.relative_position) ||
-      !(std::abs(record.relative_orientation.norm() - 1) <= 1e-6) ||
-      !(std::abs(record.local_normal.norm() - 1) <= 1e-6))
-    return Status::error("relative pose and normal: must be finite, unit quaternion and normal");
-  // A corner lies at the outer radius, give or take rounding.
-  const auto reach = [&](const BodyId& id) {
-    return may_be_used ? 1.001 * slots[id.index].body.shape.outer_radius() + record.margin
-                       : std::numeric_limits<double>::infinity();
-  };
-  const double reach_a = reach(record.a), reach_b = reach(record.b);
+      !(std::abs(record.relative_orientation.norm() - 1) <= 1e-6))
+    return Status::error("relative pose: must be finite, with a unit quaternion");
+  if (record.feature_kind > PolytopeFeature::kEdges)
+    return Status::error("feature_kind: must be 0 to 3");
+  const BodySlotState& a = slots[record.a.index];
+  const BodySlotState& b = slots[record.b.index];
+  const bool current = a.alive && b.alive && a.generation == record.a.generation &&
+                       b.generation == record.b.generation;
+  if (current && !feature_fits(a.body.shape, b.body.shape, recorded_feature(record)))
+    return Status::error("feature: names a face or edge the bodies' shapes do not have");
   for (int i = 0; i < record.count; ++i) {
     const ContactPointRecord& point = record.points[i];
-    const std::string field = "points[" + std::to_string(i) + "].";
-    if (!is_finite(point.local_a) || !is_finite(point.local_b) ||
-        !std::isfinite(point.normal_impulse) || !is_finite(point.friction_impulse))
-      return Status::error(field + "values: must be finite");
-    // A half-space's reach is infinite; its point must only be finite.
-    if (!(point.local_a.norm() <= reach_a) || !(point.local_b.norm() <= reach_b))
-      return Status::error(field + "local_a, local_b: must lie within the body's reach");
+    if (!is_finite(point.local_a) || !std::isfinite(point.normal_impulse) ||
+        !is_finite(point.friction_impulse))
+      return Status::error("points[" + std::to_string(i) + "]: must be finite");
   }
   return Status::ok();
 }

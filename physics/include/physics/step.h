@@ -53,11 +53,12 @@ struct SolverSettings {
   double slop = 1e-4;                  // m: penetration left alone, so resting contacts keep still
   double speculative_distance = 0.02;  // m: gap below which contacts exist even at rest
   double restitution_threshold = 1.0;  // m/s: slower impacts do not bounce
-  // A pair whose relative pose moved no point of either body by more than this fraction of the
-  // smaller body's size since the narrow phase last ran keeps that step's manifold (its points
-  // follow the bodies); resting contacts then skip the narrow phase. 0 collides every pair every
-  // step. At most 0.01.
-  double manifold_reuse = 0;
+  // A touching pair of polytopes (boxes, hulls) whose points of contact have moved by no more
+  // than this fraction of the smaller body's size since the separating-axis test last searched
+  // all its features keeps the feature it found (a face, or a pair of edges) and clips it again
+  // at the present poses: resting contacts skip the search, which is most of a box pair's cost.
+  // 0 searches every pair every step. At most 0.01.
+  double manifold_reuse = 1e-3;
   // Continuous collision: a body that would move more than `continuous_fraction` of its inner
   // radius in a step (for a box, its smallest half extent) keeps speculative contacts only that
   // far and is swept through the rest of its motion after the solve; the first time it comes
@@ -90,7 +91,7 @@ struct StepStats {
   std::uint32_t coloured_islands = 0, colours = 0, overflow_manifolds = 0;
   // Manifolds swept four at a time in SIMD lanes (a colour's, or small islands' side by side).
   std::uint32_t packed_manifolds = 0;
-  // Manifolds taken from the last narrow phase's record instead of colliding again
+  // Manifolds clipped on the feature a pair kept instead of searching all features again
   // (SolverSettings::manifold_reuse).
   std::uint32_t reused_manifolds = 0;
   // Islands the exact solver could not finish (pivot bound, ray termination, an answer off by

@@ -14,31 +14,30 @@ namespace tumble {
 
 struct WorldSettings;
 
-// One contact point of a persistent pair, in the bodies' axes, with the impulses the last step
-// left in it: the next step starts from them (warm start).
+// One contact point of a touching pair with the impulses the last step left in it: the next
+// step starts from them (warm start), matched to its points by feature id, or else by position in
+// A's axes.
 struct ContactPointRecord {
-  std::uint64_t feature = 0;  // the pair of features that made the point (ContactPoint)
-  Vec3 local_a = Vec3::Zero(), local_b = Vec3::Zero();  // m, from each centre of mass
-  double normal_impulse = 0;                            // N s
-  Vec3 friction_impulse = Vec3::Zero();                 // N s, world
+  std::uint64_t feature = 0;             // the pair of features that made the point (ContactPoint)
+  Vec3 local_a = Vec3::Zero();           // m, from A's centre of mass, A's axes
+  double normal_impulse = 0;             // N s
+  Vec3 friction_impulse = Vec3::Zero();  // N s, world
 };
 
-// A touching pair of bodies as the narrow phase last found it, kept from step to step: one record
-// per manifold. While B stays where it was in A's axes (within SolverSettings::manifold_reuse),
-// the next steps take the manifold from here instead of colliding the shapes again (Jolt's body
-// pair cache, with a tolerance that bounds how far any point of the pair moved); the impulses
-// stay in the record either way.
+// A touching pair of bodies as the last step left it, kept from step to step: one record per
+// manifold, which holds its impulses between steps. For two polytopes it also names the feature
+// (a face of either, or a pair of edges) the separating-axis test chose, and where B was in A's
+// axes then: while no point where they touch has moved by more than
+// SolverSettings::manifold_reuse of the smaller body's size since, the next steps clip that
+// feature again without searching all the others (the search is most of a box pair's cost).
 struct ContactPairRecord {
   BodyId a, b;
-  // Where B was in A's axes when the points were found (rotation: A's conjugate times B's).
-  Vec3 relative_position = Vec3::Zero();
-  Quat relative_orientation = Quat::Identity();
-  Vec3 local_normal = Vec3::UnitZ();  // A's axes, from A towards B
-  double depth_excess = 0;            // m: the pair's penetration beyond its deepest point's (>= 0)
-  double margin = 0;                  // m: the margin the points were found with
-  // False for records that carry impulses only (restored from a snapshot of an older version):
-  // the narrow phase runs again and matches the points to them.
-  bool reusable = true;
+  Vec3 relative_position = Vec3::Zero();         // m, B's centre in A's axes
+  Quat relative_orientation = Quat::Identity();  // A's conjugate times B's
+  // 0 none (not two polytopes, GJK/EPA, or an older snapshot), 1 a face of A, 2 a face of B, 3 a
+  // pair of edges (A's, B's); with the shapes ordered as the narrow phase orders them (by type).
+  std::uint8_t feature_kind = 0;
+  std::uint32_t feature_first = 0, feature_second = 0;
   int count = 0;  // 1..4
   std::array<ContactPointRecord, 4> points;
 };
