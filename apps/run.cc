@@ -53,6 +53,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "OpenMP threads (0 = all; default: the scene's)");
   bool no_sleep = false;
   app.add_flag("--no-sleep", no_sleep, "keep every body awake");
+  double manifold_reuse = -1;
+  app.add_option("--manifold-reuse", manifold_reuse,
+                 "pairs of polytopes that moved less than this share of their size keep their "
+                 "feature (0 to 0.01; 0 searches every step; default: the scene's)");
   CLI11_PARSE(app, argc, argv);
 
   Result<SceneDef> scene = chosen_scene(scene_file, standard);
@@ -73,6 +77,7 @@ int main(int argc, char** argv) {
   if (duration >= 0) def.duration = duration;
   if (threads >= 0) def.world.threads = threads;
   if (no_sleep) def.world.solver.sleeping = false;
+  if (app.count("--manifold-reuse") > 0) def.world.solver.manifold_reuse = manifold_reuse;
   Result<World> made = make_world(def);
   if (!made) {
     std::fprintf(stderr, "tumble-run: %s\n", made.error().c_str());
