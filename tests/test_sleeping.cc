@@ -88,4 +88,43 @@ TEST(Sleeping, CanBeSwitchedOff) {
 }
 
 }  // namespace
+// Islands sleep as sets: waking one (by hand, or by removing a body under it) wakes its bodies
+// and no others, in a world restored from a saved state as well.
+TEST(Sleeping, WakingAnIslandWakesItsBodiesOnly) {
+  WorldSettings settings;
+  World world(settings);
+  BodyDef ground;
+  ground.type = BodyType::kStatic;
+  ground.shape = HalfSpaceDef{};
+  ASSERT_TRUE(world.create_body(ground));
+  // Five stacks of two boxes, far apart: five islands.
+  std::vector<std::pair<BodyId, BodyId>> stacks;
+  for (int k = 0; k < 5; ++k) {
+    BodyDef box;
+    box.position = Vec3(4.0 * k, 0, 0.5);
+    const BodyId bottom = world.create_body(box).value();
+    box.position.z() = 1.5;
+    stacks.push_back({bottom, world.create_body(box).value()});
+  }
+  for (int n = 0; n < 120 && world.last_step().sleeping_bodies < 10; ++n)
+    ASSERT_TRUE(world.step(1.0 / 60));
+  ASSERT_EQ(world.last_step().sleeping_bodies, 10u);
+
+  auto awake = [](const World& w, const std::vector<std::pair<BodyId, BodyId>>& all) {
+    std::vector<int> which;
+    for (std::size_t k = 0; k < all.size(); ++k)
+      which.push_back((w.body(all[k].first).asleep() ? 0 : 1) +
+                      (w.body(all[k].second).asleep() ? 0 : 2));
+    return which;
+  };
+  World restored = World::from_state(world.settings(), world.save_state()).value();
+  for (World* w : {&world, &restored}) {
+    ASSERT_TRUE(w->wake(stacks[1].second));
+    EXPECT_EQ(awake(*w, stacks), (std::vector<int>{0, 3, 0, 0, 0}));
+    ASSERT_TRUE(w->remove_body(stacks[3].first));  // the top box must fall: it wakes
+    EXPECT_TRUE(!w->body(stacks[3].second).asleep());
+    EXPECT_TRUE(w->body(stacks[4].first).asleep() && w->body(stacks[2].second).asleep());
+  }
+}
+
 }  // namespace tumble::testing

@@ -908,6 +908,7 @@ void World::update_sleep(double dt) {
       Body& body = bodies_[s.islands.bodies[k]].body;
       body.asleep = true;
       body.sleep_island = island;
+      link_sleeper(s.islands.bodies[k], island);
       body.linear_velocity.setZero();
       body.angular_velocity.setZero();
     }

@@ -147,6 +147,8 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     } else {
       index = static_cast<std::uint32_t>(bodies_.size());
       bodies_.emplace_back();
+      sleeper_head_.push_back(kNoSlot);
+      sleeper_next_.push_back(kNoSlot);
     }
     Slot& slot = bodies_[index];
     slot.body = std::move(body);
@@ -160,7 +162,8 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
 Status World::remove_body(BodyId id) {
   if (!contains(id)) return Status::not_found("body: no body with this id");
   Slot& slot = bodies_[id.index];
-  wake_around(slot.body);  // whatever rested on it must fall
+  wake_around(slot.body);                                     // whatever rested on it must fall
+  if (slot.body.asleep) wake_island(slot.body.sleep_island);  // it leaves its island's set
   slot.alive = false;
   ++slot.generation;
   slot.body = Body();
@@ -253,13 +256,24 @@ Status World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point) {
 
 std::uint32_t World::wake_island(std::uint32_t island) {
   std::uint32_t woken = 0;
-  for (Slot& slot : bodies_) {
-    if (!slot.alive || !slot.body.asleep || slot.body.sleep_island != island) continue;
-    slot.body.asleep = false;
-    slot.body.sleep_timer = 0;
+  std::uint32_t next = sleeper_head_[island];
+  sleeper_head_[island] = kNoSlot;
+  while (next != kNoSlot) {
+    Body& body = bodies_[next].body;
+    TUMBLE_ASSERT(bodies_[next].alive && body.asleep && body.sleep_island == island);
+    body.asleep = false;
+    body.sleep_timer = 0;
     ++woken;
+    const std::uint32_t slot = next;
+    next = sleeper_next_[slot];
+    sleeper_next_[slot] = kNoSlot;
   }
   return woken;
+}
+
+void World::link_sleeper(std::uint32_t slot, std::uint32_t island) {
+  sleeper_next_[slot] = sleeper_head_[island];
+  sleeper_head_[island] = slot;
 }
 
 Status World::wake(BodyId id) {

@@ -141,6 +141,11 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
   for (BodySlotState& slot : state.slots)
     world.bodies_.push_back({std::move(slot.body), slot.generation, slot.alive});
   world.free_slots_ = std::move(state.free_slots);
+  world.sleeper_head_.assign(slot_count, kNoSlot);
+  world.sleeper_next_.assign(slot_count, kNoSlot);
+  for (std::uint32_t i = 0; i < slot_count; ++i)
+    if (world.bodies_[i].alive && world.bodies_[i].body.asleep)
+      world.link_sleeper(i, world.bodies_[i].body.sleep_island);
   world.live_count_ = live;
   world.time_ = state.time;
   world.stats_.step = state.step;

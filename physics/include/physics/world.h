@@ -125,12 +125,15 @@ class World {
   std::uint32_t collision_flags() const { return collision_flags_; }
 
  private:
+  static constexpr std::uint32_t kNoSlot = UINT32_MAX;
   struct Slot {
     Body body;
     std::uint32_t generation = 0;
     bool alive = false;
   };
   std::uint32_t wake_island(std::uint32_t island);
+  // Links the bodies that fall asleep together into their island's set (sleepers_).
+  void link_sleeper(std::uint32_t slot, std::uint32_t island);
   // Wakes every sleeping island whose bounds come near `body` (it moved or is going away).
   void wake_around(const Body& body);
   // After the narrow phase: sleepers touched by moving bodies wake with their islands; returns
@@ -150,6 +153,10 @@ class World {
   WorldSettings settings_;
   std::vector<Slot> bodies_;
   std::vector<std::uint32_t> free_slots_;
+  // Sleeping islands as sets, so that waking one visits its bodies, not every slot: the island
+  // with id i (its bodies' sleep_island) starts at sleeper_head_[i] and goes on through
+  // sleeper_next_ (both by slot; UINT32_MAX ends a list).
+  std::vector<std::uint32_t> sleeper_head_, sleeper_next_;
   std::size_t live_count_ = 0;
   std::vector<Aabb> bounds_;
   std::vector<std::uint8_t> movable_;
