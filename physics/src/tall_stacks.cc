@@ -171,9 +171,12 @@ IslandStiffness island_stiffness(
   // more substeps would cost their time and hold nothing: the island keeps the settings.
   const double at_most = std::min(needed_hertz, 0.25 * substeps / dt);
   if (buckling * (hertz / at_most) * (hertz / at_most) > kHopelessBuckling) return result;
-  if (substeps <= solver.substeps) return result;
+  // The settings' substeps may already allow the stiffer spring (soft with 8 substeps and the
+  // tower of 20): the island then takes the spring alone. It used to keep the settings' spring
+  // then, and its tower stood or swayed 5 cm by the last bits of the run.
+  if (!(at_most > hertz)) return result;
   result.substeps = substeps;
-  result.contact_hertz = std::min(needed_hertz, 0.25 * substeps / dt);
+  result.contact_hertz = at_most;
   return result;
 }
 
