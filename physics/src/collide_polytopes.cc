@@ -24,6 +24,15 @@ double feature_tolerance(const CollisionSettings& settings, double scale, double
          settings.feature_slack_relative * std::max(0.0, -separation);
 }
 
+// Clips the face of `reference` against the face of `incident` most opposed to it.
+void face_contact(const PlacedPolyhedron& reference, std::uint32_t face,
+                  const PlacedPolyhedron& incident, bool reference_is_a, double margin,
+                  ContactManifold* out) {
+  clip_face_contact(reference, face, incident,
+                    most_opposed_face(incident, reference.face_normal(face)), reference_is_a,
+                    margin, out);
+}
+
 void edge_contact(const PlacedPolyhedron& a, const PlacedPolyhedron& b, const EdgeQuery& query,
                   ContactManifold* out) {
   const auto& ea = a.polyhedron->edges[query.edge_a];
@@ -69,11 +78,9 @@ void manifold_from_normal(const PlacedPolyhedron& a, const PlacedPolyhedron& b, 
       use_a = sep_a >= sep_b - feature_tolerance(settings, scale, std::max(sep_a, sep_b));
     }
     if (use_a)
-      clip_face_contact(a, face_a, b, most_opposed_face(b, a.face_normal(face_a)), true, margin,
-                        out);
+      face_contact(a, face_a, b, true, margin, out);
     else
-      clip_face_contact(b, face_b, a, most_opposed_face(a, b.face_normal(face_b)), false, margin,
-                        out);
+      face_contact(b, face_b, a, false, margin, out);
     if (out->count > 0) {
       out->depth = depth;  // EPA's (or GJK's) own answer, not re-measured on the chosen face
       return;
@@ -97,20 +104,15 @@ bool take_known_feature(const PlacedPolyhedron& a, const PlacedPolyhedron& b,
                         const PolytopeFeature& known, double margin, ContactManifold* out) {
   double separation = 0;
   switch (known.kind) {
-    case PolytopeFeature::kFaceA: {
-      TUMBLE_ASSERT(known.first < a.polyhedron->faces.size());
-      separation = query_face(a, known.first, b).separation;
-      if (separation > margin) return true;  // a separating axis: no contact
-      const Vec3 n = a.face_normal(known.first);
-      clip_face_contact(a, known.first, b, most_opposed_face(b, n), true, margin, out);
-      break;
-    }
+    case PolytopeFeature::kFaceA:
     case PolytopeFeature::kFaceB: {
-      TUMBLE_ASSERT(known.first < b.polyhedron->faces.size());
-      separation = query_face(b, known.first, a).separation;
-      if (separation > margin) return true;
-      const Vec3 n = b.face_normal(known.first);
-      clip_face_contact(b, known.first, a, most_opposed_face(a, n), false, margin, out);
+      const bool on_a = known.kind == PolytopeFeature::kFaceA;
+      const PlacedPolyhedron& reference = on_a ? a : b;
+      const PlacedPolyhedron& incident = on_a ? b : a;
+      TUMBLE_ASSERT(known.first < reference.polyhedron->faces.size());
+      separation = query_face(reference, known.first, incident).separation;
+      if (separation > margin) return true;  // a separating axis: no contact
+      face_contact(reference, known.first, incident, on_a, margin, out);
       break;
     }
     case PolytopeFeature::kEdges: {
@@ -198,11 +200,9 @@ std::uint32_t collide_polytopes(const ConvexPolyhedron& a, const ConvexPolyhedro
     edge_contact(pa, pb, edges, out);
     feature = {PolytopeFeature::kEdges, edges.edge_a, edges.edge_b};
   } else if (use_a) {
-    const Vec3 n = pa.face_normal(face_a.face);
-    clip_face_contact(pa, face_a.face, pb, most_opposed_face(pb, n), true, margin, out);
+    face_contact(pa, face_a.face, pb, true, margin, out);
   } else {
-    const Vec3 n = pb.face_normal(face_b.face);
-    clip_face_contact(pb, face_b.face, pa, most_opposed_face(pa, n), false, margin, out);
+    face_contact(pb, face_b.face, pa, false, margin, out);
     feature = {PolytopeFeature::kFaceB, face_b.face, 0};
   }
   if (out->count > 0) out->depth = -deepest;  // the exact pair penetration, whatever the feature
