@@ -208,6 +208,26 @@ TUMBLE_INLINE void apply_normal(const ContactPack& pack, const PackPoint& point,
   pair.wb = select(on_b, plus_scaled(pair.wb, impulse, point.angular_b), pair.wb);
 }
 
+// Applies a block's impulse changes delta[i] at its four points at once in the lanes of `mask`
+// (PairVelocities::apply_normals). Points past most_points are zeros in every lane.
+TUMBLE_INLINE void apply_normals(const ContactPack& pack, WideMask mask, const Wide (&delta)[4],
+                                 WidePair& pair) {
+  const PackPoint* p = pack.point;
+  const Wide total = ((delta[0] + delta[1]) + delta[2]) + delta[3];
+  const auto sum = [&](WideVec3 PackPoint::*angular) {
+    const auto term = [&](int i) -> WideVec3 {
+      return {delta[i] * (p[i].*angular).x, delta[i] * (p[i].*angular).y,
+              delta[i] * (p[i].*angular).z};
+    };
+    return ((term(0) + term(1)) + term(2)) + term(3);
+  };
+  const WideMask on_a = mask & pack.moves_a, on_b = mask & pack.moves_b;
+  pair.va = select(on_a, minus_scaled(pair.va, pack.inverse_mass_a * total, pack.normal), pair.va);
+  pair.wa = select(on_a, pair.wa - sum(&PackPoint::angular_a), pair.wa);
+  pair.vb = select(on_b, plus_scaled(pair.vb, pack.inverse_mass_b * total, pack.normal), pair.vb);
+  pair.wb = select(on_b, pair.wb + sum(&PackPoint::angular_b), pair.wb);
+}
+
 // Applies impulses d1 and d2 along a point's tangents in the lanes of `mask`
 // (apply_tangent_impulses).
 TUMBLE_INLINE void apply_tangents(const ContactPack& pack, const PackPoint& point, WideMask mask,
@@ -376,17 +396,19 @@ solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodie
                    targets[i].impulse_scale * point.normal_impulse;
       feasible &= ~point.present | (updated[i] >= 0);
     }
+    // The points a lane lacks are zeros (an impulse change of +0 at a zero lever), as the scalar
+    // solver pads them: the sums below are its sums, lane by lane.
+    Wide delta[4] = {wide(0), wide(0), wide(0), wide(0)};
     for (int i = 0; i < most; ++i) {
       PackPoint& point = pack.point[i];
       const WideMask mask = feasible & point.present;
-      change = wide_max(
-          change, select(mask, wide_abs(updated[i] - point.normal_impulse) * point.normal_response,
-                         wide(0)));
-      apply_normal(pack, point, mask, updated[i] - point.normal_impulse, pair);
+      delta[i] = updated[i] - point.normal_impulse;
+      change = wide_max(change, select(mask, wide_abs(delta[i]) * point.normal_response, wide(0)));
       point.normal_impulse = select(mask, updated[i], point.normal_impulse);
       point.max_normal_impulse =
           select(mask, wide_max(point.max_normal_impulse, updated[i]), point.max_normal_impulse);
     }
+    apply_normals(pack, feasible, delta, pair);
     one_by_one |= in_block & ~feasible;
   }
   if (any(one_by_one)) {
