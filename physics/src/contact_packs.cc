@@ -22,65 +22,100 @@ WideMask mask_of(const bool (&on)[kWideLanes]) {
   return WideMask{on[0] ? -1 : 0, on[1] ? -1 : 0, on[2] ? -1 : 0, on[3] ? -1 : 0};
 }
 
-void pack_point(const ContactRow& row, int k, PackPoint* p) {
-  set_lane(&p->tangent1, k, row.tangent1);
-  set_lane(&p->tangent2, k, row.tangent2);
-  set_lane(&p->ra_cross_n, k, row.ra_cross_n);
-  set_lane(&p->rb_cross_n, k, row.rb_cross_n);
-  set_lane(&p->angular_a, k, row.angular_a);
-  set_lane(&p->angular_b, k, row.angular_b);
-  set_lane(&p->ra_cross_t1, k, row.ra_cross_t1);
-  set_lane(&p->rb_cross_t1, k, row.rb_cross_t1);
-  set_lane(&p->ra_cross_t2, k, row.ra_cross_t2);
-  set_lane(&p->rb_cross_t2, k, row.rb_cross_t2);
-  set_lane(&p->angular_a_t1, k, row.angular_a_t1);
-  set_lane(&p->angular_b_t1, k, row.angular_b_t1);
-  set_lane(&p->angular_a_t2, k, row.angular_a_t2);
-  set_lane(&p->angular_b_t2, k, row.angular_b_t2);
-  p->separation[k] = row.separation;
-  p->substep_separation[k] = row.substep_separation;
-  p->normal_mass[k] = row.normal_mass;
-  p->tangent_mass1[k] = row.tangent_mass1;
-  p->tangent_mass2[k] = row.tangent_mass2;
-  p->normal_response[k] = row.normal_response;
-  p->tangent_response1[k] = row.tangent_response1;
-  p->tangent_response2[k] = row.tangent_response2;
-  p->normal_impulse[k] = row.normal_impulse;
-  p->tangent_impulse1[k] = row.tangent_impulse1;
-  p->tangent_impulse2[k] = row.tangent_impulse2;
-  p->max_normal_impulse[k] = row.max_normal_impulse;
+// A row of zeros, which lanes without a point p copy: they compute on zeros and write nothing.
+ContactRow zero_row() {
+  ContactRow row;
+  for (Vec3* v :
+       {&row.normal, &row.tangent1, &row.tangent2, &row.ra_cross_n, &row.rb_cross_n, &row.angular_a,
+        &row.angular_b, &row.ra_cross_t1, &row.rb_cross_t1, &row.ra_cross_t2, &row.rb_cross_t2,
+        &row.angular_a_t1, &row.angular_b_t1, &row.angular_a_t2, &row.angular_b_t2})
+    v->setZero();
+  return row;
+}
+const ContactRow kZeroRow = zero_row();
+
+using LaneRows = const ContactRow* [kWideLanes];
+
+// A field of four rows, one a lane: whole vectors are stored, four times fewer stores than lane
+// by lane.
+TUMBLE_INLINE Wide lanes_of(const LaneRows& rows, double ContactRow::*field) {
+  return Wide{rows[0]->*field, rows[1]->*field, rows[2]->*field, rows[3]->*field};
+}
+TUMBLE_INLINE WideVec3 lanes_of(const LaneRows& rows, Vec3 ContactRow::*field) {
+  return {Wide{(rows[0]->*field).x(), (rows[1]->*field).x(), (rows[2]->*field).x(),
+               (rows[3]->*field).x()},
+          Wide{(rows[0]->*field).y(), (rows[1]->*field).y(), (rows[2]->*field).y(),
+               (rows[3]->*field).y()},
+          Wide{(rows[0]->*field).z(), (rows[1]->*field).z(), (rows[2]->*field).z(),
+               (rows[3]->*field).z()}};
+}
+
+// Point p of every lane from its row (kZeroRow where the lane has none).
+TUMBLE_INLINE void pack_point(const LaneRows& rows, PackPoint* p) {
+  p->tangent1 = lanes_of(rows, &ContactRow::tangent1);
+  p->tangent2 = lanes_of(rows, &ContactRow::tangent2);
+  p->ra_cross_n = lanes_of(rows, &ContactRow::ra_cross_n);
+  p->rb_cross_n = lanes_of(rows, &ContactRow::rb_cross_n);
+  p->angular_a = lanes_of(rows, &ContactRow::angular_a);
+  p->angular_b = lanes_of(rows, &ContactRow::angular_b);
+  p->ra_cross_t1 = lanes_of(rows, &ContactRow::ra_cross_t1);
+  p->rb_cross_t1 = lanes_of(rows, &ContactRow::rb_cross_t1);
+  p->ra_cross_t2 = lanes_of(rows, &ContactRow::ra_cross_t2);
+  p->rb_cross_t2 = lanes_of(rows, &ContactRow::rb_cross_t2);
+  p->angular_a_t1 = lanes_of(rows, &ContactRow::angular_a_t1);
+  p->angular_b_t1 = lanes_of(rows, &ContactRow::angular_b_t1);
+  p->angular_a_t2 = lanes_of(rows, &ContactRow::angular_a_t2);
+  p->angular_b_t2 = lanes_of(rows, &ContactRow::angular_b_t2);
+  p->separation = lanes_of(rows, &ContactRow::separation);
+  p->substep_separation = lanes_of(rows, &ContactRow::substep_separation);
+  p->earlier_substeps_impulse = wide(0);
+  p->normal_mass = lanes_of(rows, &ContactRow::normal_mass);
+  p->tangent_mass1 = lanes_of(rows, &ContactRow::tangent_mass1);
+  p->tangent_mass2 = lanes_of(rows, &ContactRow::tangent_mass2);
+  p->normal_response = lanes_of(rows, &ContactRow::normal_response);
+  p->tangent_response1 = lanes_of(rows, &ContactRow::tangent_response1);
+  p->tangent_response2 = lanes_of(rows, &ContactRow::tangent_response2);
+  p->normal_impulse = lanes_of(rows, &ContactRow::normal_impulse);
+  p->tangent_impulse1 = lanes_of(rows, &ContactRow::tangent_impulse1);
+  p->tangent_impulse2 = lanes_of(rows, &ContactRow::tangent_impulse2);
+  p->max_normal_impulse = lanes_of(rows, &ContactRow::max_normal_impulse);
 }
 
 }  // namespace
 
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
                     std::span<const std::uint32_t> row_begin, std::span<const ContactRow> rows,
                     std::span<const NormalBlock> blocks, std::span<const SolverBody> bodies,
                     ContactPack* pack) {
-  // Zero everywhere first: a lane without a manifold, or a point its manifold lacks, computes on
-  // zeros and writes nothing.
-  *pack = ContactPack{};
   const std::uint32_t* any_manifold = std::find_if(
       std::begin(manifolds), std::end(manifolds), [](std::uint32_t m) { return m != kNoManifold; });
   TUMBLE_ASSERT(any_manifold != std::end(manifolds));
   bool moves_a[kWideLanes] = {}, moves_b[kWideLanes] = {};
   bool alone[kWideLanes] = {}, in_block[kWideLanes] = {};
   bool present[4][kWideLanes] = {}, rubs[4][kWideLanes] = {};
+  LaneRows first_rows;
+  pack->most_points = 0;
   for (int k = 0; k < kWideLanes; ++k) {
     // Lanes without a manifold read another lane's bodies (any valid memory), never write.
     const std::uint32_t m = manifolds[k] != kNoManifold ? manifolds[k] : *any_manifold;
     const ContactRow& first = rows[row_begin[m]];
     pack->a[k] = first.a;
     pack->b[k] = first.b;
+    pack->first_row[k] = 0;
+    pack->points[k] = 0;
+    first_rows[k] = &kZeroRow;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        pack->block_inverse[i][j][k] = 0;
     if (manifolds[k] == kNoManifold) continue;
+    first_rows[k] = &first;
     const int count = static_cast<int>(row_begin[m + 1] - row_begin[m]);
     pack->first_row[k] = row_begin[m];
     pack->points[k] = static_cast<std::uint8_t>(count);
     pack->most_points = std::max(pack->most_points, pack->points[k]);
-    set_lane(&pack->normal, k, first.normal);
-    pack->friction[k] = first.friction;
-    pack->inverse_mass_a[k] = bodies[first.a].inverse_mass;
-    pack->inverse_mass_b[k] = bodies[first.b].inverse_mass;
     moves_a[k] = bodies[first.a].inverse_mass > 0;
     moves_b[k] = bodies[first.b].inverse_mass > 0;
     alone[k] = count == 1;
@@ -89,17 +124,26 @@ void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
       for (int j = 0; j < 4; ++j)
         pack->block_inverse[i][j][k] = blocks[m].inverse(i, j);
     for (int p = 0; p < count; ++p) {
-      const ContactRow& row = rows[row_begin[m] + p];
-      pack_point(row, k, &pack->point[p]);
       present[p][k] = true;
-      rubs[p][k] = row.friction > 0;
+      rubs[p][k] = rows[row_begin[m] + p].friction > 0;
     }
+  }
+  pack->normal = lanes_of(first_rows, &ContactRow::normal);
+  pack->friction = lanes_of(first_rows, &ContactRow::friction);
+  for (int k = 0; k < kWideLanes; ++k) {
+    pack->inverse_mass_a[k] = first_rows[k] == &kZeroRow ? 0 : bodies[pack->a[k]].inverse_mass;
+    pack->inverse_mass_b[k] = first_rows[k] == &kZeroRow ? 0 : bodies[pack->b[k]].inverse_mass;
   }
   pack->moves_a = mask_of(moves_a);
   pack->moves_b = mask_of(moves_b);
   pack->alone = mask_of(alone);
   pack->in_block = mask_of(in_block);
+  // Every point, also past the most any lane has: the block solve reads all four (as zeros).
   for (int p = 0; p < 4; ++p) {
+    LaneRows point_rows;
+    for (int k = 0; k < kWideLanes; ++k)
+      point_rows[k] = present[p][k] ? &rows[row_begin[manifolds[k]] + p] : &kZeroRow;
+    pack_point(point_rows, &pack->point[p]);
     pack->point[p].present = mask_of(present[p]);
     pack->point[p].rubs = mask_of(rubs[p]);
   }
