@@ -50,28 +50,29 @@ TUMBLE_INLINE WideVec3 lanes_of(const LaneRows& rows, Vec3 ContactRow::*field) {
                (rows[3]->*field).z()}};
 }
 
-// Point p of every lane from its row (kZeroRow where the lane has none).
-TUMBLE_INLINE void pack_point(const LaneRows& rows, PackPoint* p) {
-  p->tangent1 = lanes_of(rows, &ContactRow::tangent1);
-  p->tangent2 = lanes_of(rows, &ContactRow::tangent2);
+// Point p of every lane from its row (kZeroRow where the lane has none), its friction from
+// `friction_rows` (kZeroRow also where the point has no friction: solve_friction relies on it).
+TUMBLE_INLINE void pack_point(const LaneRows& rows, const LaneRows& friction_rows, PackPoint* p) {
+  p->tangent1 = lanes_of(friction_rows, &ContactRow::tangent1);
+  p->tangent2 = lanes_of(friction_rows, &ContactRow::tangent2);
   p->ra_cross_n = lanes_of(rows, &ContactRow::ra_cross_n);
   p->rb_cross_n = lanes_of(rows, &ContactRow::rb_cross_n);
   p->angular_a = lanes_of(rows, &ContactRow::angular_a);
   p->angular_b = lanes_of(rows, &ContactRow::angular_b);
-  p->ra_cross_t1 = lanes_of(rows, &ContactRow::ra_cross_t1);
-  p->rb_cross_t1 = lanes_of(rows, &ContactRow::rb_cross_t1);
-  p->ra_cross_t2 = lanes_of(rows, &ContactRow::ra_cross_t2);
-  p->rb_cross_t2 = lanes_of(rows, &ContactRow::rb_cross_t2);
-  p->angular_a_t1 = lanes_of(rows, &ContactRow::angular_a_t1);
-  p->angular_b_t1 = lanes_of(rows, &ContactRow::angular_b_t1);
-  p->angular_a_t2 = lanes_of(rows, &ContactRow::angular_a_t2);
-  p->angular_b_t2 = lanes_of(rows, &ContactRow::angular_b_t2);
+  p->ra_cross_t1 = lanes_of(friction_rows, &ContactRow::ra_cross_t1);
+  p->rb_cross_t1 = lanes_of(friction_rows, &ContactRow::rb_cross_t1);
+  p->ra_cross_t2 = lanes_of(friction_rows, &ContactRow::ra_cross_t2);
+  p->rb_cross_t2 = lanes_of(friction_rows, &ContactRow::rb_cross_t2);
+  p->angular_a_t1 = lanes_of(friction_rows, &ContactRow::angular_a_t1);
+  p->angular_b_t1 = lanes_of(friction_rows, &ContactRow::angular_b_t1);
+  p->angular_a_t2 = lanes_of(friction_rows, &ContactRow::angular_a_t2);
+  p->angular_b_t2 = lanes_of(friction_rows, &ContactRow::angular_b_t2);
   p->separation = lanes_of(rows, &ContactRow::separation);
   p->substep_separation = lanes_of(rows, &ContactRow::substep_separation);
   p->earlier_substeps_impulse = wide(0);
   p->normal_mass = lanes_of(rows, &ContactRow::normal_mass);
-  p->tangent_mass1 = lanes_of(rows, &ContactRow::tangent_mass1);
-  p->tangent_mass2 = lanes_of(rows, &ContactRow::tangent_mass2);
+  p->tangent_mass1 = lanes_of(friction_rows, &ContactRow::tangent_mass1);
+  p->tangent_mass2 = lanes_of(friction_rows, &ContactRow::tangent_mass2);
   p->normal_response = lanes_of(rows, &ContactRow::normal_response);
   p->tangent_response1 = lanes_of(rows, &ContactRow::tangent_response1);
   p->tangent_response2 = lanes_of(rows, &ContactRow::tangent_response2);
@@ -140,10 +141,12 @@ void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
   pack->in_block = mask_of(in_block);
   // Every point, also past the most any lane has: the block solve reads all four (as zeros).
   for (int p = 0; p < 4; ++p) {
-    LaneRows point_rows;
-    for (int k = 0; k < kWideLanes; ++k)
+    LaneRows point_rows, friction_rows;
+    for (int k = 0; k < kWideLanes; ++k) {
       point_rows[k] = present[p][k] ? &rows[row_begin[manifolds[k]] + p] : &kZeroRow;
-    pack_point(point_rows, &pack->point[p]);
+      friction_rows[k] = rubs[p][k] ? point_rows[k] : &kZeroRow;
+    }
+    pack_point(point_rows, friction_rows, &pack->point[p]);
     pack->point[p].present = mask_of(present[p]);
     pack->point[p].rubs = mask_of(rubs[p]);
   }
@@ -292,6 +295,22 @@ TUMBLE_INLINE void apply_tangents(const ContactPack& pack, const PackPoint& poin
   pair.wb = select(on_b, pair.wb + angular_b, pair.wb);
 }
 
+// apply_tangents in every lane (solve_friction says when that is the same).
+TUMBLE_INLINE void add_tangents(const ContactPack& pack, const PackPoint& point, Wide d1, Wide d2,
+                                WidePair& pair) {
+  const WideVec3 linear = {d1 * point.tangent1.x + d2 * point.tangent2.x,
+                           d1 * point.tangent1.y + d2 * point.tangent2.y,
+                           d1 * point.tangent1.z + d2 * point.tangent2.z};
+  pair.va = minus_scaled(pair.va, pack.inverse_mass_a, linear);
+  pair.wa = pair.wa - WideVec3{d1 * point.angular_a_t1.x + d2 * point.angular_a_t2.x,
+                               d1 * point.angular_a_t1.y + d2 * point.angular_a_t2.y,
+                               d1 * point.angular_a_t1.z + d2 * point.angular_a_t2.z};
+  pair.vb = plus_scaled(pair.vb, pack.inverse_mass_b, linear);
+  pair.wb = pair.wb + WideVec3{d1 * point.angular_b_t1.x + d2 * point.angular_b_t2.x,
+                               d1 * point.angular_b_t1.y + d2 * point.angular_b_t2.y,
+                               d1 * point.angular_b_t1.z + d2 * point.angular_b_t2.z};
+}
+
 // solve_friction for a point in the lanes of `mask`. Returns the velocity change per lane.
 TUMBLE_INLINE Wide solve_friction(const ContactPack& pack, PackPoint& point, WideMask mask,
                                   WidePair& pair) {
@@ -316,11 +335,14 @@ TUMBLE_INLINE Wide solve_friction(const ContactPack& pack, PackPoint& point, Wid
   }
   point.tangent_impulse1 = select(mask, new1, old1);
   point.tangent_impulse2 = select(mask, new2, old2);
+  // Applied in every lane, without the selects: a lane outside `mask` either has no friction at
+  // this point (its friction data are zeros, pack_manifolds, so it adds +0 to each velocity, which
+  // leaves every value as it was, -0 included) or is not swept now (solve_pack writes back only the
+  // swept lanes), and a static body adds 0 times its zero inverse mass and inertia to its own zero
+  // velocity, which stays +0. The rows' bits, in fewer operations.
   const Wide d1 = new1 - old1, d2 = new2 - old2;
-  apply_tangents(pack, point, mask, d1, d2, pair);
-  const Wide change =
-      wide_max(wide_abs(d1) * point.tangent_response1, wide_abs(d2) * point.tangent_response2);
-  return select(mask, change, wide(0));
+  add_tangents(pack, point, d1, d2, pair);
+  return wide_max(wide_abs(d1) * point.tangent_response1, wide_abs(d2) * point.tangent_response2);
 }
 
 // solve_normal for point p in the lanes of `mask`.
