@@ -158,9 +158,28 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   // (2) One sorted array: the threads' sorted runs merged in thread order.
   merge_sorted(thread_entries_, threads, &entries_, &merge_buffer_);
 
-  const auto emit = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
+  // Bodies off the grid meet the others directly, once.
+  const auto meet = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
     if (a == b || !(input.movable[a] || input.movable[b])) return;
     if (!bounds[a].overlaps(bounds[b])) return;
+    out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+  };
+  // Two boxes that overlap share every cell their overlap covers, but a pair is emitted only from
+  // the cell holding its overlap's lowest corner (on the level where it was found): once, not once
+  // per shared cell, so that the threads' lists are not mostly duplicates to sort away. (Cells
+  // whose keys collide can still give a pair twice; the reduction's unique pass removes those.)
+  const auto emit = [&](std::uint32_t a, std::uint32_t b, int level, std::uint32_t key,
+                        std::vector<BodyPair>& out) {
+    if (a == b || !(input.movable[a] || input.movable[b])) return;
+    if (!bounds[a].overlaps(bounds[b])) return;
+    const double cell = base * std::ldexp(1.0, level);
+    // Floored as the boxes' corners were when their cells were listed, so the corner's cell is one
+    // both boxes listed.
+    const Eigen::Array3d corner = (bounds[a].min.cwiseMax(bounds[b].min) / cell).array().floor();
+    if (cell_key(level, static_cast<std::int64_t>(corner.x()),
+                 static_cast<std::int64_t>(corner.y()),
+                 static_cast<std::int64_t>(corner.z())) != key)
+      return;
     out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
   };
 
@@ -172,10 +191,17 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     // Same cell: each run of equal keys, visited from its first entry.
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < entry_count; ++i) {
-      if (i > 0 && entries_[i - 1].key() == entries_[i].key()) continue;
-      for (std::int64_t j = i; j < entry_count && entries_[j].key() == entries_[i].key(); ++j)
-        for (std::int64_t k = j + 1; k < entry_count && entries_[k].key() == entries_[i].key(); ++k)
-          emit(entries_[j].body(), entries_[k].body(), out);
+      const std::uint32_t key = entries_[i].key();
+      if (i > 0 && entries_[i - 1].key() == key) continue;
+      for (std::int64_t j = i; j < entry_count && entries_[j].key() == key; ++j) {
+        const std::uint32_t a = entries_[j].body();
+        for (std::int64_t k = j + 1; k < entry_count && entries_[k].key() == key; ++k) {
+          const std::uint32_t b = entries_[k].body();
+          // Bodies of different levels meet in the coarser level's lookup below (here only
+          // through a collision of keys).
+          if (level_[a] == level_[b]) emit(a, b, level_[a], key, out);
+        }
+      }
     }
     // Coarser levels: each body looks up the cells it covers there.
 #pragma omp for schedule(static)
@@ -199,7 +225,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
               auto it = std::lower_bound(entries_.begin(), entries_.end(), Entry(key, 0));
               for (; it != entries_.end() && it->key() == key; ++it)
                 if (level_[it->body()] == level)
-                  emit(static_cast<std::uint32_t>(i), it->body(), out);
+                  emit(static_cast<std::uint32_t>(i), it->body(), level, key, out);
             }
       }
     }
@@ -208,7 +234,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
       if (level_[i] == kDeadSlot) continue;
       for (std::uint32_t u : unbounded_)
-        if (level_[i] == kMeetsEveryone ? u < i : true) emit(static_cast<std::uint32_t>(i), u, out);
+        if (level_[i] == kMeetsEveryone ? u < i : true) meet(static_cast<std::uint32_t>(i), u, out);
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
