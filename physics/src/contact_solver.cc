@@ -32,7 +32,8 @@ Vec3 any_perpendicular(const Vec3& n) {
   return n.cross(axis).normalized();
 }
 
-// The inverse of the leading count x count block of the symmetric `k` through its Cholesky
+// The inverse of the leading count x count block of the symmetric `k` (of which it reads the
+// lower triangle and the diagonal) through its Cholesky
 // factor L (k = L L^T, inverse = L^-T L^-1), written out for at most four rows: Eigen's LLT of a
 // fixed 4x4 goes through its general blocked kernels, which cost more than the arithmetic (3% of
 // an awake pile's step). Leaves `inverse` zero when k is not positive definite.
@@ -85,6 +86,8 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   const Mat3 ra_to_local = a.orientation.conjugate().toRotationMatrix();
   const Mat3 rb_to_local = b.orientation.conjugate().toRotationMatrix();
   const double match_distance = 0.05 * std::min(a.shape.size(), b.shape.size());
+  // The friction basis of a point that does not slide (one per manifold: it depends on n alone).
+  const Vec3 resting_tangent = any_perpendicular(n);
 
   for (int i = 0; i < manifold.count; ++i) {
     const ContactPoint& point = manifold.points[i];
@@ -112,7 +115,7 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     // Coulomb force, whatever its direction (no bias from the basis).
     const Vec3 slip = dv - far.relative_velocity * n;
     const double slip_speed = slip.norm();
-    row.tangent1 = slip_speed > kSlidingSpeed ? Vec3(slip / slip_speed) : any_perpendicular(n);
+    row.tangent1 = slip_speed > kSlidingSpeed ? Vec3(slip / slip_speed) : resting_tangent;
     row.tangent2 = n.cross(row.tangent1);
     row.ra_cross_n = far.ra.cross(n);
     row.rb_cross_n = far.rb.cross(n);
@@ -167,10 +170,11 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   NormalBlock normal_block;
   const int count = manifold.count;
   if (count > 1) {
+    // The lower triangle and diagonal: all that the factorisation reads (K is symmetric).
     Eigen::Matrix4d k = Eigen::Matrix4d::Zero();
     for (int i = 0; i < count; ++i) {
       const ContactRow& ri = rows[i];
-      for (int j = 0; j < count; ++j) {
+      for (int j = 0; j <= i; ++j) {
         const ContactRow& rj = rows[j];
         k(i, j) = a.inverse_mass + b.inverse_mass + rj.ra_cross_n.dot(ri.angular_a) +
                   rj.rb_cross_n.dot(ri.angular_b);
