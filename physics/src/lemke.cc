@@ -2,13 +2,43 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
+
+#include "wide.h"
 
 namespace tumble {
 namespace {
 
 using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Row i of the row-major n x n `rows` minus column[i] times row `pivot_row`, for every other row
+// with column[i] != 0: the pivot's elimination, where Lemke's time goes (half of an exact
+// island's solve). Four doubles at a time in the AVX2 clone; element by element the same
+// operation as Eigen's row update (a - c * b, no fused multiply-add), so the same bits on any
+// machine.
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void eliminate(double* rows, int n, int pivot_row, const double* column) {
+  const double* pivot = rows + static_cast<std::ptrdiff_t>(pivot_row) * n;
+  for (int i = 0; i < n; ++i) {
+    if (i == pivot_row || column[i] == 0) continue;
+    double* target = rows + static_cast<std::ptrdiff_t>(i) * n;
+    const Wide factor = wide(column[i]);
+    int k = 0;
+    for (; k + kWideLanes <= n; k += kWideLanes) {
+      Wide a, b;
+      std::memcpy(&a, target + k, sizeof a);
+      std::memcpy(&b, pivot + k, sizeof b);
+      a = a - factor * b;
+      std::memcpy(target + k, &a, sizeof a);
+    }
+    for (; k < n; ++k)
+      target[k] -= column[i] * pivot[k];
+  }
+}
 
 // Variables are numbered w_0..w_{n-1}, z_0..z_{n-1}, then the artificial z0 (index 2n). The
 // tableau lives in the caller's workspace, so repeated solves allocate nothing.
@@ -35,9 +65,9 @@ struct Tableau {
     const double p = column[row];
     basis_inverse.row(row) /= p;
     values[row] /= p;
+    eliminate(basis_inverse.data(), n, row, column.data());
     for (int i = 0; i < n; ++i) {
       if (i == row || column[i] == 0) continue;
-      basis_inverse.row(i) -= column[i] * basis_inverse.row(row);
       values[i] -= column[i] * values[row];
     }
     basic[row] = entering;

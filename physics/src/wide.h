@@ -1,8 +1,9 @@
 // Four doubles worked on at once: one lane per contact manifold in the packed contact solver
-// (contact_packs.h). GCC's vector extensions give SSE2 pairs on a plain x86-64 build and one
-// AVX register where the target has it; every operation is the scalar IEEE one lane by lane
-// (contraction into fused multiply-adds is off for the whole build), so a lane computes the same
-// bits as the scalar solver whatever the width of the machine.
+// (contact_packs.h), four columns of a row in Lemke's eliminations (lemke.cc). GCC's vector
+// extensions give SSE2 pairs on a plain x86-64 build and one AVX register where the target has it;
+// every operation is the scalar IEEE one lane by lane (contraction into fused multiply-adds is off
+// for the whole build), so a lane computes the same bits as the scalar solver whatever the width of
+// the machine.
 #pragma once
 
 #include <cstdint>
