@@ -15,21 +15,36 @@ namespace {
 // contacts keep one basis from step to step.
 constexpr double kSlidingSpeed = 1e-3;
 
-// J M^-1 J^T of a row from its precomputed angular parts, r x d and I^-1 (r x d): the velocity
-// change a unit impulse gives the contact.
-double velocity_response(const Body& a, const Body& b, const Vec3& ra_cross, const Vec3& angular_a,
-                         const Vec3& rb_cross, const Vec3& angular_b) {
-  return a.inverse_mass + b.inverse_mass + ra_cross.dot(angular_a) + rb_cross.dot(angular_b);
-}
-
-double mass_of(double response) {
-  return response > 0 ? 1.0 / response : 0.0;
-}
-
 // A unit vector perpendicular to `n`, chosen the same way every time.
 Vec3 any_perpendicular(const Vec3& n) {
   const Vec3 axis = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
   return n.cross(axis).normalized();
+}
+
+// Eigen's 3-vector arithmetic on four vectors at once, operation for operation (checked bit for
+// bit by the pinned hashes): the cross product's formula, and Matrix3d * Vector3d's sums, whose
+// first two rows Eigen adds as (a0 + a1) + a2 in SIMD pairs and whose last as a0 + (a1 + a2).
+TUMBLE_INLINE WideVec3 broadcast(const Vec3& v) {
+  return {wide(v.x()), wide(v.y()), wide(v.z())};
+}
+TUMBLE_INLINE WideVec3 cross(const WideVec3& a, const WideVec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+TUMBLE_INLINE WideVec3 times(const Mat3& m, const WideVec3& v) {
+  return {(m(0, 0) * v.x + m(0, 1) * v.y) + m(0, 2) * v.z,
+          (m(1, 0) * v.x + m(1, 1) * v.y) + m(1, 2) * v.z,
+          m(2, 0) * v.x + (m(2, 1) * v.y + m(2, 2) * v.z)};
+}
+TUMBLE_INLINE WideVec3 scaled(Wide s, const WideVec3& v) {
+  return {s * v.x, s * v.y, s * v.z};
+}
+TUMBLE_INLINE void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
+  wide_vector->x[k] = v.x();
+  wide_vector->y[k] = v.y();
+  wide_vector->z[k] = v.z();
+}
+TUMBLE_INLINE Vec3 lane_of(const WideVec3& wide_vector, int k) {
+  return {wide_vector.x[k], wide_vector.y[k], wide_vector.z[k]};
 }
 
 // The inverse of the leading count x count block of the symmetric `k` (of which it reads the
@@ -76,10 +91,14 @@ void invert_positive_definite(const Eigen::Matrix4d& k, int count, Eigen::Matrix
 
 }  // namespace
 
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
                   const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
                   ContactRow* rows, ContactRowCold* cold, NormalBlock* block) {
   TUMBLE_ASSERT(manifold.count >= 1 && manifold.count <= 4);
+  const int count = manifold.count;
   const Vec3& n = manifold.normal;
   const double friction = std::sqrt(a.friction * b.friction);
   const double restitution = std::max(a.restitution, b.restitution);
@@ -89,55 +108,101 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   // The friction basis of a point that does not slide (one per manifold: it depends on n alone).
   const Vec3 resting_tangent = any_perpendicular(n);
 
-  for (int i = 0; i < manifold.count; ++i) {
+  // The manifold's points side by side, one a lane (lanes past the count repeat the last point,
+  // and are not written): each lane computes Eigen's expressions for its point operation for
+  // operation (wide.h), so the rows are what a loop over the points would write.
+  WideVec3 point_a, point_b;
+  for (int k = 0; k < kWideLanes; ++k) {
+    const ContactPoint& point = manifold.points[std::min(k, count - 1)];
+    set_lane(&point_a, k, point.point_a);
+    set_lane(&point_b, k, point.point_b);
+  }
+  const WideVec3 normal = broadcast(n);
+  const WideVec3 ra = point_a - broadcast(a.position);
+  const WideVec3 rb = point_b - broadcast(b.position);
+  const WideVec3 local_a = times(ra_to_local, ra);
+  const WideVec3 local_b = times(rb_to_local, rb);
+  const WideVec3 dv = ((broadcast(b.linear_velocity) + cross(broadcast(b.angular_velocity), rb)) -
+                       broadcast(a.linear_velocity)) -
+                      cross(broadcast(a.angular_velocity), ra);
+  const Wide relative_velocity = dot(dv, normal);
+  // Friction along the sliding direction when sliding: a sliding body then feels exactly the
+  // Coulomb force, whatever its direction (no bias from the basis).
+  const WideVec3 slip = dv - scaled(relative_velocity, normal);
+  const Wide slip_squared = dot(slip, slip);
+  Wide slip_speed;
+  for (int k = 0; k < kWideLanes; ++k)
+    slip_speed[k] = std::sqrt(slip_squared[k]);
+  const WideVec3 tangent1 =
+      select(slip_speed > kSlidingSpeed,
+             WideVec3{slip.x / slip_speed, slip.y / slip_speed, slip.z / slip_speed},
+             broadcast(resting_tangent));
+  const WideVec3 tangent2 = cross(normal, tangent1);
+  const WideVec3 ra_cross_n = cross(ra, normal), rb_cross_n = cross(rb, normal);
+  const WideVec3 ra_cross_t1 = cross(ra, tangent1), rb_cross_t1 = cross(rb, tangent1);
+  const WideVec3 ra_cross_t2 = cross(ra, tangent2), rb_cross_t2 = cross(rb, tangent2);
+  const Mat3& inertia_a = a.inverse_inertia_world;
+  const Mat3& inertia_b = b.inverse_inertia_world;
+  const WideVec3 angular_a = times(inertia_a, ra_cross_n), angular_b = times(inertia_b, rb_cross_n);
+  const WideVec3 angular_a_t1 = times(inertia_a, ra_cross_t1);
+  const WideVec3 angular_b_t1 = times(inertia_b, rb_cross_t1);
+  const WideVec3 angular_a_t2 = times(inertia_a, ra_cross_t2);
+  const WideVec3 angular_b_t2 = times(inertia_b, rb_cross_t2);
+  // J M^-1 J^T of a row from its angular parts, r x d and I^-1 (r x d): the velocity change a unit
+  // impulse gives the contact.
+  const auto response = [&](const WideVec3& ra_cross, const WideVec3& angular_on_a,
+                            const WideVec3& rb_cross, const WideVec3& angular_on_b) {
+    return ((wide(a.inverse_mass) + b.inverse_mass) + dot(ra_cross, angular_on_a)) +
+           dot(rb_cross, angular_on_b);
+  };
+  const Wide normal_response = response(ra_cross_n, angular_a, rb_cross_n, angular_b);
+  const Wide tangent_response1 = response(ra_cross_t1, angular_a_t1, rb_cross_t1, angular_b_t1);
+  const Wide tangent_response2 = response(ra_cross_t2, angular_a_t2, rb_cross_t2, angular_b_t2);
+  // Its inverse, the row's effective mass (none for a row that nothing can move).
+  const auto mass = [](Wide r) { return select(r > 0, 1.0 / r, wide(0)); };
+  const Wide normal_mass = mass(normal_response);
+  const Wide tangent_mass1 = mass(tangent_response1);
+  const Wide tangent_mass2 = mass(tangent_response2);
+
+  for (int i = 0; i < count; ++i) {
     const ContactPoint& point = manifold.points[i];
     ContactRow row;
     ContactRowCold far;
     row.a = id_a.index;
     row.b = id_b.index;
     row.normal = n;
-    far.ra = point.point_a - a.position;
-    far.rb = point.point_b - b.position;
-    far.local_a = ra_to_local * far.ra;
-    far.local_b = rb_to_local * far.rb;
+    far.ra = lane_of(ra, i);
+    far.rb = lane_of(rb, i);
+    far.local_a = lane_of(local_a, i);
+    far.local_b = lane_of(local_b, i);
     row.separation = -point.depth;
     row.friction = friction;
     far.restitution = restitution;
     far.feature = point.feature_id;
     row.manifold = block_index;
     row.block_index = static_cast<std::uint8_t>(i);
-    row.block_size = static_cast<std::uint8_t>(manifold.count);
-
-    const Vec3 dv = b.linear_velocity + b.angular_velocity.cross(far.rb) - a.linear_velocity -
-                    a.angular_velocity.cross(far.ra);
-    far.relative_velocity = dv.dot(n);
-    // Friction along the sliding direction when sliding: a sliding body then feels exactly the
-    // Coulomb force, whatever its direction (no bias from the basis).
-    const Vec3 slip = dv - far.relative_velocity * n;
-    const double slip_speed = slip.norm();
-    row.tangent1 = slip_speed > kSlidingSpeed ? Vec3(slip / slip_speed) : resting_tangent;
-    row.tangent2 = n.cross(row.tangent1);
-    row.ra_cross_n = far.ra.cross(n);
-    row.rb_cross_n = far.rb.cross(n);
-    row.angular_a = a.inverse_inertia_world * row.ra_cross_n;
-    row.angular_b = b.inverse_inertia_world * row.rb_cross_n;
-    row.ra_cross_t1 = far.ra.cross(row.tangent1);
-    row.rb_cross_t1 = far.rb.cross(row.tangent1);
-    row.ra_cross_t2 = far.ra.cross(row.tangent2);
-    row.rb_cross_t2 = far.rb.cross(row.tangent2);
-    row.angular_a_t1 = a.inverse_inertia_world * row.ra_cross_t1;
-    row.angular_b_t1 = b.inverse_inertia_world * row.rb_cross_t1;
-    row.angular_a_t2 = a.inverse_inertia_world * row.ra_cross_t2;
-    row.angular_b_t2 = b.inverse_inertia_world * row.rb_cross_t2;
-    row.normal_response =
-        velocity_response(a, b, row.ra_cross_n, row.angular_a, row.rb_cross_n, row.angular_b);
-    row.tangent_response1 = velocity_response(a, b, row.ra_cross_t1, row.angular_a_t1,
-                                              row.rb_cross_t1, row.angular_b_t1);
-    row.tangent_response2 = velocity_response(a, b, row.ra_cross_t2, row.angular_a_t2,
-                                              row.rb_cross_t2, row.angular_b_t2);
-    row.normal_mass = mass_of(row.normal_response);
-    row.tangent_mass1 = mass_of(row.tangent_response1);
-    row.tangent_mass2 = mass_of(row.tangent_response2);
+    row.block_size = static_cast<std::uint8_t>(count);
+    far.relative_velocity = relative_velocity[i];
+    row.tangent1 = lane_of(tangent1, i);
+    row.tangent2 = lane_of(tangent2, i);
+    row.ra_cross_n = lane_of(ra_cross_n, i);
+    row.rb_cross_n = lane_of(rb_cross_n, i);
+    row.angular_a = lane_of(angular_a, i);
+    row.angular_b = lane_of(angular_b, i);
+    row.ra_cross_t1 = lane_of(ra_cross_t1, i);
+    row.rb_cross_t1 = lane_of(rb_cross_t1, i);
+    row.ra_cross_t2 = lane_of(ra_cross_t2, i);
+    row.rb_cross_t2 = lane_of(rb_cross_t2, i);
+    row.angular_a_t1 = lane_of(angular_a_t1, i);
+    row.angular_b_t1 = lane_of(angular_b_t1, i);
+    row.angular_a_t2 = lane_of(angular_a_t2, i);
+    row.angular_b_t2 = lane_of(angular_b_t2, i);
+    row.normal_response = normal_response[i];
+    row.tangent_response1 = tangent_response1[i];
+    row.tangent_response2 = tangent_response2[i];
+    row.normal_mass = normal_mass[i];
+    row.tangent_mass1 = tangent_mass1[i];
+    row.tangent_mass2 = tangent_mass2[i];
 
     // Feature ids change when a vertex of a face resting on an equal face moves across the
     // other's edge by a nanometre; the point has not moved, so its impulse still applies (Jolt
@@ -168,7 +233,6 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   }
 
   NormalBlock normal_block;
-  const int count = manifold.count;
   if (count > 1) {
     // The lower triangle and diagonal: all that the factorisation reads (K is symmetric).
     Eigen::Matrix4d k = Eigen::Matrix4d::Zero();
