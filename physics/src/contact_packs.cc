@@ -7,18 +7,20 @@
 namespace tumble {
 namespace {
 
-void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
+TUMBLE_INLINE void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
   wide_vector->x[k] = v.x();
   wide_vector->y[k] = v.y();
   wide_vector->z[k] = v.z();
 }
 
-Vec3 lane_of(const WideVec3& wide_vector, int k) {
+TUMBLE_INLINE Vec3 lane_of(const WideVec3& wide_vector, int k) {
   return {wide_vector.x[k], wide_vector.y[k], wide_vector.z[k]};
 }
 
-// Which lanes `on` selects, as a mask.
-WideMask mask_of(const bool (&on)[kWideLanes]) {
+// Which lanes `on` selects, as a mask. (Every helper that takes or returns a vector is inlined
+// into the AVX2 clones: called out of line it would pass the vector by another convention than
+// the clone expects, wide.h.)
+TUMBLE_INLINE WideMask mask_of(const bool (&on)[kWideLanes]) {
   return WideMask{on[0] ? -1 : 0, on[1] ? -1 : 0, on[2] ? -1 : 0, on[3] ? -1 : 0};
 }
 
@@ -255,24 +257,29 @@ TUMBLE_INLINE void apply_normal(const ContactPack& pack, const PackPoint& point,
   pair.wb = select(on_b, plus_scaled(pair.wb, impulse, point.angular_b), pair.wb);
 }
 
+// delta[i] times point i's angular part, summed over the four points in the rows' order.
+TUMBLE_INLINE WideVec3 summed_angular(const PackPoint* p, const Wide (&delta)[4],
+                                      WideVec3 PackPoint::*angular) {
+  WideVec3 term[4];
+  for (int i = 0; i < 4; ++i)
+    term[i] = {delta[i] * (p[i].*angular).x, delta[i] * (p[i].*angular).y,
+               delta[i] * (p[i].*angular).z};
+  return ((term[0] + term[1]) + term[2]) + term[3];
+}
+
 // Applies a block's impulse changes delta[i] at its four points at once in the lanes of `mask`
 // (PairVelocities::apply_normals). Points past most_points are zeros in every lane.
 TUMBLE_INLINE void apply_normals(const ContactPack& pack, WideMask mask, const Wide (&delta)[4],
                                  WidePair& pair) {
   const PackPoint* p = pack.point;
   const Wide total = ((delta[0] + delta[1]) + delta[2]) + delta[3];
-  const auto sum = [&](WideVec3 PackPoint::*angular) {
-    const auto term = [&](int i) -> WideVec3 {
-      return {delta[i] * (p[i].*angular).x, delta[i] * (p[i].*angular).y,
-              delta[i] * (p[i].*angular).z};
-    };
-    return ((term(0) + term(1)) + term(2)) + term(3);
-  };
+  const WideVec3 sum_a = summed_angular(p, delta, &PackPoint::angular_a);
+  const WideVec3 sum_b = summed_angular(p, delta, &PackPoint::angular_b);
   const WideMask on_a = mask & pack.moves_a, on_b = mask & pack.moves_b;
   pair.va = select(on_a, minus_scaled(pair.va, pack.inverse_mass_a * total, pack.normal), pair.va);
-  pair.wa = select(on_a, pair.wa - sum(&PackPoint::angular_a), pair.wa);
+  pair.wa = select(on_a, pair.wa - sum_a, pair.wa);
   pair.vb = select(on_b, plus_scaled(pair.vb, pack.inverse_mass_b * total, pack.normal), pair.vb);
-  pair.wb = select(on_b, pair.wb + sum(&PackPoint::angular_b), pair.wb);
+  pair.wb = select(on_b, pair.wb + sum_b, pair.wb);
 }
 
 // Applies impulses d1 and d2 along a point's tangents in the lanes of `mask`

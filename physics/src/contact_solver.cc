@@ -22,8 +22,9 @@ Vec3 any_perpendicular(const Vec3& n) {
 }
 
 // Eigen's 3-vector arithmetic on four vectors at once, operation for operation (checked bit for
-// bit by the pinned hashes): the cross product's formula, and Matrix3d * Vector3d's sums, whose
-// first two rows Eigen adds as (a0 + a1) + a2 in SIMD pairs and whose last as a0 + (a1 + a2).
+// bit by the pinned hashes), always inlined into the AVX2 clone of prepare_rows (wide.h): the cross
+// product's formula, and Matrix3d * Vector3d's sums, whose first two rows Eigen adds as (a0 + a1) +
+// a2 in SIMD pairs and whose last as a0 + (a1 + a2).
 TUMBLE_INLINE WideVec3 broadcast(const Vec3& v) {
   return {wide(v.x()), wide(v.y()), wide(v.z())};
 }
@@ -45,6 +46,20 @@ TUMBLE_INLINE void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
 }
 TUMBLE_INLINE Vec3 lane_of(const WideVec3& wide_vector, int k) {
   return {wide_vector.x[k], wide_vector.y[k], wide_vector.z[k]};
+}
+
+// J M^-1 J^T of a row from its angular parts, r x d and I^-1 (r x d): the velocity change a unit
+// impulse gives the contact.
+TUMBLE_INLINE Wide velocity_response(const Body& a, const Body& b, const WideVec3& ra_cross,
+                                     const WideVec3& angular_a, const WideVec3& rb_cross,
+                                     const WideVec3& angular_b) {
+  return ((wide(a.inverse_mass) + b.inverse_mass) + dot(ra_cross, angular_a)) +
+         dot(rb_cross, angular_b);
+}
+
+// Its inverse, the row's effective mass (none for a row that nothing can move).
+TUMBLE_INLINE Wide mass_of(Wide response) {
+  return select(response > 0, 1.0 / response, wide(0));
 }
 
 // The inverse of the leading count x count block of the symmetric `k` (of which it reads the
@@ -148,21 +163,15 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
   const WideVec3 angular_b_t1 = times(inertia_b, rb_cross_t1);
   const WideVec3 angular_a_t2 = times(inertia_a, ra_cross_t2);
   const WideVec3 angular_b_t2 = times(inertia_b, rb_cross_t2);
-  // J M^-1 J^T of a row from its angular parts, r x d and I^-1 (r x d): the velocity change a unit
-  // impulse gives the contact.
-  const auto response = [&](const WideVec3& ra_cross, const WideVec3& angular_on_a,
-                            const WideVec3& rb_cross, const WideVec3& angular_on_b) {
-    return ((wide(a.inverse_mass) + b.inverse_mass) + dot(ra_cross, angular_on_a)) +
-           dot(rb_cross, angular_on_b);
-  };
-  const Wide normal_response = response(ra_cross_n, angular_a, rb_cross_n, angular_b);
-  const Wide tangent_response1 = response(ra_cross_t1, angular_a_t1, rb_cross_t1, angular_b_t1);
-  const Wide tangent_response2 = response(ra_cross_t2, angular_a_t2, rb_cross_t2, angular_b_t2);
-  // Its inverse, the row's effective mass (none for a row that nothing can move).
-  const auto mass = [](Wide r) { return select(r > 0, 1.0 / r, wide(0)); };
-  const Wide normal_mass = mass(normal_response);
-  const Wide tangent_mass1 = mass(tangent_response1);
-  const Wide tangent_mass2 = mass(tangent_response2);
+  const Wide normal_response =
+      velocity_response(a, b, ra_cross_n, angular_a, rb_cross_n, angular_b);
+  const Wide tangent_response1 =
+      velocity_response(a, b, ra_cross_t1, angular_a_t1, rb_cross_t1, angular_b_t1);
+  const Wide tangent_response2 =
+      velocity_response(a, b, ra_cross_t2, angular_a_t2, rb_cross_t2, angular_b_t2);
+  const Wide normal_mass = mass_of(normal_response);
+  const Wide tangent_mass1 = mass_of(tangent_response1);
+  const Wide tangent_mass2 = mass_of(tangent_response2);
 
   for (int i = 0; i < count; ++i) {
     const ContactPoint& point = manifold.points[i];
