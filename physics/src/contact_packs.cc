@@ -7,16 +7,6 @@
 namespace tumble {
 namespace {
 
-TUMBLE_INLINE void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
-  wide_vector->x[k] = v.x();
-  wide_vector->y[k] = v.y();
-  wide_vector->z[k] = v.z();
-}
-
-TUMBLE_INLINE Vec3 lane_of(const WideVec3& wide_vector, int k) {
-  return {wide_vector.x[k], wide_vector.y[k], wide_vector.z[k]};
-}
-
 // Which lanes `on` selects, as a mask. (Every helper that takes or returns a vector is inlined
 // into the AVX2 clones: called out of line it would pass the vector by another convention than
 // the clone expects, wide.h.)

@@ -25,9 +25,6 @@ Vec3 any_perpendicular(const Vec3& n) {
 // bit by the pinned hashes), always inlined into the AVX2 clone of prepare_rows (wide.h): the cross
 // product's formula, and Matrix3d * Vector3d's sums, whose first two rows Eigen adds as (a0 + a1) +
 // a2 in SIMD pairs and whose last as a0 + (a1 + a2).
-TUMBLE_INLINE WideVec3 broadcast(const Vec3& v) {
-  return {wide(v.x()), wide(v.y()), wide(v.z())};
-}
 TUMBLE_INLINE WideVec3 cross(const WideVec3& a, const WideVec3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
@@ -38,14 +35,6 @@ TUMBLE_INLINE WideVec3 times(const Mat3& m, const WideVec3& v) {
 }
 TUMBLE_INLINE WideVec3 scaled(Wide s, const WideVec3& v) {
   return {s * v.x, s * v.y, s * v.z};
-}
-TUMBLE_INLINE void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
-  wide_vector->x[k] = v.x();
-  wide_vector->y[k] = v.y();
-  wide_vector->z[k] = v.z();
-}
-TUMBLE_INLINE Vec3 lane_of(const WideVec3& wide_vector, int k) {
-  return {wide_vector.x[k], wide_vector.y[k], wide_vector.z[k]};
 }
 
 // J M^-1 J^T of a row from its angular parts, r x d and I^-1 (r x d): the velocity change a unit

@@ -8,8 +8,12 @@
 
 #include <cstdint>
 
-// Always inlined: a vector of four doubles passed to an out-of-line function goes through memory
-// on a build without AVX, and the solver's small parts are called in its innermost loops.
+#include "physics/math.h"
+
+// Always inlined, and so must be every helper that takes or returns one of these vectors: a
+// function called out of line from an AVX2 clone (target_clones) passes a vector of four in a
+// register, a plain one expects it in memory, and the two disagree (a crash seen in the sanitizer
+// build, which inlines less). It also keeps the solver's small parts in its innermost loops.
 #define TUMBLE_INLINE inline __attribute__((always_inline))
 
 // GCC warns that passing these vectors by value has another ABI with AVX than without; every
@@ -74,6 +78,18 @@ TUMBLE_INLINE WideVec3 minus_scaled(const WideVec3& a, Wide s, const WideVec3& b
 }
 TUMBLE_INLINE WideVec3 plus_scaled(const WideVec3& a, Wide s, const WideVec3& b) {
   return {a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
+}
+// A 3-vector in every lane; lane k of a vector of them, in and out.
+TUMBLE_INLINE WideVec3 broadcast(const Vec3& v) {
+  return {wide(v.x()), wide(v.y()), wide(v.z())};
+}
+TUMBLE_INLINE void set_lane(WideVec3* wide_vector, int k, const Vec3& v) {
+  wide_vector->x[k] = v.x();
+  wide_vector->y[k] = v.y();
+  wide_vector->z[k] = v.z();
+}
+TUMBLE_INLINE Vec3 lane_of(const WideVec3& wide_vector, int k) {
+  return {wide_vector.x[k], wide_vector.y[k], wide_vector.z[k]};
 }
 TUMBLE_INLINE WideVec3 select(WideMask mask, const WideVec3& yes, const WideVec3& no) {
   return {select(mask, yes.x, no.x), select(mask, yes.y, no.y), select(mask, yes.z, no.z)};
