@@ -13,6 +13,7 @@ namespace {
 struct Run {
   std::uint64_t hash = 0;
   std::uint32_t coloured_islands = 0;  // in the last step
+  double residual = 0;                 // the last step's
 };
 
 Run run_with_threads(const SceneDef& base, int threads, long steps) {
@@ -20,7 +21,7 @@ Run run_with_threads(const SceneDef& base, int threads, long steps) {
   scene.world.threads = threads;
   World world = build(scene);
   run(world, scene.dt, steps);
-  return {state_hash(world), world.last_step().coloured_islands};
+  return {state_hash(world), world.last_step().coloured_islands, world.last_step().residual};
 }
 
 void expect_same_bits(const SceneDef& scene, long steps) {
@@ -55,8 +56,9 @@ TEST(Determinism, DefaultSceneWithSweptBodiesSameBitsForAnyThreadCountAndRun) {
 }
 
 // Packs (contact_packs.h) are a layout for the sweeps, not another solver: swept in packs or row
-// by row, every solver gives the same bits, on one thread and on two, for the pile's small islands
-// (side by side in lanes) and the pyramid's one (a colour's manifolds in lanes).
+// by row, every solver gives the same bits (and the same residual), on one thread and on two, for
+// the pile's small islands (side by side in lanes) and the pyramid's one (a colour's manifolds in
+// lanes).
 TEST(Determinism, PackedSweepsGiveTheRowsBits) {
   const bool machine_default = packed_sweeps();
   SceneDef pile = pile_scene(1000);
@@ -70,14 +72,18 @@ TEST(Determinism, PackedSweepsGiveTheRowsBits) {
         SCOPED_TRACE(scene.name + " " + std::string(solver_name(kind)) + " " +
                      std::to_string(threads) + " threads");
         set_packed_sweeps(true);
-        const std::uint64_t packed = run_with_threads(scene, threads, 60).hash;
+        const auto packed = run_with_threads(scene, threads, 60);
         SceneDef one_step = scene;
         one_step.world.threads = threads;
         World world = build(one_step);
         run(world, scene.dt, 60);
         EXPECT_GT(world.last_step().packed_manifolds, world.last_step().manifolds / 2);
         set_packed_sweeps(false);
-        EXPECT_EQ(run_with_threads(scene, threads, 60).hash, packed);
+        const auto rows = run_with_threads(scene, threads, 60);
+        EXPECT_EQ(rows.hash, packed.hash);
+        // The residual the step reports is measured on the packs: the rows' bits too.
+        EXPECT_EQ(rows.residual, packed.residual);
+        EXPECT_GT(packed.residual, 0.0);
         world.step(scene.dt);
         EXPECT_EQ(world.last_step().packed_manifolds, 0u);
       }

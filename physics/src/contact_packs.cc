@@ -415,6 +415,32 @@ void update_separations(ContactPack& pack, std::span<const SolverBody> bodies) {
     set_substep_separation(pack, motion, pack.point[p]);
 }
 
+#if defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies, double h,
+                    double (&lane_residuals)[kWideLanes]) {
+  const WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);
+  const WidePair motion =
+      gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
+  Wide residual = wide(0);
+  for (int p = 0; p < pack.most_points; ++p) {
+    const PackPoint& point = pack.point[p];
+    // Rows that nothing can move are left out, as normal_residual leaves them.
+    const WideMask measured = point.present & (point.normal_mass > 0);
+    const Wide separation = point.separation + dot(pack.normal, motion.vb - motion.va) +
+                            dot(motion.wb, point.rb_cross_n) - dot(motion.wa, point.ra_cross_n);
+    const Wide target = select(separation > 0, -separation / h, wide(0));
+    const Wide gap_velocity = normal_velocity(pack, point, pair) - target;
+    const Wide impulse_velocity = point.normal_impulse / point.normal_mass;
+    // std::min's choice, then std::max's.
+    const Wide smaller = select(gap_velocity < impulse_velocity, gap_velocity, impulse_velocity);
+    residual = select(measured, wide_max(residual, wide_abs(smaller)), residual);
+  }
+  for (int k = 0; k < kWideLanes; ++k)
+    lane_residuals[k] = residual[k];
+}
+
 // Compiled twice, for AVX2 (one register a vector) and for any x86-64 (two), and chosen when the
 // program loads: the same operations lane by lane, so the same bits on either.
 // (Vectors cross its boundary by reference: GCC gives the clones one calling convention only

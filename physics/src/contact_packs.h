@@ -69,6 +69,11 @@ void store_impulses(const ContactPack& pack, std::span<ContactRow> rows,
 void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep);
 void update_separations(ContactPack& pack, std::span<const SolverBody> bodies);
 
+// normal_residual's measure for each lane's manifold, in lane_residuals[k] (0 for a lane without
+// one): the same bits, so an island's residual does not depend on whether it was packed.
+void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies, double h,
+                    double (&lane_residuals)[kWideLanes]);
+
 // One Gauss-Seidel sweep over the manifolds of a pack's lanes in `lanes` (solve_manifold's
 // bits, lane by lane).
 // Returns the largest velocity change it gave a contact (m/s), and each lane's in

@@ -259,10 +259,16 @@ class IslandLanes {
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    for (const ContactPack& pack : packs_)
+    double residual[kWideLanes] = {};
+    for (const ContactPack& pack : packs_) {
       store_impulses(pack, s_.rows, s_.cold_rows);
+      double lane_residuals[kWideLanes];
+      pack_residuals(pack, s_.bodies, h, lane_residuals);
+      for (std::size_t k = 0; k < count_; ++k)
+        residual[k] = std::max(residual[k], lane_residuals[k]);
+    }
     for (std::size_t k = 0; k < count_; ++k)
-      lanes_[k]->record_residual(h);
+      reports_[k]->residual = residual[k];
     move();
     for (std::size_t k = 0; k < count_; ++k)
       lanes_[k]->apply_restitution();
@@ -442,9 +448,15 @@ class TeamIsland {
           return 0.0;
         },
         [](const ManifoldRows&) { return 0.0; }, false);
-    const double residual =
-        sweep_colours(s_, first_, last_, false, [&](std::span<const std::uint32_t> ids) {
-          return normal_residual(s_.rows, ids, s_.bodies, h);
+    const double residual = sweep_packs(
+        s_, first_, last_, false,
+        [&](const ContactPack& pack) {
+          double lane_residuals[kWideLanes];
+          pack_residuals(pack, s_.bodies, h, lane_residuals);
+          return *std::max_element(std::begin(lane_residuals), std::end(lane_residuals));
+        },
+        [&](const ManifoldRows& manifold) {
+          return normal_residual(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies, h);
         });
     move();
     each_manifold([&](std::span<const std::uint32_t> ids) {
