@@ -52,10 +52,10 @@ TUMBLE_INLINE Wide mass_of(Wide response) {
 }
 
 // The inverse of the leading count x count block of the symmetric `k` (of which it reads the
-// lower triangle and the diagonal) through its Cholesky
-// factor L (k = L L^T, inverse = L^-T L^-1), written out for at most four rows: Eigen's LLT of a
-// fixed 4x4 goes through its general blocked kernels, which cost more than the arithmetic (3% of
-// an awake pile's step). Leaves `inverse` zero when k is not positive definite.
+// lower triangle and the diagonal) through its Cholesky factor L (k = L L^T, inverse =
+// L^-T L^-1), written out for at most four rows: Eigen's LLT of a fixed 4x4 goes through its
+// general blocked kernels, which cost more than the arithmetic (3% of an awake pile's step).
+// Leaves `inverse` zero when k is not positive definite.
 void invert_positive_definite(const Eigen::Matrix4d& k, int count, Eigen::Matrix4d* inverse) {
   double l[4][4] = {};
   for (int j = 0; j < count; ++j) {
