@@ -158,11 +158,13 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   // (2) One sorted array: the threads' sorted runs merged in thread order.
   merge_sorted(thread_entries_, threads, &entries_, &merge_buffer_);
 
+  // Whether a and b may touch: two bodies, one of them movable, bounds overlapping.
+  const auto may_touch = [&](std::uint32_t a, std::uint32_t b) {
+    return a != b && (input.movable[a] || input.movable[b]) && bounds[a].overlaps(bounds[b]);
+  };
   // Bodies off the grid meet the others directly, once.
   const auto meet = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
-    if (a == b || !(input.movable[a] || input.movable[b])) return;
-    if (!bounds[a].overlaps(bounds[b])) return;
-    out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+    if (may_touch(a, b)) out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
   };
   // Two boxes that overlap share every cell their overlap covers, but a pair is emitted only from
   // the cell holding its overlap's lowest corner (on the level where it was found): once, not once
@@ -170,8 +172,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   // whose keys collide can still give a pair twice; the reduction's unique pass removes those.)
   const auto emit = [&](std::uint32_t a, std::uint32_t b, int level, std::uint32_t key,
                         std::vector<BodyPair>& out) {
-    if (a == b || !(input.movable[a] || input.movable[b])) return;
-    if (!bounds[a].overlaps(bounds[b])) return;
+    if (!may_touch(a, b)) return;
     const double cell = base * std::ldexp(1.0, level);
     // Floored as the boxes' corners were when their cells were listed, so the corner's cell is one
     // both boxes listed.

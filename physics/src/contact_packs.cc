@@ -200,12 +200,18 @@ TUMBLE_INLINE void scatter(const ContactPack& pack, WideMask lanes, const WidePa
   }
 }
 
-// current_separation, lane by lane, set in the lanes where the point is present.
+// current_separation, lane by lane.
+TUMBLE_INLINE Wide current_separation(const ContactPack& pack, const WidePair& motion,
+                                      const PackPoint& point) {
+  return point.separation + dot(pack.normal, motion.vb - motion.va) +
+         dot(motion.wb, point.rb_cross_n) - dot(motion.wa, point.ra_cross_n);
+}
+
+// The same, set in the lanes where the point is present.
 TUMBLE_INLINE void set_substep_separation(const ContactPack& pack, const WidePair& motion,
                                           PackPoint& point) {
-  const Wide separation = point.separation + dot(pack.normal, motion.vb - motion.va) +
-                          dot(motion.wb, point.rb_cross_n) - dot(motion.wa, point.ra_cross_n);
-  point.substep_separation = select(point.present, separation, point.substep_separation);
+  point.substep_separation =
+      select(point.present, current_separation(pack, motion, point), point.substep_separation);
 }
 
 // normal_target's bias, mass scale and impulse scale, lane by lane.
@@ -428,8 +434,7 @@ void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies,
     const PackPoint& point = pack.point[p];
     // Rows that nothing can move are left out, as normal_residual leaves them.
     const WideMask measured = point.present & (point.normal_mass > 0);
-    const Wide separation = point.separation + dot(pack.normal, motion.vb - motion.va) +
-                            dot(motion.wb, point.rb_cross_n) - dot(motion.wa, point.ra_cross_n);
+    const Wide separation = current_separation(pack, motion, point);
     const Wide target = select(separation > 0, -separation / h, wide(0));
     const Wide gap_velocity = normal_velocity(pack, point, pair) - target;
     const Wide impulse_velocity = point.normal_impulse / point.normal_mass;

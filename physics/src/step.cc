@@ -140,12 +140,9 @@ class SerialIsland {
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    record_residual(h);
+    report_->residual = normal_residual(rows_, c_.rows, bodies_, h);
     move();
     apply_restitution();
-  }
-  void record_residual(double h) {
-    report_->residual = normal_residual(rows_, c_.rows, bodies_, h);
   }
   void apply_restitution() {
     tumble::apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_,
