@@ -14,6 +14,14 @@ TUMBLE_INLINE WideMask mask_of(const bool (&on)[kWideLanes]) {
   return WideMask{on[0] ? -1 : 0, on[1] ? -1 : 0, on[2] ? -1 : 0, on[3] ? -1 : 0};
 }
 
+// Where entry (i, j) of a block's inverse is kept (ContactPack::block_inverse): its lower triangle.
+constexpr int triangle_index(int i, int j) {
+  return i >= j ? i * (i + 1) / 2 + j : j * (j + 1) / 2 + i;
+}
+TUMBLE_INLINE const Wide& block_entry(const ContactPack& pack, int i, int j) {
+  return pack.block_inverse[triangle_index(i, j)];
+}
+
 // A row of zeros, which lanes without a point p copy: they compute on zeros and write nothing.
 ContactRow zero_row() {
   ContactRow row;
@@ -100,9 +108,8 @@ void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
     pack->first_row[k] = 0;
     pack->points[k] = 0;
     first_rows[k] = &kZeroRow;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        pack->block_inverse[i][j][k] = 0;
+    for (Wide& entry : pack->block_inverse)
+      entry[k] = 0;
     if (manifolds[k] == kNoManifold) continue;
     first_rows[k] = &first;
     const int count = static_cast<int>(row_begin[m + 1] - row_begin[m]);
@@ -114,8 +121,8 @@ void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
     alone[k] = count == 1;
     in_block[k] = count > 1;
     for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        pack->block_inverse[i][j][k] = blocks[m].inverse(i, j);
+      for (int j = 0; j <= i; ++j)
+        pack->block_inverse[triangle_index(i, j)][k] = blocks[m].inverse(i, j);
     for (int p = 0; p < count; ++p) {
       present[p][k] = true;
       rubs[p][k] = rows[row_begin[m] + p].friction > 0;
@@ -484,8 +491,8 @@ solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodie
     WideMask feasible = in_block;
     for (int i = 0; i < most; ++i) {
       const PackPoint& point = pack.point[i];
-      const Wide step = pack.block_inverse[i][0] * error[0] + pack.block_inverse[i][1] * error[1] +
-                        pack.block_inverse[i][2] * error[2] + pack.block_inverse[i][3] * error[3];
+      const Wide step = block_entry(pack, i, 0) * error[0] + block_entry(pack, i, 1) * error[1] +
+                        block_entry(pack, i, 2) * error[2] + block_entry(pack, i, 3) * error[3];
       updated[i] = point.normal_impulse - targets[i].mass_scale * step -
                    targets[i].impulse_scale * point.normal_impulse;
       feasible &= ~point.present | (updated[i] >= 0);

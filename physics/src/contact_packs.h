@@ -43,7 +43,10 @@ struct ContactPack {
   WideMask moves_a, moves_b;  // a moving body, which the lane writes back; statics are shared
   WideMask alone;             // one point: solved without its block
   WideMask in_block;          // several points: NormalBlock's solve first
-  Wide block_inverse[4][4];   // NormalBlock::inverse(i, j), lane by lane
+  // NormalBlock::inverse's lower triangle, lane by lane: (i, j) with j <= i at i (i + 1) / 2 + j.
+  // The inverse is symmetric to the bit (invert_positive_definite writes each entry to both sides),
+  // so the upper half would repeat it: 6 of the pack's 16 block vectors, read every sweep.
+  Wide block_inverse[10];
   std::uint32_t a[kWideLanes] = {}, b[kWideLanes] = {};  // body slots
   std::uint32_t first_row[kWideLanes] = {};              // the lane's manifold's rows follow it
   std::uint8_t points[kWideLanes] = {};                  // 0 in lanes without a manifold

@@ -462,16 +462,11 @@ class TeamIsland {
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    sweep_packs(
-        s_, first_, last_, false,
-        [&](const ContactPack& pack) {
-          store_impulses(pack, s_.rows, s_.cold_rows);
-          return 0.0;
-        },
-        [](const ManifoldRows&) { return 0.0; }, false);
+    // One pass over the packs for both: a large island's packs come from memory each pass.
     const double residual = sweep_packs(
         s_, first_, last_, false,
         [&](const ContactPack& pack) {
+          store_impulses(pack, s_.rows, s_.cold_rows);
           double lane_residuals[kWideLanes];
           pack_residuals(pack, s_.bodies, h, lane_residuals);
           return *std::max_element(std::begin(lane_residuals), std::end(lane_residuals));
