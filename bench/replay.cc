@@ -1,0 +1,125 @@
+// The same stretch of a scene stepped again and again from one saved state, for comparing two
+// builds of the engine with less noise than whole runs give: a whole run's time moves with its
+// chaotic first seconds (where a pile lands, which islands are exact) and with everything else
+// the shared machine does meanwhile; here every round steps exactly the same work (a restored
+// world steps on bit for bit, World::save_state), and the rounds of two builds can be alternated.
+//
+// Usage: bench_replay SCENE [FROM [STEPS [ROUNDS [THREADS]]]]
+//   SCENE    a standard scene (standard.h): pile:16000, pyramid:20, ...
+//   FROM     steps taken once before the state is saved (default 120)
+//   STEPS    steps per round from that state (default 10)
+//   ROUNDS   rounds (default 5)
+//   THREADS  step threads (default 1)
+// Sleeping is off, so the whole scene is awake. Prints the mean time per step of each stage per
+// round, then each stage's minimum and median over the rounds, and the state's hash after a round
+// (the same in every round, and in two builds that change no bit).
+//
+// Comparing builds A and B: run them alternately, e.g.
+//   for r in 1 2 3; do A/bench_replay pile:16000; B/bench_replay pile:16000; done
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "physics/world.h"
+#include "scene_runner.h"  // tests/: state_hash
+#include "scenes/standard.h"
+
+namespace {
+
+using namespace tumble;
+
+struct Times {
+  double broad = 0, narrow = 0, prepare = 0, solve = 0, total = 0;
+};
+
+int whole_argument(int argc, char** argv, int index, int fallback, int least, int most) {
+  if (argc <= index) return fallback;
+  char* end = nullptr;
+  const long value = std::strtol(argv[index], &end, 10);
+  if (*end != '\0' || value < least || value > most) {
+    std::fprintf(stderr,
+                 "bench_replay: argument %d (\"%s\") must be a whole number from %d to %d\n", index,
+                 argv[index], least, most);
+    std::exit(2);
+  }
+  return static_cast<int>(value);
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: bench_replay SCENE [FROM [STEPS [ROUNDS [THREADS]]]]\n");
+    return 2;
+  }
+  const int from = whole_argument(argc, argv, 2, 120, 0, 100000);
+  const int steps = whole_argument(argc, argv, 3, 10, 1, 100000);
+  const int rounds = whole_argument(argc, argv, 4, 5, 1, 1000);
+  const int threads = whole_argument(argc, argv, 5, 1, 1, 256);
+  Result<SceneDef> scene = standard_scene(argv[1]);
+  if (!scene.ok()) {
+    std::fprintf(stderr, "bench_replay: %s\n", scene.status().message().c_str());
+    return 2;
+  }
+  scene.value().world.threads = threads;
+  scene.value().world.solver.sleeping = false;
+  const double dt = scene.value().dt;
+  Result<World> made = make_world(scene.value());
+  if (!made.ok()) {
+    std::fprintf(stderr, "bench_replay: %s\n", made.status().message().c_str());
+    return 2;
+  }
+  for (int i = 0; i < from; ++i)
+    (void)made.value().step(dt);
+  const WorldStateData saved = made.value().save_state();
+  const WorldSettings settings = made.value().settings();
+
+  std::printf("%s from step %d, %d steps a round, %d thread(s), sleeping off: ms per step\n",
+              argv[1], from, steps, threads);
+  std::printf("round   broad  narrow prepare   solve   total  state hash\n");
+  std::vector<Times> per_round;
+  for (int round = 0; round < rounds; ++round) {
+    World world = World::from_state(settings, saved).value();
+    Times sum;
+    for (int i = 0; i < steps; ++i) {
+      (void)world.step(dt);
+      const StageTimes& t = world.last_step().time;
+      sum.broad += t.broad_phase;
+      sum.narrow += t.narrow_phase;
+      sum.prepare += t.prepare;
+      sum.solve += t.solve;
+      sum.total += t.total;
+    }
+    const double scale = 1e3 / steps;
+    const Times mean{sum.broad * scale, sum.narrow * scale, sum.prepare * scale, sum.solve * scale,
+                     sum.total * scale};
+    per_round.push_back(mean);
+    std::printf("%5d %7.3f %7.3f %7.3f %7.3f %7.3f  %016llx\n", round + 1, mean.broad, mean.narrow,
+                mean.prepare, mean.solve, mean.total,
+                static_cast<unsigned long long>(tumble::testing::state_hash(world)));
+  }
+  const auto stage = [&](double Times::*field) {
+    std::vector<double> values;
+    for (const Times& t : per_round)
+      values.push_back(t.*field);
+    return values;
+  };
+  for (const char* label : {"min", "median"}) {
+    const bool is_min = label[1] == 'i';
+    const auto pick = [&](double Times::*field) {
+      const std::vector<double> values = stage(field);
+      return is_min ? *std::min_element(values.begin(), values.end()) : median(values);
+    };
+    std::printf("%-6s%7.3f %7.3f %7.3f %7.3f %7.3f\n", label, pick(&Times::broad),
+                pick(&Times::narrow), pick(&Times::prepare), pick(&Times::solve),
+                pick(&Times::total));
+  }
+  return 0;
+}
