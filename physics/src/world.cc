@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "broad_phase.h"
+#include "buffer_growth.h"
 #include "parallel.h"
 #include "step_scratch.h"
 
@@ -368,10 +369,10 @@ void World::find_contacts(double dt) {
   const std::int64_t n = static_cast<std::int64_t>(pairs_.size());
   // Every pair writes its own slot, then the touching ones are packed in pair order: the same
   // result for any thread count.
-  contacts_.resize(pairs_.size());
-  s.next_pairs.resize(pairs_.size());
-  s.previous_pair.resize(pairs_.size());
-  s.reused.resize(pairs_.size());
+  resize_reusing(contacts_, pairs_.size());
+  resize_reusing(s.next_pairs, pairs_.size());
+  resize_reusing(s.previous_pair, pairs_.size());
+  resize_reusing(s.reused, pairs_.size());
   const double reuse = dt > 0 ? settings_.solver.manifold_reuse : 0.0;
   const std::uint32_t flags = or_over_indices(
       thread_count(settings_.threads), n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
