@@ -38,7 +38,7 @@ struct Colouring {
 
 // Scratch for colour_manifolds, reused from call to call.
 struct ColouringScratch {
-  std::vector<std::uint64_t> used;  // by body slot; all zero between calls
+  std::vector<std::uint64_t> used;  // by body; all zero between calls
   std::vector<std::uint8_t> colour_of;
 };
 

@@ -47,7 +47,7 @@ struct ContactPack {
   // The inverse is symmetric to the bit (invert_positive_definite writes each entry to both sides),
   // so the upper half would repeat it: 6 of the pack's 16 block vectors, read every sweep.
   Wide block_inverse[10];
-  std::uint32_t a[kWideLanes] = {}, b[kWideLanes] = {};  // body slots
+  std::uint32_t a[kWideLanes] = {}, b[kWideLanes] = {};  // solver bodies
   std::uint32_t first_row[kWideLanes] = {};              // the lane's manifold's rows follow it
   std::uint8_t points[kWideLanes] = {};                  // 0 in lanes without a manifold
   std::uint8_t most_points = 0;

@@ -98,7 +98,8 @@ void invert_positive_definite(const Eigen::Matrix4d& k, int count, Eigen::Matrix
 #if defined(__x86_64__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
+void prepare_rows(const ContactManifold& manifold, std::uint32_t solver_a, const Body& a,
+                  std::uint32_t solver_b,
                   const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
                   ContactRow* rows, ContactRowCold* cold, NormalBlock* block) {
   TUMBLE_ASSERT(manifold.count >= 1 && manifold.count <= 4);
@@ -166,8 +167,8 @@ void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, B
     const ContactPoint& point = manifold.points[i];
     ContactRow row;
     ContactRowCold far;
-    row.a = id_a.index;
-    row.b = id_b.index;
+    row.a = solver_a;
+    row.b = solver_b;
     row.normal = n;
     far.ra = lane_of(ra, i);
     far.rb = lane_of(rb, i);

@@ -41,7 +41,8 @@ struct SolverBody {
   Vec3 w_free = Vec3::Zero();
 };
 
-// One contact point between bodies `a` and `b` (slot indices): what the velocity sweeps read and
+// One contact point between bodies `a` and `b` (the step's solver indices, StepScratch): what the
+// velocity sweeps read and
 // write, every sweep (the rest is in ContactRowCold, so that the sweeps stream through less).
 struct ContactRow {
   std::uint32_t a = 0, b = 0;
@@ -94,8 +95,8 @@ struct NormalBlock {
 // which is blocks[block_index]. A row starts from the impulse of the point in `previous` (the
 // pair's record of the last step; null: none) with its feature id, or else of the nearest one
 // close enough.
-void prepare_rows(const ContactManifold& manifold, BodyId id_a, const Body& a, BodyId id_b,
-                  const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
+void prepare_rows(const ContactManifold& manifold, std::uint32_t solver_a, const Body& a,
+                  std::uint32_t solver_b, const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
                   ContactRow* rows, ContactRowCold* cold, NormalBlock* block);
 
 // Spring parameters of a soft contact over a substep h (Catto 2011, "Soft constraints").

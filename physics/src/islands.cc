@@ -17,14 +17,14 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
 
 void build_islands(std::span<const std::uint8_t> dynamic, std::span<const IslandLink> links,
                    Islands* out) {
-  const std::uint32_t slots = static_cast<std::uint32_t>(dynamic.size());
+  const std::uint32_t body_count = static_cast<std::uint32_t>(dynamic.size());
   std::vector<std::uint32_t>& parent = out->parent;
-  parent.resize(slots);
+  parent.resize(body_count);
   std::iota(parent.begin(), parent.end(), 0u);
   for (const IslandLink& link : links) {
     if (!dynamic[link.a] || !dynamic[link.b]) continue;
     const std::uint32_t ra = find_root(parent, link.a), rb = find_root(parent, link.b);
-    // The lower slot becomes the root, so roots are the islands' lowest bodies.
+    // The lower index becomes the root, so roots are the islands' lowest bodies.
     if (ra < rb)
       parent[rb] = ra;
     else if (rb < ra)
@@ -33,17 +33,17 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
 
   constexpr std::uint32_t kNone = UINT32_MAX;
   std::vector<std::uint32_t>& island_of = out->island_of;
-  island_of.assign(slots, kNone);
+  island_of.assign(body_count, kNone);
   std::vector<std::uint32_t>& body_counts = out->body_counts;
   body_counts.clear();
-  for (std::uint32_t s = 0; s < slots; ++s) {
+  for (std::uint32_t s = 0; s < body_count; ++s) {
     if (!dynamic[s]) continue;
     const std::uint32_t root = find_root(parent, s);
     if (root == s) {
       island_of[s] = static_cast<std::uint32_t>(body_counts.size());
       body_counts.push_back(0);
     } else {
-      island_of[s] = island_of[root];  // the root has a lower slot: already numbered
+      island_of[s] = island_of[root];  // the root has a lower index: already numbered
     }
     ++body_counts[island_of[s]];
   }
@@ -55,7 +55,7 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
   out->bodies.resize(out->body_begin[count]);
   std::vector<std::uint32_t>& cursor = out->cursor;
   cursor.assign(out->body_begin.begin(), out->body_begin.end() - 1);
-  for (std::uint32_t s = 0; s < slots; ++s)
+  for (std::uint32_t s = 0; s < body_count; ++s)
     if (dynamic[s]) out->bodies[cursor[island_of[s]]++] = s;
 
   std::vector<std::uint32_t>& link_counts = out->link_counts;

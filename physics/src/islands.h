@@ -9,7 +9,7 @@
 namespace tumble {
 
 struct IslandLink {
-  std::uint32_t a, b;  // body slots
+  std::uint32_t a, b;  // bodies: the step's solver indices (step_scratch.h)
 };
 
 struct Islands {
@@ -23,8 +23,8 @@ struct Islands {
   std::vector<std::uint32_t> parent, island_of, body_counts, link_counts, cursor;
 };
 
-// `dynamic[slot]` marks the bodies that move; every link touches at least one of them. Islands
-// come in the order of their lowest body slot, so the result does not depend on link order
+// `dynamic[body]` marks the bodies that move; every link touches at least one of them. Islands
+// come in the order of their lowest body, so the result does not depend on link order
 // beyond the lists' own order.
 void build_islands(std::span<const std::uint8_t> dynamic, std::span<const IslandLink> links,
                    Islands* out);

@@ -34,7 +34,7 @@ struct IslandContext {
   std::span<const std::uint32_t> rows;
   StepScratch& scratch;
   const WorldSettings& settings;
-  std::span<const Body* const> body_of_slot;
+  std::span<const Body* const> body_of;  // by solver index
 };
 
 // The velocity recipe of one island, written once for every solver and thread count. `run`
@@ -104,15 +104,15 @@ class SerialIsland {
 
   bool has_rows() const { return !c_.rows.empty(); }
   void integrate_velocities(double h) {
-    for (std::uint32_t slot : c_.bodies) {
-      if (!integrate_velocity(*c_.body_of_slot[slot], c_.scratch.poses[slot].orientation,
-                              c_.settings.gravity, h, &bodies_[slot]))
+    for (std::uint32_t k : c_.bodies) {
+      if (!integrate_velocity(*c_.body_of[k], c_.scratch.poses[k].orientation,
+                              c_.settings.gravity, h, &bodies_[k]))
         ++report_->gyroscopic_limit_hits;
     }
   }
   void integrate_positions(double h) {
-    for (std::uint32_t slot : c_.bodies)
-      integrate_position(h, &bodies_[slot], &c_.scratch.poses[slot]);
+    for (std::uint32_t k : c_.bodies)
+      integrate_position(h, &bodies_[k], &c_.scratch.poses[k]);
   }
   void refresh_separations() { update_separations(rows_, c_.rows, bodies_); }
   void warm_start(bool keep_last_substep) {
@@ -163,7 +163,7 @@ IslandContext island_context(StepScratch& s, const WorldSettings& settings, std:
           .subspan(s.islands.body_begin[i], s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
       std::span(s.island_rows)
           .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]),
-      s, settings, s.body_of_slot};
+      s, settings, s.body_of};
 }
 
 // advance_with's parts for up to kWideLanes small islands of the same recipe (soft with the
@@ -391,9 +391,9 @@ std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
   const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
 #pragma omp for schedule(static)
   for (std::int64_t k = 0; k < n; ++k) {
-    const std::uint32_t slot = c.bodies[k];
-    if (!integrate_velocity(*c.body_of_slot[slot], c.scratch.poses[slot].orientation,
-                            c.settings.gravity, h, &c.scratch.bodies[slot]))
+    const std::uint32_t body = c.bodies[k];
+    if (!integrate_velocity(*c.body_of[body], c.scratch.poses[body].orientation,
+                            c.settings.gravity, h, &c.scratch.bodies[body]))
       ++hits;
   }
   return hits;
@@ -403,8 +403,8 @@ void team_integrate_positions(const IslandContext& c, double h) {
   const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
 #pragma omp for schedule(static)
   for (std::int64_t k = 0; k < n; ++k) {
-    const std::uint32_t slot = c.bodies[k];
-    integrate_position(h, &c.scratch.bodies[slot], &c.scratch.poses[slot]);
+    const std::uint32_t body = c.bodies[k];
+    integrate_position(h, &c.scratch.bodies[body], &c.scratch.poses[body]);
   }
 }
 
@@ -564,26 +564,49 @@ Status World::step(double dt) {
   return Status::ok();
 }
 
+void World::number_solver_bodies() {
+  StepScratch& s = *scratch_;
+  // Only the slots the last step numbered are cleared: no pass over every slot.
+  for (std::uint32_t slot : s.solver_slot)
+    if (slot < s.solver_of_slot.size()) s.solver_of_slot[slot] = kNoSolverBody;
+  s.solver_of_slot.resize(bodies_.size(), kNoSolverBody);
+  const std::span<const std::uint32_t> awake = awake_slots();
+  s.solver_slot.assign(awake.begin(), awake.end());
+  s.moving = static_cast<std::uint32_t>(awake.size());
+  for (std::uint32_t k = 0; k < s.moving; ++k) {
+    TUMBLE_ASSERT(bodies_[awake[k]].alive && bodies_[awake[k]].body.is_moving());
+    s.solver_of_slot[awake[k]] = k;
+  }
+  for (const Contact& contact : contacts_) {
+    for (const std::uint32_t slot : {contact.a.index, contact.b.index}) {
+      if (s.solver_of_slot[slot] != kNoSolverBody) continue;
+      s.solver_of_slot[slot] = static_cast<std::uint32_t>(s.solver_slot.size());
+      s.solver_slot.push_back(slot);
+    }
+  }
+}
+
 void World::prepare_contacts(double dt) {
   StepScratch& s = *scratch_;
-  const std::size_t slots = bodies_.size();
-  s.bodies.resize(slots);
-  s.poses.resize(slots);
-  s.dynamic.resize(slots);
+  number_solver_bodies();
+  const std::uint32_t solver_bodies = static_cast<std::uint32_t>(s.solver_slot.size());
+  s.bodies.resize(solver_bodies);
+  s.poses.resize(solver_bodies);
+  s.dynamic.resize(solver_bodies);
+  s.body_of.resize(solver_bodies);
   const int threads = team_size(settings_.threads);
-  const std::int64_t slot_count = static_cast<std::int64_t>(slots);
-  for_indices(threads, slots > 256, slot_count, [&](std::int64_t i) {
-    const Slot& slot = bodies_[i];
-    SolverBody& sb = s.bodies[i];
+  for_indices(threads, solver_bodies > 256, solver_bodies, [&](std::int64_t k) {
+    const Body& body = bodies_[s.solver_slot[k]].body;
+    SolverBody& sb = s.bodies[k];
     sb = SolverBody{};
-    s.dynamic[i] = slot.alive && slot.body.is_moving();
-    if (!slot.alive) return;
-    s.poses[i] = slot.body.pose();
-    if (!s.dynamic[i]) return;
-    sb.v = slot.body.linear_velocity;
-    sb.w = slot.body.angular_velocity;
-    sb.inverse_mass = slot.body.inverse_mass;
-    sb.inverse_inertia = slot.body.inverse_inertia_world;
+    s.dynamic[k] = k < s.moving;
+    s.body_of[k] = &body;
+    s.poses[k] = body.pose();
+    if (!s.dynamic[k]) return;
+    sb.v = body.linear_velocity;
+    sb.w = body.angular_velocity;
+    sb.inverse_mass = body.inverse_mass;
+    sb.inverse_inertia = body.inverse_inertia_world;
   });
 
   // Every manifold's rows have a place known in advance, so they are built in parallel.
@@ -596,7 +619,7 @@ void World::prepare_contacts(double dt) {
   for (std::size_t m = 0; m < manifolds; ++m) {
     const Contact& contact = contacts_[m];
     s.row_begin[m + 1] = s.row_begin[m] + static_cast<std::uint32_t>(contact.manifold.count);
-    s.links[m] = {contact.a.index, contact.b.index};
+    s.links[m] = {s.solver_of_slot[contact.a.index], s.solver_of_slot[contact.b.index]};
     s.touching[m] = contact.manifold.depth > -settings_.solver.slop;
     stats_.reused_manifolds += s.reused[m];
     deepest = std::max(deepest, contact.manifold.depth);
@@ -614,17 +637,14 @@ void World::prepare_contacts(double dt) {
   for_indices(threads, count > 64, count, [&](std::int64_t m) {
     const Contact& contact = contacts_[m];
     const std::uint32_t previous = s.previous_pair[m];
-    prepare_rows(contact.manifold, contact.a, bodies_[contact.a.index].body, contact.b,
+    prepare_rows(contact.manifold, s.links[m].a, bodies_[contact.a.index].body, s.links[m].b,
                  bodies_[contact.b.index].body,
                  previous == kNoRecord ? nullptr : &s.pairs[previous],
                  static_cast<std::uint32_t>(m), &s.rows[s.row_begin[m]],
                  &s.cold_rows[s.row_begin[m]], &s.blocks[m]);
   });
   build_islands(s.dynamic, s.links, &s.islands);
-  s.body_of_slot.resize(slots);  // reused: no allocation once warmed up
-  for (std::size_t i = 0; i < slots; ++i)
-    s.body_of_slot[i] = &bodies_[i].body;
-  s.support_level.resize(slots);
+  s.support_level.resize(solver_bodies);
 
   const std::size_t islands = s.islands.count();
   s.island_rows.clear();
@@ -678,7 +698,7 @@ void World::prepare_contacts(double dt) {
                                            s.islands.link_begin[i + 1] - s.islands.link_begin[i]);
     if (kind == IslandSolver::kSoft) {
       const IslandStiffness stiffness = island_stiffness(
-          island_bodies, island_links, s.links, s.touching, s.dynamic, s.body_of_slot,
+          island_bodies, island_links, s.links, s.touching, s.dynamic, s.body_of,
           settings_.gravity, dt, solver, &s.support_level, &s.level_sums);
       s.reports[i].substeps = stiffness.substeps;
       s.reports[i].contact_hertz = stiffness.contact_hertz;
@@ -746,6 +766,7 @@ void World::prepare_contacts(double dt) {
     pack_manifolds(lanes, s.row_begin, s.rows, s.blocks, s.bodies, &s.packs[k]);
   });
 
+  stats_.solver_bodies = solver_bodies;
   stats_.pairs = static_cast<std::uint32_t>(pairs_.size());
   stats_.manifolds = static_cast<std::uint32_t>(contacts_.size());
   stats_.contact_points = static_cast<std::uint32_t>(s.rows.size());
@@ -924,48 +945,52 @@ std::uint32_t World::wake_touched() {
 void World::update_sleep(double dt) {
   StepScratch& s = *scratch_;
   const SolverSettings& solver = settings_.solver;
+  bool fell_asleep = false;
   for (std::size_t i = 0; i < s.islands.count(); ++i) {
     double shortest = std::numeric_limits<double>::infinity();
     for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
-      Body& body = bodies_[s.islands.bodies[k]].body;
+      Body& body = bodies_[s.solver_slot[s.islands.bodies[k]]].body;
       const bool slow = body.linear_velocity.norm() < solver.sleep_linear_speed &&
                         body.angular_velocity.norm() < solver.sleep_angular_speed;
       body.sleep_timer = slow ? body.sleep_timer + dt : 0.0;
       shortest = std::min(shortest, body.sleep_timer);
     }
     if (!solver.sleeping || shortest < solver.sleep_delay) continue;
-    const std::uint32_t island = s.islands.bodies[s.islands.body_begin[i]];
+    // Named by its lowest slot (solver indices keep the slots' order).
+    const std::uint32_t island = s.solver_slot[s.islands.bodies[s.islands.body_begin[i]]];
     for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
-      Body& body = bodies_[s.islands.bodies[k]].body;
+      const std::uint32_t slot = s.solver_slot[s.islands.bodies[k]];
+      Body& body = bodies_[slot].body;
       body.asleep = true;
       body.sleep_island = island;
-      link_sleeper(s.islands.bodies[k], island);
+      link_sleeper(slot, island);
       body.linear_velocity.setZero();
       body.angular_velocity.setZero();
+      fell_asleep = true;
     }
   }
-  for (const Slot& slot : bodies_)
-    stats_.sleeping_bodies += slot.alive && slot.body.asleep ? 1 : 0;
+  if (fell_asleep)
+    std::erase_if(awake_, [&](std::uint32_t slot) { return bodies_[slot].body.asleep; });
+  stats_.sleeping_bodies = static_cast<std::uint32_t>(sleeping_count_);
 }
 
 void World::finish_step(double dt) {
   StepScratch& s = *scratch_;
   const int threads = team_size(settings_.threads);
-  const std::int64_t slots = static_cast<std::int64_t>(bodies_.size());
+  const std::int64_t moving = s.moving;
   const std::int64_t manifolds = static_cast<std::int64_t>(contacts_.size());
   TUMBLE_ASSERT(s.cold_rows.size() == s.rows.size() && s.row_begin.size() == contacts_.size() + 1 &&
                 s.row_begin.back() == s.rows.size());
   TUMBLE_ASSERT(s.next_pairs.size() == contacts_.size());
   impulses_.resize(s.rows.size());
   std::uint32_t non_finite = 0, slowed = 0, stopped = 0;
-  run_region(threads, slots > 256, [&] {
+  run_region(threads, std::max(moving, manifolds) > 256, [&] {
     std::uint32_t my_non_finite = 0, my_slowed = 0, my_stopped = 0;
 #pragma omp for schedule(static) nowait
-    for (std::int64_t i = 0; i < slots; ++i) {
-      if (!s.dynamic[i]) continue;
-      Body& body = bodies_[i].body;
+    for (std::int64_t k = 0; k < moving; ++k) {
+      Body& body = bodies_[s.solver_slot[k]].body;
       const std::uint8_t guard =
-          take_step_result(&body, s.poses[i], s.bodies[i].v, s.bodies[i].w, settings_.limits);
+          take_step_result(&body, s.poses[k], s.bodies[k].v, s.bodies[k].w, settings_.limits);
       my_non_finite += (guard & kStepNonFinite) != 0;
       my_slowed += (guard & kStepSlowed) != 0;
       my_stopped += (guard & kStepAtEdge) != 0;

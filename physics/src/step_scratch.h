@@ -36,10 +36,21 @@ struct IslandReport {
 // answer does not depend on the thread count).
 constexpr std::uint32_t kColouredIsland = 64;
 
+// A slot without a solver body this step.
+constexpr std::uint32_t kNoSolverBody = UINT32_MAX;
+
 struct StepScratch {
-  std::vector<SolverBody> bodies;  // by slot
-  std::vector<Pose> poses;         // by slot
-  std::vector<std::uint8_t> dynamic;
+  // The step's bodies, dense, by solver index: the moving bodies in slot order, then the other
+  // bodies this step's contacts touch (statics: inverse mass 0, never written). A step visits
+  // these and not every slot of the world. Every per-body array below, the islands, the colouring
+  // and the rows' and packs' bodies are by solver index; solver_of_slot numbers a slot
+  // (kNoSolverBody where it has none), solver_slot names it back.
+  std::vector<std::uint32_t> solver_slot, solver_of_slot;
+  std::uint32_t moving = 0;  // solver indices [0, moving) move
+  std::vector<SolverBody> bodies;
+  std::vector<Pose> poses;
+  std::vector<std::uint8_t> dynamic;  // 1 for [0, moving)
+  std::vector<const Body*> body_of;
   std::vector<ContactRow> rows;           // manifold order
   std::vector<ContactRowCold> cold_rows;  // beside rows, row for row
   std::vector<NormalBlock> blocks;        // one per manifold
@@ -86,8 +97,7 @@ struct StepScratch {
   std::vector<std::uint32_t> swept_pairs;
   std::vector<ImpactResult> impacts;
   std::vector<double> first_impact;
-  std::vector<const Body*> body_of_slot;
-  std::vector<std::uint32_t> support_level;  // by slot, for tall_stacks.h
+  std::vector<std::uint32_t> support_level;  // for tall_stacks.h
   std::vector<LevelSums> level_sums;
   // The touching pairs as the last step left them, with their impulses (contact_pairs.h), sorted
   // by body pair; and this step's, contact for contact, with the index of each one's record in

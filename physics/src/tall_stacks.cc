@@ -19,8 +19,8 @@ std::uint32_t support_depth(std::span<const std::uint32_t> island_bodies,
                             std::span<const std::uint8_t> touching,
                             std::span<const std::uint8_t> dynamic,
                             std::vector<std::uint32_t>& level, bool* exhausted) {
-  for (std::uint32_t slot : island_bodies)
-    level[slot] = 0;  // not reached
+  for (std::uint32_t body : island_bodies)
+    level[body] = 0;  // not reached
   for (std::uint32_t l : island_links) {
     if (!touching[l]) continue;
     const IslandLink& link = links[l];
@@ -48,8 +48,8 @@ std::uint32_t support_depth(std::span<const std::uint32_t> island_bodies,
     }
   }
   std::uint32_t depth = 0;
-  for (std::uint32_t slot : island_bodies)
-    depth = std::max(depth, level[slot]);
+  for (std::uint32_t body : island_bodies)
+    depth = std::max(depth, level[body]);
   return depth;
 }
 
@@ -97,7 +97,7 @@ Column measure_column(std::span<const std::uint32_t> island_bodies,
                       std::span<const std::uint32_t> island_links,
                       std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
                       std::span<const std::uint8_t> dynamic,
-                      std::span<const Body* const> body_of_slot, const Vec3& gravity,
+                      std::span<const Body* const> body_of, const Vec3& gravity,
                       std::vector<std::uint32_t>* level, std::vector<LevelSums>* level_sums) {
   Column result;
   const double g = gravity.norm();
@@ -119,9 +119,9 @@ Column measure_column(std::span<const std::uint32_t> island_bodies,
   std::vector<LevelSums>& levels = *level_sums;
   levels.assign(levels_found + 1, LevelSums{});
   double tallest = 0;
-  for (std::uint32_t slot : island_bodies) {
-    const std::uint32_t l = (*level)[slot];
-    const Body& body = *body_of_slot[slot];
+  for (std::uint32_t index : island_bodies) {
+    const std::uint32_t l = (*level)[index];
+    const Body& body = *body_of[index];
     if (l == 0 || !(body.inverse_mass > 0)) continue;
     add_to_level(body, across1, across2, &levels[l]);
     tallest = std::max(tallest, height_along(body, up));
@@ -150,12 +150,12 @@ double buckling_at_settings(const Column& column, double dt, const SolverSetting
 IslandStiffness island_stiffness(
     std::span<const std::uint32_t> island_bodies, std::span<const std::uint32_t> island_links,
     std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
-    std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of_slot,
+    std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of,
     const Vec3& gravity, double dt, const SolverSettings& solver, std::vector<std::uint32_t>* level,
     std::vector<LevelSums>* level_sums) {
   IslandStiffness result;
   const Column column = measure_column(island_bodies, island_links, links, touching, dynamic,
-                                       body_of_slot, gravity, level, level_sums);
+                                       body_of, gravity, level, level_sums);
   result.capped = column.exhausted;
   if (column.depth < 2) return result;
   double hertz = 0;

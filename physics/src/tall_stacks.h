@@ -53,14 +53,14 @@ struct IslandStiffness {
   bool capped = false;
 };
 
-// One island's bodies (slots) and links (indices into `links`): the substeps and spring it
+// One island's bodies (the step's solver indices) and links (indices into `links`): the substeps and spring it
 // needs. Only links marked `touching` (overlapping, or apart by less than the slop) carry load:
-// speculative contacts between falling bodies make no column. `level` (by slot) and
+// speculative contacts between falling bodies make no column. `level` (by body) and
 // `level_sums` are working memory.
 IslandStiffness island_stiffness(
     std::span<const std::uint32_t> island_bodies, std::span<const std::uint32_t> island_links,
     std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
-    std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of_slot,
+    std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of,
     const Vec3& gravity, double dt, const SolverSettings& solver, std::vector<std::uint32_t>* level,
     std::vector<LevelSums>* level_sums);
 

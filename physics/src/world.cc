@@ -154,6 +154,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     Slot& slot = bodies_[index];
     slot.body = std::move(body);
     slot.alive = true;
+    if (slot.body.is_moving()) join_awake(index);
     ids.push_back({index, slot.generation});
     ++live_count_;
   }
@@ -165,6 +166,7 @@ Status World::remove_body(BodyId id) {
   Slot& slot = bodies_[id.index];
   wake_around(slot.body);                                     // whatever rested on it must fall
   if (slot.body.asleep) wake_island(slot.body.sleep_island);  // it leaves its island's set
+  if (slot.body.is_moving()) leave_awake(id.index);
   slot.alive = false;
   ++slot.generation;
   slot.body = Body();
@@ -265,6 +267,8 @@ std::uint32_t World::wake_island(std::uint32_t island) {
     body.asleep = false;
     body.sleep_timer = 0;
     ++woken;
+    --sleeping_count_;
+    join_awake(next);
     const std::uint32_t slot = next;
     next = sleeper_next_[slot];
     sleeper_next_[slot] = kNoSlot;
@@ -272,9 +276,29 @@ std::uint32_t World::wake_island(std::uint32_t island) {
   return woken;
 }
 
+void World::join_awake(std::uint32_t slot) {
+  awake_sorted_ = awake_sorted_ && (awake_.empty() || awake_.back() < slot);
+  awake_.push_back(slot);
+}
+
+void World::leave_awake(std::uint32_t slot) {
+  const auto at = std::find(awake_.begin(), awake_.end(), slot);
+  TUMBLE_ASSERT(at != awake_.end());
+  awake_.erase(at);  // erasing keeps the order
+}
+
+std::span<const std::uint32_t> World::awake_slots() {
+  if (!awake_sorted_) {
+    std::sort(awake_.begin(), awake_.end());
+    awake_sorted_ = true;
+  }
+  return awake_;
+}
+
 void World::link_sleeper(std::uint32_t slot, std::uint32_t island) {
   sleeper_next_[slot] = sleeper_head_[island];
   sleeper_head_[island] = slot;
+  ++sleeping_count_;
 }
 
 Status World::wake(BodyId id) {

@@ -22,13 +22,15 @@ void World::sweep_fast_bodies(double /*dt*/) {
     if (fast_[pairs_[k].a] || fast_[pairs_[k].b]) s.swept_pairs.push_back(k);
   s.impacts.resize(s.swept_pairs.size());
 
+  // A body that does not move this step may have no solver index: it stays where it is.
   auto motion_of = [&](std::uint32_t slot) {
     const Body& body = bodies_[slot].body;
     SweptMotion motion;
     motion.start = body.pose();
-    if (s.dynamic[slot]) {
-      motion.translation = s.poses[slot].position - body.position;
-      motion.rotation = s.bodies[slot].delta_angle;  // not wrapped at pi, unlike the end pose
+    const std::uint32_t k = s.solver_of_slot[slot];
+    if (k != kNoSolverBody && s.dynamic[k]) {
+      motion.translation = s.poses[k].position - body.position;
+      motion.rotation = s.bodies[k].delta_angle;  // not wrapped at pi, unlike the end pose
       motion.outer_radius = body.shape.outer_radius();
     }
     return motion;
@@ -69,9 +71,10 @@ void World::sweep_fast_bodies(double /*dt*/) {
     // (an energy gain of m g dz (1 - t) per impact).
     const double t = s.first_impact[slot];
     const Body& body = bodies_[slot].body;
-    s.poses[slot] = pose_at(motion_of(slot), t);
-    s.bodies[slot].v = body.linear_velocity + t * (s.bodies[slot].v - body.linear_velocity);
-    s.bodies[slot].w = body.angular_velocity + t * (s.bodies[slot].w - body.angular_velocity);
+    const std::uint32_t k = s.solver_of_slot[slot];  // fast bodies move: they have one
+    s.poses[k] = pose_at(motion_of(slot), t);
+    s.bodies[k].v = body.linear_velocity + t * (s.bodies[k].v - body.linear_velocity);
+    s.bodies[k].w = body.angular_velocity + t * (s.bodies[k].w - body.angular_velocity);
   }
 }
 

@@ -143,9 +143,11 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
   world.free_slots_ = std::move(state.free_slots);
   world.sleeper_head_.assign(slot_count, kNoSlot);
   world.sleeper_next_.assign(slot_count, kNoSlot);
-  for (std::uint32_t i = 0; i < slot_count; ++i)
-    if (world.bodies_[i].alive && world.bodies_[i].body.asleep)
-      world.link_sleeper(i, world.bodies_[i].body.sleep_island);
+  for (std::uint32_t i = 0; i < slot_count; ++i) {
+    if (!world.bodies_[i].alive) continue;
+    if (world.bodies_[i].body.asleep) world.link_sleeper(i, world.bodies_[i].body.sleep_island);
+    if (world.bodies_[i].body.is_moving()) world.awake_.push_back(i);
+  }
   world.live_count_ = live;
   world.time_ = state.time;
   world.stats_.step = state.step;

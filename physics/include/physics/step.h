@@ -111,6 +111,9 @@ struct StepStats {
   // |min(impulse / effective mass, normal velocity - target)|; 0 when exactly solved.
   double residual = 0;
   std::uint32_t sleeping_bodies = 0, woken_bodies = 0;
+  // Bodies the step solved: the moving ones and the others their contacts touch (statics).
+  // Sleepers and untouched statics cost the solver nothing, however many the world holds.
+  std::uint32_t solver_bodies = 0;
   // Continuous collision: bodies swept, of those stopped early, and swept pairs that hit the
   // iteration bound (they stop at the last safe time).
   std::uint32_t swept_bodies = 0, continuous_impacts = 0, continuous_limit_hits = 0;

@@ -144,6 +144,7 @@ class World {
   void run_broad_phase();
   void find_contacts(double dt);
   // Stages of step().
+  void number_solver_bodies();  // StepScratch's solver indices, for prepare_contacts
   void prepare_contacts(double dt);
   void solve_islands(double dt);
   void correct_positions();
@@ -157,6 +158,17 @@ class World {
   // with id i (its bodies' sleep_island) starts at sleeper_head_[i] and goes on through
   // sleeper_next_ (both by slot; UINT32_MAX ends a list).
   std::vector<std::uint32_t> sleeper_head_, sleeper_next_;
+  // The moving bodies' slots (dynamic and awake), so that a step visits them and not every slot:
+  // bodies join when they are made or wake, and leave when they fall asleep or are removed. The
+  // step wants them in slot order (it numbers its solver bodies so, and islands by their lowest
+  // body); joining may break the order, which the next step restores.
+  std::vector<std::uint32_t> awake_;
+  bool awake_sorted_ = true;
+  std::size_t sleeping_count_ = 0;  // bodies in sleeper_head_'s sets
+  void join_awake(std::uint32_t slot);
+  void leave_awake(std::uint32_t slot);
+  // The step's view of awake_: sorted (restoring the order joins broke).
+  std::span<const std::uint32_t> awake_slots();
   std::size_t live_count_ = 0;
   std::vector<Aabb> bounds_;
   std::vector<std::uint8_t> movable_;
