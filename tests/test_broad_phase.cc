@@ -105,6 +105,54 @@ TEST(BroadPhase, HugeAndFarBodiesCostNoMemoryInProportionToTheirSize) {
   }
 }
 
+// Resting bodies (not movable) keep their cells while the caller's resting_version stays: the
+// moving bodies move, grow and shrink between calls, and the pairs still equal brute force; a
+// change of the resting bodies under a new version is picked up. Most bodies rest here, and sizes
+// span 1 mm to 100 m, so moving boxes meet finer resting levels both cell by cell and body by body.
+TEST_P(BroadPhaseScenes, RestingCellsKeptWhileTheyDoNotChange) {
+  Random rng(5);
+  Scene scene = make_scene(GetParam(), rng, 1500);
+  for (std::size_t i = 0; i + 2 < scene.movable.size(); ++i)
+    scene.movable[i] = i % 7 == 0 ? 1 : 0;
+  auto moving_of = [](const Scene& s) {
+    std::vector<std::uint32_t> moving;
+    for (std::uint32_t i = 0; i < s.movable.size(); ++i)
+      if (s.movable[i]) moving.push_back(i);
+    return moving;
+  };
+  for (int threads : {1, 2}) {
+    HashGrid grid;
+    Scene now = scene;
+    std::uint64_t version = 7;
+    for (int call = 0; call < 6; ++call) {
+      if (call == 4) {
+        // A resting body grows over its neighbours and another starts to move.
+        now.bounds[3].max += Vec3::Constant(5);
+        now.movable[10] = 1;
+        ++version;
+      }
+      const std::vector<std::uint32_t> moving = moving_of(now);
+      BroadPhaseInput input{now.bounds, now.movable, threads};
+      input.moving = moving;
+      input.moving_listed = true;
+      input.resting_version = version;
+      std::vector<BodyPair> pairs;
+      grid.find_pairs(input, &pairs);
+      const std::vector<BodyPair> expected = brute_force(now);
+      ASSERT_GT(expected.size(), 20u);
+      EXPECT_EQ(pairs, expected) << threads << " threads, call " << call;
+      for (std::uint32_t i : moving) {
+        if (!now.bounds[i].is_bounded()) continue;
+        const Vec3 shift = rng.vector(-1, 1);
+        const double grow = rng.uniform(0.5, 2.0);
+        const Vec3 centre = 0.5 * (now.bounds[i].min + now.bounds[i].max) + shift;
+        const Vec3 half = 0.5 * grow * (now.bounds[i].max - now.bounds[i].min);
+        now.bounds[i] = {centre - half, centre + half};
+      }
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Scenes, BroadPhaseScenes,
                          ::testing::Values("uniform", "clustered", "wide", "borders", "far"));
 

@@ -77,7 +77,106 @@ void merge_sorted(const std::vector<std::vector<T>>& runs, int count, std::vecto
   }
 }
 
+// A body is on the grid unless it is unbounded (the ground half-space), larger than the top
+// level's cells, or so far out that its cell numbers would not fit an integer: such a body would
+// cover cells without bound (memory in proportion to its size), so it meets every body directly.
+bool off_grid(const Aabb& box, double base) {
+  const double top_cell = base * std::ldexp(1.0, kMaxLevels - 1);
+  const double farthest = base * kFarthestCell;
+  return !box.is_bounded() || box.extent().maxCoeff() > top_cell ||
+         box.min.cwiseAbs().maxCoeff() > farthest || box.max.cwiseAbs().maxCoeff() > farthest;
+}
+
+// The cells [lo, hi] a box covers on a level of cell size `cell`, floored as every listing and
+// lookup floors them (so that two boxes agree on the cells they share).
+struct CellRange {
+  Eigen::Array3d lo, hi;
+  CellRange(const Aabb& box, double cell)
+      : lo((box.min / cell).array().floor()), hi((box.max / cell).array().floor()) {}
+  double count() const { return (hi - lo + 1).prod(); }
+  template <class Fn>
+  void each(Fn&& fn) const {
+    for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
+      for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y()); ++y)
+        for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z());
+             ++z)
+          fn(x, y, z);
+  }
+};
+
 }  // namespace
+
+void HashGrid::list_cells(std::span<const Aabb> bounds, std::span<const std::uint32_t> bodies,
+                          int threads, std::vector<Entry>* out, std::uint64_t* occupied) {
+  std::uint64_t levels = 0;
+  const std::int64_t count = static_cast<std::int64_t>(bodies.size());
+  run_region(threads, count > 256, [&] {
+    const int t = omp_get_thread_num();
+    auto& mine = thread_entries_[t];
+    mine.clear();
+    std::uint64_t my_levels = 0;
+#pragma omp for schedule(static)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const std::uint32_t i = bodies[k];
+      const Aabb& box = bounds[i];
+      const double extent = box.extent().maxCoeff();
+      int level = 0;
+      double cell = base_;
+      while (cell < extent && level < kMaxLevels - 1) {
+        cell *= 2;
+        ++level;
+      }
+      level_[i] = static_cast<std::int8_t>(level);
+      my_levels |= 1ull << level;
+      CellRange(box, cell).each([&](std::int64_t x, std::int64_t y, std::int64_t z) {
+        mine.emplace_back(cell_key(level, x, y, z), i);
+      });
+    }
+#pragma omp atomic update
+    levels |= my_levels;
+    sort_by_high_half(&mine, &thread_scratch_[t]);
+  });
+  // One sorted array: the threads' sorted runs merged in thread order.
+  merge_sorted(thread_entries_, count > 256 ? threads : 1, out, &merge_buffer_);
+  *occupied = levels;
+}
+
+void HashGrid::list_resting(const BroadPhaseInput& input) {
+  const auto& bounds = input.bounds;
+  const std::size_t n = bounds.size();
+  // Base cell size: the median extent of the bounded bodies, moving or not. Kept with the resting
+  // cells: it changes the speed, never the pairs.
+  sizes_.clear();
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (!is_dead(bounds[i]) && bounds[i].is_bounded())
+      sizes_.push_back(bounds[i].extent().maxCoeff());
+  base_ = 1.0;
+  if (!sizes_.empty()) {
+    auto middle = sizes_.begin() + static_cast<std::ptrdiff_t>(sizes_.size() / 2);
+    std::nth_element(sizes_.begin(), middle, sizes_.end());
+    if (*middle > 0) base_ = kCellPerMedianExtent * *middle;
+  }
+  level_.assign(n, kDeadSlot);
+  resting_.clear();
+  resting_unbounded_.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (is_dead(bounds[i]) || input.movable[i]) continue;
+    if (off_grid(bounds[i], base_)) {
+      level_[i] = kMeetsEveryone;
+      resting_unbounded_.push_back(i);
+    } else {
+      resting_.push_back(i);
+    }
+  }
+  list_cells(bounds, resting_, std::max(1, input.threads), &resting_entries_, &resting_occupied_);
+  resting_on_level_.resize(kMaxLevels);
+  for (auto& level : resting_on_level_)
+    level.clear();
+  for (std::uint32_t i : resting_)
+    resting_on_level_[level_[i]].push_back(i);
+  resting_version_ = input.resting_version;
+  resting_slots_ = n;
+}
 
 void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
@@ -88,81 +187,36 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   thread_scratch_.resize(threads);
   thread_pairs_.resize(threads);
 
-  // Base cell size: the median extent of the bounded bodies.
-  sizes_.clear();
-  unbounded_.clear();
-  for (std::uint32_t i = 0; i < n; ++i) {
-    if (is_dead(bounds[i])) continue;
-    if (!bounds[i].is_bounded()) {
-      unbounded_.push_back(i);
-      continue;
-    }
-    sizes_.push_back(bounds[i].extent().maxCoeff());
+  std::span<const std::uint32_t> moving = input.moving;
+  if (!input.moving_listed) {
+    moving_found_.clear();
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (!is_dead(bounds[i]) && input.movable[i]) moving_found_.push_back(i);
+    moving = moving_found_;
   }
-  double base = 1.0;
-  if (!sizes_.empty()) {
-    auto middle = sizes_.begin() + static_cast<std::ptrdiff_t>(sizes_.size() / 2);
-    std::nth_element(sizes_.begin(), middle, sizes_.end());
-    if (*middle > 0) base = kCellPerMedianExtent * *middle;
-  }
-  // A body larger than the top level's cells, or so far out that its cell numbers would not fit
-  // an integer, would cover cells without bound (memory in proportion to its size): it joins the
-  // unbounded bodies and meets every body directly.
-  level_.assign(n, kDeadSlot);
-  const double top_cell = base * std::ldexp(1.0, kMaxLevels - 1);
-  const double farthest = base * kFarthestCell;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    if (is_dead(bounds[i])) continue;
-    const Aabb& box = bounds[i];
-    if (!box.is_bounded() || box.extent().maxCoeff() > top_cell ||
-        box.min.cwiseAbs().maxCoeff() > farthest || box.max.cwiseAbs().maxCoeff() > farthest) {
-      level_[i] = kMeetsEveryone;
-      if (box.is_bounded()) unbounded_.push_back(i);
-    }
-  }
-  std::sort(unbounded_.begin(), unbounded_.end());
-  std::uint64_t occupied = 0;  // bit per level
+  if (input.resting_version == 0 || input.resting_version != resting_version_ ||
+      resting_slots_ != n)
+    list_resting(input);
 
-  // (1) Cells of each body on its own level.
-  run_region(threads, true, [&] {
-    const int t = omp_get_thread_num();
-    auto& out = thread_entries_[t];
-    out.clear();
-    std::uint64_t mine = 0;
-#pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-      const Aabb& box = bounds[i];
-      if (is_dead(box) || level_[i] == kMeetsEveryone) continue;
-      const double extent = box.extent().maxCoeff();
-      int level = 0;
-      double cell = base;
-      while (cell < extent && level < kMaxLevels - 1) {
-        cell *= 2;
-        ++level;
-      }
-      level_[i] = static_cast<std::int8_t>(level);
-      mine |= 1ull << level;
-      const Eigen::Array3d lo = (box.min / cell).array().floor();
-      const Eigen::Array3d hi = (box.max / cell).array().floor();
-      for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
-        for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y());
-             ++y)
-          for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z());
-               ++z)
-            out.emplace_back(cell_key(level, x, y, z), static_cast<std::uint32_t>(i));
+  // (1) The moving bodies' cells, each on its own level.
+  moving_unbounded_.clear();
+  moving_on_grid_.clear();
+  for (std::uint32_t i : moving) {
+    if (off_grid(bounds[i], base_)) {
+      level_[i] = kMeetsEveryone;
+      moving_unbounded_.push_back(i);
+    } else {
+      moving_on_grid_.push_back(i);
     }
-#pragma omp atomic update
-    occupied |= mine;
-    sort_by_high_half(&out, &thread_scratch_[t]);
-  });
-  // (2) One sorted array: the threads' sorted runs merged in thread order.
-  merge_sorted(thread_entries_, threads, &entries_, &merge_buffer_);
+  }
+  std::uint64_t moving_occupied = 0;
+  list_cells(bounds, moving_on_grid_, threads, &moving_entries_, &moving_occupied);
+  const std::span<const std::uint32_t> on_grid = moving_on_grid_;
 
   // Whether a and b may touch: two bodies, one of them movable, bounds overlapping.
   const auto may_touch = [&](std::uint32_t a, std::uint32_t b) {
     return a != b && (input.movable[a] || input.movable[b]) && bounds[a].overlaps(bounds[b]);
   };
-  // Bodies off the grid meet the others directly, once.
   const auto meet = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
     if (may_touch(a, b)) out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
   };
@@ -173,9 +227,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   const auto emit = [&](std::uint32_t a, std::uint32_t b, int level, std::uint32_t key,
                         std::vector<BodyPair>& out) {
     if (!may_touch(a, b)) return;
-    const double cell = base * std::ldexp(1.0, level);
-    // Floored as the boxes' corners were when their cells were listed, so the corner's cell is one
-    // both boxes listed.
+    const double cell = base_ * std::ldexp(1.0, level);
     const Eigen::Array3d corner = (bounds[a].min.cwiseMax(bounds[b].min) / cell).array().floor();
     if (cell_key(level, static_cast<std::int64_t>(corner.x()),
                  static_cast<std::int64_t>(corner.y()),
@@ -183,64 +235,81 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
       return;
     out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
   };
+  // Body i against the bodies of `entries` listed on `level`, in the cells i covers there.
+  const auto look_up = [&](std::uint32_t i, int level, const std::vector<Entry>& entries,
+                           std::vector<BodyPair>& out) {
+    CellRange(bounds[i], base_ * std::ldexp(1.0, level))
+        .each([&](std::int64_t x, std::int64_t y, std::int64_t z) {
+          const std::uint32_t key = cell_key(level, x, y, z);
+          auto it = std::lower_bound(entries.begin(), entries.end(), Entry(key, 0));
+          for (; it != entries.end() && it->key() == key; ++it)
+            if (level_[it->body()] == level) emit(i, it->body(), level, key, out);
+        });
+  };
 
-  // (3) Candidate pairs.
-  const std::int64_t entry_count = static_cast<std::int64_t>(entries_.size());
+  // (2) Candidate pairs.
+  const std::int64_t entry_count = static_cast<std::int64_t>(moving_entries_.size());
+  const std::int64_t grid_count = static_cast<std::int64_t>(on_grid.size());
+  const std::int64_t moving_count = static_cast<std::int64_t>(moving.size());
   run_region(threads, true, [&] {
     auto& out = thread_pairs_[omp_get_thread_num()];
     out.clear();
-    // Same cell: each run of equal keys, visited from its first entry.
+    // Moving bodies in the same cell: each run of equal keys, visited from its first entry.
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < entry_count; ++i) {
-      const std::uint32_t key = entries_[i].key();
-      if (i > 0 && entries_[i - 1].key() == key) continue;
-      for (std::int64_t j = i; j < entry_count && entries_[j].key() == key; ++j) {
-        const std::uint32_t a = entries_[j].body();
-        for (std::int64_t k = j + 1; k < entry_count && entries_[k].key() == key; ++k) {
-          const std::uint32_t b = entries_[k].body();
+      const std::uint32_t key = moving_entries_[i].key();
+      if (i > 0 && moving_entries_[i - 1].key() == key) continue;
+      for (std::int64_t j = i; j < entry_count && moving_entries_[j].key() == key; ++j) {
+        const std::uint32_t a = moving_entries_[j].body();
+        for (std::int64_t k = j + 1; k < entry_count && moving_entries_[k].key() == key; ++k) {
+          const std::uint32_t b = moving_entries_[k].body();
           // Bodies of different levels meet in the coarser level's lookup below (here only
           // through a collision of keys).
           if (level_[a] == level_[b]) emit(a, b, level_[a], key, out);
         }
       }
     }
-    // Coarser levels: each body looks up the cells it covers there.
+    // Each moving body on the grid: the moving bodies of coarser levels, the resting bodies of its
+    // level and coarser ones in the cells it covers there, and the finer resting bodies in the
+    // cells it covers on their level, or one by one where they are fewer than those cells (a
+    // large box over fine gravel).
 #pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+    for (std::int64_t k = 0; k < grid_count; ++k) {
+      const std::uint32_t i = on_grid[k];
       const int own = level_[i];
-      if (own < 0) continue;  // dead, or meets everyone below
-      const Aabb& box = bounds[i];
-      // Only the occupied coarser levels (most scenes have one or two levels in all).
-      for (std::uint64_t above = occupied & ~((2ull << own) - 1); above != 0; above &= above - 1) {
-        const int level = std::countr_zero(above);
-        const double cell = base * std::ldexp(1.0, level);
-        const Eigen::Array3d lo = (box.min / cell).array().floor();
-        const Eigen::Array3d hi = (box.max / cell).array().floor();
-        for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x());
-             ++x)
-          for (auto y = static_cast<std::int64_t>(lo.y()); y <= static_cast<std::int64_t>(hi.y());
-               ++y)
-            for (auto z = static_cast<std::int64_t>(lo.z()); z <= static_cast<std::int64_t>(hi.z());
-                 ++z) {
-              const std::uint32_t key = cell_key(level, x, y, z);
-              auto it = std::lower_bound(entries_.begin(), entries_.end(), Entry(key, 0));
-              for (; it != entries_.end() && it->key() == key; ++it)
-                if (level_[it->body()] == level)
-                  emit(static_cast<std::uint32_t>(i), it->body(), level, key, out);
-            }
+      for (std::uint64_t above = moving_occupied & ~((2ull << own) - 1); above != 0;
+           above &= above - 1)
+        look_up(i, std::countr_zero(above), moving_entries_, out);
+      for (std::uint64_t levels = resting_occupied_; levels != 0; levels &= levels - 1) {
+        const int level = std::countr_zero(levels);
+        const auto& finer = resting_on_level_[level];
+        if (level < own &&
+            CellRange(bounds[i], base_ * std::ldexp(1.0, level)).count() > finer.size()) {
+          for (std::uint32_t r : finer)
+            meet(i, r, out);
+        } else {
+          look_up(i, level, resting_entries_, out);
+        }
       }
     }
-    // Unbounded and oversized bodies meet everyone (each such pair once).
+    // Bodies off the grid meet the others directly: resting ones every moving body, moving ones
+    // every body.
 #pragma omp for schedule(static) nowait
-    for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
-      if (level_[i] == kDeadSlot) continue;
-      for (std::uint32_t u : unbounded_)
-        if (level_[i] == kMeetsEveryone ? u < i : true) meet(static_cast<std::uint32_t>(i), u, out);
+    for (std::int64_t k = 0; k < moving_count; ++k)
+      for (std::uint32_t u : resting_unbounded_)
+        meet(moving[k], u, out);
+    if (!moving_unbounded_.empty()) {
+#pragma omp for schedule(static) nowait
+      for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+        if (is_dead(bounds[i])) continue;
+        for (std::uint32_t u : moving_unbounded_)
+          meet(static_cast<std::uint32_t>(i), u, out);
+      }
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
   });
-  // (4) Reduction: merge the threads' sorted lists, then drop pairs found by several threads.
+  // (3) Reduction: merge the threads' sorted lists, then drop pairs found by several threads.
   merge_sorted(thread_pairs_, threads, pairs, &pair_buffer_);
   pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
 }

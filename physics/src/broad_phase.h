@@ -8,13 +8,22 @@
 // numbers, stay out of the grid and are paired with every body directly: no body costs memory in
 // proportion to its size.
 //
-// Steps: (1) level and cells of every body, in parallel, into per-thread buffers of
-// (cell key, body) entries, each sorted by its thread (a radix sort on the key); (2) one sorted
-// array of entries, merged; (3) pairs within each cell, and each body against the cells of coarser
-// levels it covers (binary search), in parallel into per-thread pair buffers, keeping only pairs
-// whose boxes really overlap and that have a dynamic body, each buffer sorted and unique; (4) the
-// reduction: merge, drop duplicates (a pair shared by several cells and threads). The result is the
-// same for any thread count because it is sorted and unique.
+// Bodies that do not move (statics and sleepers: "resting") never pair with one another, and keep
+// their cells from call to call while the caller says they have not changed (resting_version), so
+// that a world of sleepers with a few moving bodies pays for the moving ones: each call lists the
+// moving bodies' cells, pairs them among themselves, and looks each one up among the resting
+// bodies' kept cells (Box2D v3 and Jolt keep static and sleeping bodies in trees of their own for
+// the same reason).
+//
+// Steps: (1) level and cells of every moving body (every resting body too when they changed), in
+// parallel, into per-thread buffers of (cell key, body) entries, each sorted by its thread (a radix
+// sort on the key), merged into one sorted array per set; (2) pairs within each cell, and each
+// moving body against the cells of coarser levels it covers (binary search) of both sets and of
+// the resting set's finer levels (or that level's bodies one by one, when they are fewer than the
+// cells), in parallel into per-thread pair buffers, keeping only pairs whose boxes really overlap,
+// each buffer sorted and unique; (3) the reduction: merge, drop duplicates. The result is the same
+// for any thread count, and whether resting cells were kept or listed anew, because it is the
+// sorted set of overlapping pairs.
 #pragma once
 
 #include <span>
@@ -26,8 +35,15 @@ namespace tumble {
 
 struct BroadPhaseInput {
   std::span<const Aabb> bounds;           // by body slot; an empty box is a dead slot
-  std::span<const std::uint8_t> movable;  // 1 for dynamic bodies
+  std::span<const std::uint8_t> movable;  // 1 for moving bodies (dynamic and awake)
   int threads = 1;
+  // The movable slots, ascending, when the caller keeps them (else found from `movable`).
+  std::span<const std::uint32_t> moving = {};
+  bool moving_listed = false;
+  // A number the caller changes whenever a body that is not movable changed its bounds, came,
+  // went, or became movable or not: while it stays, the grid keeps those bodies' cells from the
+  // last call. 0: list them every call.
+  std::uint64_t resting_version = 0;
 };
 
 class HashGrid {
@@ -46,13 +62,28 @@ class HashGrid {
     std::uint32_t body() const { return static_cast<std::uint32_t>(bits); }
     bool operator<(const Entry& o) const { return bits < o.bits; }
   };
+  // Lists the cells of `bodies` (all on the grid) into `out`, sorted by key, and sets their
+  // levels; `occupied` gets a bit per level used.
+  void list_cells(std::span<const Aabb> bounds, std::span<const std::uint32_t> bodies,
+                  int threads, std::vector<Entry>* out, std::uint64_t* occupied);
+  // Chooses the base cell and lists the resting bodies' cells.
+  void list_resting(const BroadPhaseInput& input);
+
   std::vector<std::vector<Entry>> thread_entries_, thread_scratch_;
   std::vector<std::vector<BodyPair>> thread_pairs_;
-  std::vector<Entry> entries_, merge_buffer_;
+  std::vector<Entry> moving_entries_, resting_entries_, merge_buffer_;
   std::vector<BodyPair> pair_buffer_;
-  std::vector<std::int8_t> level_;
+  std::vector<std::int8_t> level_;  // by slot
   std::vector<double> sizes_;
-  std::vector<std::uint32_t> unbounded_;
+  std::vector<std::uint32_t> moving_found_, moving_on_grid_, moving_unbounded_;
+  std::vector<std::uint32_t> resting_, resting_unbounded_;
+  // The resting bodies of each level, for a moving body that would cover more cells of that level
+  // than it has bodies.
+  std::vector<std::vector<std::uint32_t>> resting_on_level_;
+  std::uint64_t resting_occupied_ = 0;
+  std::uint64_t resting_version_ = 0;  // of the kept resting cells; 0: none kept
+  std::size_t resting_slots_ = 0;      // the slot count they were listed for
+  double base_ = 1.0;                  // level 0's cell, m; kept with the resting cells
 };
 
 void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);

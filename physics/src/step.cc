@@ -969,8 +969,10 @@ void World::update_sleep(double dt) {
       fell_asleep = true;
     }
   }
-  if (fell_asleep)
+  if (fell_asleep) {
     std::erase_if(awake_, [&](std::uint32_t slot) { return bodies_[slot].body.asleep; });
+    ++resting_version_;
+  }
   stats_.sleeping_bodies = static_cast<std::uint32_t>(sleeping_count_);
 }
 

@@ -23,12 +23,6 @@ int thread_count(int requested) {
   return requested > 0 ? requested : omp_get_max_threads();
 }
 
-// One grid per thread of the program: the world's own scratch, reused from call to call.
-HashGrid& scratch_grid() {
-  thread_local HashGrid grid;
-  return grid;
-}
-
 std::pair<Vec3, Vec3> velocities_after_impulse(const Body& body, const Vec3& impulse,
                                                const Vec3* point) {
   Vec3 w = body.angular_velocity;
@@ -155,6 +149,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     slot.body = std::move(body);
     slot.alive = true;
     if (slot.body.is_moving()) join_awake(index);
+    ++resting_version_;
     ids.push_back({index, slot.generation});
     ++live_count_;
   }
@@ -167,6 +162,7 @@ Status World::remove_body(BodyId id) {
   wake_around(slot.body);                                     // whatever rested on it must fall
   if (slot.body.asleep) wake_island(slot.body.sleep_island);  // it leaves its island's set
   if (slot.body.is_moving()) leave_awake(id.index);
+  ++resting_version_;
   slot.alive = false;
   ++slot.generation;
   slot.body = Body();
@@ -227,6 +223,7 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
     if (motion.angular_velocity) body.angular_velocity = *motion.angular_velocity;
   }
   body.update_world_inertia();
+  ++resting_version_;  // a static moved (a sleeper wakes below)
   if (body.is_static())
     wake_around(body);  // and what it now touches
   else if (body.asleep)
@@ -269,6 +266,7 @@ std::uint32_t World::wake_island(std::uint32_t island) {
     ++woken;
     --sleeping_count_;
     join_awake(next);
+    ++resting_version_;
     const std::uint32_t slot = next;
     next = sleeper_next_[slot];
     sleeper_next_[slot] = kNoSlot;
@@ -326,17 +324,23 @@ BodyId World::id_at(std::uint32_t index) const {
 // touch are found before they do. Its speculative distance is that motion, or for a fast body
 // (continuous collision) the part of it the sweep does not cover.
 void World::compute_bounds(double dt) {
-  const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
+  const double base_margin =
+      settings_.collision.margin + (dt > 0 ? settings_.solver.speculative_distance : 0.0);
+  if (base_margin != bounds_margin_) {
+    bounds_margin_ = base_margin;
+    ++resting_version_;
+  }
+  // Bodies that do not move keep last time's bounds while none of them changed.
+  const bool all = bounds_version_ != resting_version_ || bounds_.size() != bodies_.size();
+  bounds_version_ = resting_version_;
   bounds_.resize(bodies_.size());
   movable_.resize(bodies_.size());
   speculative_.assign(bodies_.size(), 0.0);
   fast_.assign(bodies_.size(), 0);
   motion_.assign(bodies_.size(), 0.0);
-  const double base_margin =
-      settings_.collision.margin + (dt > 0 ? settings_.solver.speculative_distance : 0.0);
   const double gravity = settings_.gravity.norm();
   const SolverSettings& solver = settings_.solver;
-  for_indices(thread_count(settings_.threads), n > 256, n, [&](std::int64_t i) {
+  auto bound = [&](std::uint32_t i) {
     const Slot& slot = bodies_[i];
     if (!slot.alive) {
       bounds_[i] = Aabb();
@@ -360,8 +364,19 @@ void World::compute_bounds(double dt) {
         transform_aabb(body.shape.local_bounds(), body.pose()).expanded(base_margin + motion);
     // Sleepers pair only with moving bodies, as statics do.
     movable_[i] = body.is_moving() ? 1 : 0;
-  });
-  fast_count_ = static_cast<std::uint32_t>(std::count(fast_.begin(), fast_.end(), 1));
+  };
+  const int threads = thread_count(settings_.threads);
+  const std::span<const std::uint32_t> awake = awake_slots();
+  if (all) {
+    const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
+    for_indices(threads, n > 256, n, [&](std::int64_t i) { bound(static_cast<std::uint32_t>(i)); });
+  } else {
+    const std::int64_t n = static_cast<std::int64_t>(awake.size());
+    for_indices(threads, n > 256, n, [&](std::int64_t k) { bound(awake[k]); });
+  }
+  fast_count_ = 0;
+  for (std::uint32_t slot : awake)
+    fast_count_ += fast_[slot];
 }
 
 std::span<const BodyPair> World::find_pairs() {
@@ -371,7 +386,10 @@ std::span<const BodyPair> World::find_pairs() {
 }
 
 void World::run_broad_phase() {
-  const BroadPhaseInput input{bounds_, movable_, thread_count(settings_.threads)};
+  BroadPhaseInput input{bounds_, movable_, thread_count(settings_.threads)};
+  input.moving = awake_slots();
+  input.moving_listed = true;
+  input.resting_version = resting_version_;
   BroadPhaseMethod method = settings_.broad_phase;
   if (method == BroadPhaseMethod::kAuto)
     method = live_count_ < kSweepAndPruneBelow ? BroadPhaseMethod::kSweepAndPrune
@@ -379,7 +397,7 @@ void World::run_broad_phase() {
   if (method == BroadPhaseMethod::kSweepAndPrune)
     sweep_and_prune(input, &pairs_);
   else
-    scratch_grid().find_pairs(input, &pairs_);
+    scratch_->grid.find_pairs(input, &pairs_);
 }
 
 std::span<const Contact> World::find_contacts() {

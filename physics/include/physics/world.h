@@ -165,6 +165,11 @@ class World {
   std::vector<std::uint32_t> awake_;
   bool awake_sorted_ = true;
   std::size_t sleeping_count_ = 0;  // bodies in sleeper_head_'s sets
+  // Bodies that do not move (statics, sleepers) keep their bounds, and the broad phase their
+  // cells, until one of them changes: every change to them (made, removed, moved, asleep, woken)
+  // bumps resting_version_; bounds_ were computed at bounds_version_ with bounds_margin_.
+  std::uint64_t resting_version_ = 1, bounds_version_ = 0;
+  double bounds_margin_ = -1;
   void join_awake(std::uint32_t slot);
   void leave_awake(std::uint32_t slot);
   // The step's view of awake_: sorted (restoring the order joins broke).
