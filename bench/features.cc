@@ -211,5 +211,26 @@ int main(int argc, char** argv) {
     row(spacing < 1 ? "overlapping (0.5 m apart)" : "apart (2 m)", m,
         std::to_string(m.last.pairs) + " pairs");
   }
+
+  header("Sleepers around one moving body: 10,000 boxes asleep on the floor and one falling, "
+         "against the falling box alone");
+  for (const bool with_sleepers : {true, false}) {
+    SceneDef scene;
+    scene.name = "sleepers";
+    scene.world.threads = 1;
+    scene.bodies.push_back(floor_plane());
+    if (with_sleepers)
+      for (int i = 0; i < 100; ++i)
+        for (int j = 0; j < 100; ++j)
+          scene.bodies.push_back(box_at(Vec3(2.0 * i, 2.0 * j, 0.5)));
+    scene.bodies.push_back(box_at(Vec3(-50, -50, 1000)));
+    World world = make(scene);
+    for (int s = 0; s < 60; ++s)  // past the sleep delay (0.5 s)
+      world.step(dt);
+    const Measured m = measure(world, dt, steps);
+    row(with_sleepers ? "10,000 asleep, 1 falling" : "1 falling, alone", m,
+        std::to_string(m.last.sleeping_bodies) + " sleeping, " +
+            std::to_string(m.last.solver_bodies) + " solver bodies");
+  }
   return 0;
 }

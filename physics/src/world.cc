@@ -335,9 +335,13 @@ void World::compute_bounds(double dt) {
   bounds_version_ = resting_version_;
   bounds_.resize(bodies_.size());
   movable_.resize(bodies_.size());
-  speculative_.assign(bodies_.size(), 0.0);
-  fast_.assign(bodies_.size(), 0);
-  motion_.assign(bodies_.size(), 0.0);
+  // Zero for every body that does not move; a moving body's are set below. While the moving set
+  // stays, so do the zeros.
+  if (all) {
+    speculative_.assign(bodies_.size(), 0.0);
+    fast_.assign(bodies_.size(), 0);
+    motion_.assign(bodies_.size(), 0.0);
+  }
   const double gravity = settings_.gravity.norm();
   const SolverSettings& solver = settings_.solver;
   auto bound = [&](std::uint32_t i) {
@@ -349,6 +353,9 @@ void World::compute_bounds(double dt) {
     }
     const Body& body = slot.body;
     double motion = 0;
+    speculative_[i] = 0;
+    fast_[i] = 0;
+    motion_[i] = 0;
     if (dt > 0 && body.is_moving()) {
       motion = (body.linear_velocity.norm() + gravity * dt +
                 body.angular_velocity.norm() * body.shape.outer_radius()) *
