@@ -212,8 +212,9 @@ int main(int argc, char** argv) {
         std::to_string(m.last.pairs) + " pairs");
   }
 
-  header("Sleepers around one moving body: 10,000 boxes asleep on the floor and one falling, "
-         "against the falling box alone");
+  header(
+      "Sleepers around one moving body: 10,000 boxes asleep on the floor and one falling, "
+      "against the falling box alone");
   for (const bool with_sleepers : {true, false}) {
     SceneDef scene;
     scene.name = "sleepers";

@@ -1,6 +1,6 @@
-// Contact pair records (contact_pairs.h): a known feature gives the manifold the search would,
-// the motion bound covers the points where the pair can touch, and a world keeps features only
-// of pairs that barely moved.
+// Contact pair records (contact_pairs.h): pairs find their records in one walk, a known feature
+// gives the manifold the search would, the motion bound covers the points where the pair can
+// touch, and a world keeps features only of pairs that barely moved.
 #include <gtest/gtest.h>
 
 #include "contact_pairs.h"
@@ -25,6 +25,35 @@ Shape random_shape(Random& rng, int kind) {
       for (int i = 0; i < 12; ++i)
         hull.points.push_back(rng.vector(-1, 1));
       return Shape::create(hull).value();
+    }
+  }
+}
+
+// This step's pairs find last step's records in one walk over both sorted lists: each pair gets the
+// record of its two slots, or none, as a search of every record would say.
+TEST(ContactPairs, PairsMatchTheirRecordsInOneWalk) {
+  Random rng(3);
+  for (int round = 0; round < 50; ++round) {
+    std::vector<BodyPair> pairs;
+    std::vector<ContactPairRecord> records;
+    for (std::uint32_t a = 0; a < 40; ++a)
+      for (std::uint32_t b = a + 1; b < 40; ++b) {
+        if (rng.uniform() < 0.1) pairs.push_back({a, b});
+        if (rng.uniform() < 0.1) {
+          ContactPairRecord record;
+          record.a = {a, 0};
+          record.b = {b, 0};
+          records.push_back(record);
+        }
+      }
+    std::vector<std::uint32_t> matched(pairs.size(), 12345);
+    match_pair_records(pairs, records, matched);
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      std::uint32_t expected = kNoRecord;
+      for (std::size_t r = 0; r < records.size(); ++r)
+        if (records[r].a.index == pairs[i].a && records[r].b.index == pairs[i].b)
+          expected = static_cast<std::uint32_t>(r);
+      ASSERT_EQ(matched[i], expected) << "round " << round << ", pair " << i;
     }
   }
 }

@@ -64,8 +64,8 @@ class HashGrid {
   };
   // Lists the cells of `bodies` (all on the grid) into `out`, sorted by key, and sets their
   // levels; `occupied` gets a bit per level used.
-  void list_cells(std::span<const Aabb> bounds, std::span<const std::uint32_t> bodies,
-                  int threads, std::vector<Entry>* out, std::uint64_t* occupied);
+  void list_cells(std::span<const Aabb> bounds, std::span<const std::uint32_t> bodies, int threads,
+                  std::vector<Entry>* out, std::uint64_t* occupied);
   // Chooses the base cell and lists the resting bodies' cells.
   void list_resting(const BroadPhaseInput& input);
 

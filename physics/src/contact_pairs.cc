@@ -14,13 +14,19 @@ double moved_at_most(double shift, double angle, double radius) {
 
 }  // namespace
 
-std::uint32_t find_pair_record(std::span<const ContactPairRecord> records, BodyId a, BodyId b) {
-  const auto found =
-      std::lower_bound(records.begin(), records.end(), 0, [&](const ContactPairRecord& r, int) {
-        return r.a.index != a.index ? r.a.index < a.index : r.b.index < b.index;
-      });
-  if (found == records.end() || found->a != a || found->b != b) return kNoRecord;
-  return static_cast<std::uint32_t>(found - records.begin());
+void match_pair_records(std::span<const BodyPair> pairs, std::span<const ContactPairRecord> records,
+                        std::span<std::uint32_t> out) {
+  const auto before = [](const ContactPairRecord& r, const BodyPair& p) {
+    return r.a.index != p.a ? r.a.index < p.a : r.b.index < p.b;
+  };
+  std::size_t r = 0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    while (r < records.size() && before(records[r], pairs[i]))
+      ++r;
+    const bool same =
+        r < records.size() && records[r].a.index == pairs[i].a && records[r].b.index == pairs[i].b;
+    out[i] = same ? static_cast<std::uint32_t>(r) : kNoRecord;
+  }
 }
 
 double relative_motion(const ContactPairRecord& record, const Pose& pose_a, const Pose& pose_b,

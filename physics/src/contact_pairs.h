@@ -1,20 +1,23 @@
-// Touching pairs kept from step to step (ContactPairRecord, world_state.h): finding last step's
-// record of a pair, how far the pair has moved since, and recording a manifold.
+// Touching pairs kept from step to step (ContactPairRecord, world_state.h): matching this step's
+// pairs to last step's records, how far the pair has moved since, and recording a manifold.
 #pragma once
 
 #include <cstdint>
 #include <span>
 
 #include "narrow_phase.h"
+#include "physics/world.h"
 #include "physics/world_state.h"
 
 namespace tumble {
 
 constexpr std::uint32_t kNoRecord = UINT32_MAX;
 
-// The record of the pair (a, b), same generations, in `records` sorted by body pair; kNoRecord
-// when there is none.
-std::uint32_t find_pair_record(std::span<const ContactPairRecord> records, BodyId a, BodyId b);
+// Each pair's record of the last step, found by walking both lists once (both are sorted by body
+// pair, so no pair is looked up): out[i] is the index in `records` of the record of pairs[i]'s
+// slots, or kNoRecord. The caller compares generations (a slot may have been given to a new body).
+void match_pair_records(std::span<const BodyPair> pairs, std::span<const ContactPairRecord> records,
+                        std::span<std::uint32_t> out);
 
 // How far a point where the bodies can touch (inside both outer spheres) can have moved relative
 // to the other body since the record's pose (m): B's centre's shift in A's axes plus the turn

@@ -96,8 +96,9 @@ struct NormalBlock {
 // pair's record of the last step; null: none) with its feature id, or else of the nearest one
 // close enough.
 void prepare_rows(const ContactManifold& manifold, std::uint32_t solver_a, const Body& a,
-                  std::uint32_t solver_b, const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
-                  ContactRow* rows, ContactRowCold* cold, NormalBlock* block);
+                  std::uint32_t solver_b, const Body& b, const ContactPairRecord* previous,
+                  std::uint32_t block_index, ContactRow* rows, ContactRowCold* cold,
+                  NormalBlock* block);
 
 // Spring parameters of a soft contact over a substep h (Catto 2011, "Soft constraints").
 struct Softness {

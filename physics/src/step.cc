@@ -105,8 +105,8 @@ class SerialIsland {
   bool has_rows() const { return !c_.rows.empty(); }
   void integrate_velocities(double h) {
     for (std::uint32_t k : c_.bodies) {
-      if (!integrate_velocity(*c_.body_of[k], c_.scratch.poses[k].orientation,
-                              c_.settings.gravity, h, &bodies_[k]))
+      if (!integrate_velocity(*c_.body_of[k], c_.scratch.poses[k].orientation, c_.settings.gravity,
+                              h, &bodies_[k]))
         ++report_->gyroscopic_limit_hits;
     }
   }
@@ -392,8 +392,8 @@ std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
 #pragma omp for schedule(static)
   for (std::int64_t k = 0; k < n; ++k) {
     const std::uint32_t body = c.bodies[k];
-    if (!integrate_velocity(*c.body_of[body], c.scratch.poses[body].orientation,
-                            c.settings.gravity, h, &c.scratch.bodies[body]))
+    if (!integrate_velocity(*c.body_of[body], c.scratch.poses[body].orientation, c.settings.gravity,
+                            h, &c.scratch.bodies[body]))
       ++hits;
   }
   return hits;
@@ -697,9 +697,9 @@ void World::prepare_contacts(double dt) {
                                   .subspan(s.islands.link_begin[i],
                                            s.islands.link_begin[i + 1] - s.islands.link_begin[i]);
     if (kind == IslandSolver::kSoft) {
-      const IslandStiffness stiffness = island_stiffness(
-          island_bodies, island_links, s.links, s.touching, s.dynamic, s.body_of,
-          settings_.gravity, dt, solver, &s.support_level, &s.level_sums);
+      const IslandStiffness stiffness =
+          island_stiffness(island_bodies, island_links, s.links, s.touching, s.dynamic, s.body_of,
+                           settings_.gravity, dt, solver, &s.support_level, &s.level_sums);
       s.reports[i].substeps = stiffness.substeps;
       s.reports[i].contact_hertz = stiffness.contact_hertz;
       s.reports[i].stiffness_capped = stiffness.capped;

@@ -96,9 +96,9 @@ struct Column {
 Column measure_column(std::span<const std::uint32_t> island_bodies,
                       std::span<const std::uint32_t> island_links,
                       std::span<const IslandLink> links, std::span<const std::uint8_t> touching,
-                      std::span<const std::uint8_t> dynamic,
-                      std::span<const Body* const> body_of, const Vec3& gravity,
-                      std::vector<std::uint32_t>* level, std::vector<LevelSums>* level_sums) {
+                      std::span<const std::uint8_t> dynamic, std::span<const Body* const> body_of,
+                      const Vec3& gravity, std::vector<std::uint32_t>* level,
+                      std::vector<LevelSums>* level_sums) {
   Column result;
   const double g = gravity.norm();
   if (!(g > 0) || island_links.empty()) return result;

@@ -53,9 +53,9 @@ struct IslandStiffness {
   bool capped = false;
 };
 
-// One island's bodies (the step's solver indices) and links (indices into `links`): the substeps and spring it
-// needs. Only links marked `touching` (overlapping, or apart by less than the slop) carry load:
-// speculative contacts between falling bodies make no column. `level` (by body) and
+// One island's bodies (the step's solver indices) and links (indices into `links`): the substeps
+// and spring it needs. Only links marked `touching` (overlapping, or apart by less than the slop)
+// carry load: speculative contacts between falling bodies make no column. `level` (by body) and
 // `level_sums` are working memory.
 IslandStiffness island_stiffness(
     std::span<const std::uint32_t> island_bodies, std::span<const std::uint32_t> island_links,

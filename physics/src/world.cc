@@ -423,6 +423,7 @@ void World::find_contacts(double dt) {
   resize_reusing(s.previous_pair, pairs_.size());
   resize_reusing(s.reused, pairs_.size());
   const double reuse = dt > 0 ? settings_.solver.manifold_reuse : 0.0;
+  match_pair_records(pairs_, s.pairs, s.previous_pair);
   const std::uint32_t flags = or_over_indices(
       thread_count(settings_.threads), n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
         const Body& a = bodies_[pairs_[i].a].body;
@@ -430,7 +431,10 @@ void World::find_contacts(double dt) {
         Contact& contact = contacts_[i];
         contact.a = {pairs_[i].a, bodies_[pairs_[i].a].generation};
         contact.b = {pairs_[i].b, bodies_[pairs_[i].b].generation};
-        const std::uint32_t previous = find_pair_record(s.pairs, contact.a, contact.b);
+        std::uint32_t previous = s.previous_pair[i];
+        if (previous != kNoRecord &&
+            (s.pairs[previous].a != contact.a || s.pairs[previous].b != contact.b))
+          previous = kNoRecord;  // the slot now holds another body
         s.previous_pair[i] = previous;
         s.reused[i] = 0;
         const Pose pose_a = a.pose(), pose_b = b.pose();
