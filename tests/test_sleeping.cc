@@ -177,4 +177,49 @@ TEST(Sleeping, AStepSolvesTheMovingBodiesOnly) {
   EXPECT_GT(world.last_step().sleeping_bodies, 0u);
 }
 
+// Removing or moving a static body wakes the sleepers on it (a static joins no island, so only
+// this look finds them), through the broad phase's kept cells and the bodies fallen asleep since it
+// last listed them, instead of a look at every slot: a hundred boxes on static pedestals, enough
+// for the hash grid. Right after they fall asleep, one step later, and when the ground moves
+// (a half-space is near everything).
+TEST(Sleeping, RemovingAStaticWakesTheSleepersOnItOnly) {
+  World world;
+  BodyDef ground;
+  ground.type = BodyType::kStatic;
+  ground.shape = HalfSpaceDef{};
+  const BodyId floor = world.create_body(ground).value();
+  std::vector<BodyId> pedestals, boxes;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) {
+      BodyDef box;
+      box.position = Vec3(3.0 * i, 3.0 * j, 0.5);
+      box.type = BodyType::kStatic;
+      pedestals.push_back(world.create_body(box).value());
+      box.type = BodyType::kDynamic;
+      box.position.z() = 1.5;
+      boxes.push_back(world.create_body(box).value());
+    }
+  for (int n = 0; n < 120 && world.last_step().sleeping_bodies < 100; ++n)
+    ASSERT_TRUE(world.step(1.0 / 60));
+  ASSERT_EQ(world.last_step().sleeping_bodies, 100u);
+  auto awake = [&] {
+    std::vector<std::size_t> which;
+    for (std::size_t k = 0; k < boxes.size(); ++k)
+      if (!world.body(boxes[k]).asleep()) which.push_back(k);
+    return which;
+  };
+  ASSERT_TRUE(world.remove_body(pedestals[0]));  // they fell asleep in the last step
+  EXPECT_EQ(awake(), (std::vector<std::size_t>{0}));
+  ASSERT_TRUE(world.step(1.0 / 60));
+  ASSERT_TRUE(world.remove_body(pedestals[57]));  // listed by the grid now
+  EXPECT_EQ(awake(), (std::vector<std::size_t>{0, 57}));
+  BodyMotion lowered;
+  lowered.position = Vec3(3.0 * 3, 3.0 * 3, 0.499);
+  ASSERT_TRUE(world.set_motion(pedestals[33], lowered));
+  EXPECT_EQ(awake(), (std::vector<std::size_t>{0, 33, 57}));
+  lowered.position = Vec3(0, 0, -0.001);
+  ASSERT_TRUE(world.set_motion(floor, lowered));
+  EXPECT_EQ(awake().size(), 100u);
+}
+
 }  // namespace tumble::testing

@@ -314,6 +314,25 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
 }
 
+void HashGrid::resting_near(const Aabb& box, std::vector<std::uint32_t>* out) const {
+  out->insert(out->end(), resting_unbounded_.begin(), resting_unbounded_.end());
+  for (std::uint64_t levels = resting_occupied_; levels != 0; levels &= levels - 1) {
+    const int level = std::countr_zero(levels);
+    const auto& on_level = resting_on_level_[level];
+    const CellRange cells(box, base_ * std::ldexp(1.0, level));
+    if (!(cells.count() <= static_cast<double>(on_level.size()))) {
+      out->insert(out->end(), on_level.begin(), on_level.end());
+      continue;
+    }
+    cells.each([&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      const std::uint32_t key = cell_key(level, x, y, z);
+      auto it = std::lower_bound(resting_entries_.begin(), resting_entries_.end(), Entry(key, 0));
+      for (; it != resting_entries_.end() && it->key() == key; ++it)
+        if (level_[it->body()] == level) out->push_back(it->body());
+    });
+  }
+}
+
 void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
   const auto& bounds = input.bounds;

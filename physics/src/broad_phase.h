@@ -49,6 +49,10 @@ struct BroadPhaseInput {
 class HashGrid {
  public:
   void find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);
+  // The resting bodies of the last find_pairs whose cells meet `box` (and those off the grid),
+  // appended to `out`, possibly more than once: candidates, which the caller checks, since the
+  // bodies may have changed since.
+  void resting_near(const Aabb& box, std::vector<std::uint32_t>* out) const;
 
  private:
   // A (cell key, body) pair packed in one word, key above, so that ordering the words orders by

@@ -964,6 +964,7 @@ void World::update_sleep(double dt) {
       body.asleep = true;
       body.sleep_island = island;
       link_sleeper(slot, island);
+      if (sleepers_indexed_) recent_sleepers_.push_back(slot);
       body.linear_velocity.setZero();
       body.angular_velocity.setZero();
       fell_asleep = true;

@@ -174,12 +174,24 @@ Status World::remove_body(BodyId id) {
 void World::wake_around(const Body& body) {
   const Aabb near = transform_aabb(body.shape.local_bounds(), body.pose())
                         .expanded(settings_.solver.speculative_distance + 0.05);
-  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+  auto wake_if_near = [&](std::uint32_t i) {
     const Body& other = bodies_[i].body;
     if (bodies_[i].alive && other.asleep &&
         transform_aabb(other.shape.local_bounds(), other.pose()).overlaps(near))
       wake_island(other.sleep_island);
+  };
+  if (!sleepers_indexed_) {
+    for (std::uint32_t i = 0; i < bodies_.size(); ++i)
+      wake_if_near(i);
+    return;
   }
+  // The sleepers the grid listed near the body, and those fallen asleep since; each is checked
+  // as it is now (it may have woken, or its slot gone to another body).
+  near_scratch_.clear();
+  scratch_->grid.resting_near(near, &near_scratch_);
+  near_scratch_.insert(near_scratch_.end(), recent_sleepers_.begin(), recent_sleepers_.end());
+  for (std::uint32_t i : near_scratch_)
+    wake_if_near(i);
 }
 
 Status World::check_motion(BodyId id, const BodyMotion& motion) const {
@@ -401,6 +413,9 @@ void World::run_broad_phase() {
   if (method == BroadPhaseMethod::kAuto)
     method = live_count_ < kSweepAndPruneBelow ? BroadPhaseMethod::kSweepAndPrune
                                                : BroadPhaseMethod::kHashGrid;
+  // The grid lists every body that does not move, sleepers included; sweep and prune keeps none.
+  sleepers_indexed_ = method == BroadPhaseMethod::kHashGrid;
+  recent_sleepers_.clear();
   if (method == BroadPhaseMethod::kSweepAndPrune)
     sweep_and_prune(input, &pairs_);
   else

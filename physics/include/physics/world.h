@@ -170,6 +170,10 @@ class World {
   // bumps resting_version_; bounds_ were computed at bounds_version_ with bounds_margin_.
   std::uint64_t resting_version_ = 1, bounds_version_ = 0;
   double bounds_margin_ = -1;
+  // Whether the hash grid's resting cells and recent_sleepers_ (bodies fallen asleep since the grid
+  // last listed them) hold every sleeper, so that wake_around asks them instead of every slot.
+  bool sleepers_indexed_ = false;
+  std::vector<std::uint32_t> recent_sleepers_, near_scratch_;
   void join_awake(std::uint32_t slot);
   void leave_awake(std::uint32_t slot);
   // The step's view of awake_: sorted (restoring the order joins broke).
