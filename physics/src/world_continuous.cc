@@ -51,7 +51,11 @@ void World::sweep_fast_bodies(double /*dt*/) {
       },
       4);
 
-  s.first_impact.assign(bodies_.size(), 1.0);
+  // Only moving bodies are fast: the step visits them, not every slot.
+  const std::span<const std::uint32_t> awake = awake_slots();
+  s.first_impact.resize(bodies_.size());
+  for (std::uint32_t slot : awake)
+    s.first_impact[slot] = 1.0;
   for (std::size_t k = 0; k < s.impacts.size(); ++k) {
     const ImpactResult& impact = s.impacts[k];
     if (impact.status == ImpactStatus::kIterationLimit) ++stats_.continuous_limit_hits;
@@ -61,7 +65,7 @@ void World::sweep_fast_bodies(double /*dt*/) {
     for (std::uint32_t slot : {pair.a, pair.b})
       if (fast_[slot]) s.first_impact[slot] = std::min(s.first_impact[slot], impact.t);
   }
-  for (std::uint32_t slot = 0; slot < bodies_.size(); ++slot) {
+  for (std::uint32_t slot : awake) {
     if (!fast_[slot]) continue;
     ++stats_.swept_bodies;
     if (s.first_impact[slot] >= 1) continue;
