@@ -234,6 +234,43 @@ int main(int argc, char** argv) {
             std::to_string(m.last.solver_bodies) + " solver bodies");
   }
 
+  header("Spawning: a box made every step (and removed 30 steps later) among 10,000 sleepers, "
+         "against the same in an empty world");
+  for (const bool with_sleepers : {true, false}) {
+    SceneDef scene;
+    scene.name = "spawning";
+    scene.world.threads = 1;
+    scene.bodies.push_back(floor_plane());
+    if (with_sleepers)
+      for (int i = 0; i < 100; ++i)
+        for (int j = 0; j < 100; ++j)
+          scene.bodies.push_back(box_at(Vec3(2.0 * i, 2.0 * j, 0.5)));
+    World world = make(scene);
+    for (int s = 0; s < 60; ++s)
+      world.step(dt);
+    std::vector<BodyId> spawned;
+    std::vector<double> total, narrow, solve;
+    for (long s = 0; s < steps; ++s) {
+      // Dropped beside the field, so that no sleeper wakes: what is measured is the spawning.
+      const auto start = std::chrono::steady_clock::now();
+      spawned.push_back(
+          world.create_body(box_at(Vec3(-10.0 - 2.0 * (s % 31), -10.0, 5.0))).value());
+      if (spawned.size() > 30) {
+        world.remove_body(spawned.front());
+        spawned.erase(spawned.begin());
+      }
+      world.step(dt);
+      total.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                                .count());
+      narrow.push_back(1e3 * world.last_step().time.narrow_phase);
+      solve.push_back(1e3 * world.last_step().time.solve);
+    }
+    const Measured m{median(total), median(narrow), median(solve), world.last_step()};
+    row(with_sleepers ? "10,000 asleep" : "empty", m,
+        std::to_string(m.last.sleeping_bodies) + " sleeping, " +
+            std::to_string(m.last.solver_bodies) + " solver bodies (make, remove, step)");
+  }
+
   header("Removing static pedestals from under sleepers (each wakes the box on it): a world of "
          "1,000 against one of 10,000");
   for (const int side : {32, 100}) {

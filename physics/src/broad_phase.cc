@@ -175,7 +175,6 @@ void HashGrid::list_resting(const BroadPhaseInput& input) {
   for (std::uint32_t i : resting_)
     resting_on_level_[level_[i]].push_back(i);
   resting_version_ = input.resting_version;
-  resting_slots_ = n;
 }
 
 void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
@@ -194,9 +193,12 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
       if (!is_dead(bounds[i]) && input.movable[i]) moving_found_.push_back(i);
     moving = moving_found_;
   }
-  if (input.resting_version == 0 || input.resting_version != resting_version_ ||
-      resting_slots_ != n)
+  if (input.resting_version == 0 || input.resting_version != resting_version_) {
     list_resting(input);
+  } else if (level_.size() != n) {
+    // Slots made since hold moving bodies, or none: the kept cells stand.
+    level_.resize(n, kDeadSlot);
+  }
 
   // (1) The moving bodies' cells, each on its own level.
   moving_unbounded_.clear();

@@ -42,7 +42,7 @@ struct BroadPhaseInput {
   bool moving_listed = false;
   // A number the caller changes whenever a body that is not movable changed its bounds, came,
   // went, or became movable or not: while it stays, the grid keeps those bodies' cells from the
-  // last call. 0: list them every call.
+  // last call (slots added since must be movable or dead). 0: list them every call.
   std::uint64_t resting_version = 0;
 };
 
@@ -86,7 +86,6 @@ class HashGrid {
   std::vector<std::vector<std::uint32_t>> resting_on_level_;
   std::uint64_t resting_occupied_ = 0;
   std::uint64_t resting_version_ = 0;  // of the kept resting cells; 0: none kept
-  std::size_t resting_slots_ = 0;      // the slot count they were listed for
   double base_ = 1.0;                  // level 0's cell, m; kept with the resting cells
 };
 

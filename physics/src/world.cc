@@ -148,8 +148,12 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     Slot& slot = bodies_[index];
     slot.body = std::move(body);
     slot.alive = true;
-    if (slot.body.is_moving()) join_awake(index);
-    ++resting_version_;
+    // A moving body joins the moving set, which every step visits anyway; only a resting one
+    // changes what the broad phase keeps.
+    if (slot.body.is_moving())
+      join_awake(index);
+    else
+      ++resting_version_;
     ids.push_back({index, slot.generation});
     ++live_count_;
   }
@@ -161,8 +165,18 @@ Status World::remove_body(BodyId id) {
   Slot& slot = bodies_[id.index];
   wake_around(slot.body);                                     // whatever rested on it must fall
   if (slot.body.asleep) wake_island(slot.body.sleep_island);  // it leaves its island's set
-  if (slot.body.is_moving()) leave_awake(id.index);
-  ++resting_version_;
+  if (slot.body.is_moving())
+    leave_awake(id.index);
+  else
+    ++resting_version_;
+  // The step's per-slot data forget it (bounds kept for moving bodies are not visited again).
+  if (id.index < bounds_.size()) {
+    bounds_[id.index] = Aabb();
+    movable_[id.index] = 0;
+    speculative_[id.index] = 0;
+    fast_[id.index] = 0;
+    motion_[id.index] = 0;
+  }
   slot.alive = false;
   ++slot.generation;
   slot.body = Body();
@@ -235,7 +249,7 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
     if (motion.angular_velocity) body.angular_velocity = *motion.angular_velocity;
   }
   body.update_world_inertia();
-  ++resting_version_;  // a static moved (a sleeper wakes below)
+  if (body.is_static()) ++resting_version_;  // (a sleeper wakes below, which counts too)
   if (body.is_static())
     wake_around(body);  // and what it now touches
   else if (body.asleep)
@@ -342,13 +356,16 @@ void World::compute_bounds(double dt) {
     bounds_margin_ = base_margin;
     ++resting_version_;
   }
-  // Bodies that do not move keep last time's bounds while none of them changed.
-  const bool all = bounds_version_ != resting_version_ || bounds_.size() != bodies_.size();
+  // Bodies that do not move keep last time's bounds while none of them changed. Slots made since
+  // hold moving bodies (a resting one changes the version), which are visited below, or none.
+  const bool all = bounds_version_ != resting_version_;
   bounds_version_ = resting_version_;
   bounds_.resize(bodies_.size());
   movable_.resize(bodies_.size());
-  // Zero for every body that does not move; a moving body's are set below. While the moving set
-  // stays, so do the zeros.
+  speculative_.resize(bodies_.size());
+  fast_.resize(bodies_.size());
+  motion_.resize(bodies_.size());
+  // Zero for every body that does not move; a moving body's are set below.
   if (all) {
     speculative_.assign(bodies_.size(), 0.0);
     fast_.assign(bodies_.size(), 0);
