@@ -84,6 +84,19 @@ SceneDef resting_grid(double friction, SolverKind kind) {
   return scene;
 }
 
+// side x side boxes resting on the floor 2 m apart (they fall asleep after the sleep delay), one
+// thread.
+SceneDef field_of_boxes(int side) {
+  SceneDef scene;
+  scene.name = "field";
+  scene.world.threads = 1;
+  scene.bodies.push_back(floor_plane());
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j)
+      scene.bodies.push_back(box_at(Vec3(2.0 * i, 2.0 * j, 0.5)));
+  return scene;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -216,14 +229,7 @@ int main(int argc, char** argv) {
       "Sleepers around one moving body: 10,000 boxes asleep on the floor and one falling, "
       "against the falling box alone");
   for (const bool with_sleepers : {true, false}) {
-    SceneDef scene;
-    scene.name = "sleepers";
-    scene.world.threads = 1;
-    scene.bodies.push_back(floor_plane());
-    if (with_sleepers)
-      for (int i = 0; i < 100; ++i)
-        for (int j = 0; j < 100; ++j)
-          scene.bodies.push_back(box_at(Vec3(2.0 * i, 2.0 * j, 0.5)));
+    SceneDef scene = field_of_boxes(with_sleepers ? 100 : 0);
     scene.bodies.push_back(box_at(Vec3(-50, -50, 1000)));
     World world = make(scene);
     for (int s = 0; s < 60; ++s)  // past the sleep delay (0.5 s)
@@ -234,19 +240,12 @@ int main(int argc, char** argv) {
             std::to_string(m.last.solver_bodies) + " solver bodies");
   }
 
-  header("Spawning: a box made every step (and removed 30 steps later) among 10,000 sleepers, "
-         "against the same in an empty world");
+  header(
+      "Spawning: a box made every step (and removed 30 steps later) among 10,000 sleepers, "
+      "against the same in an empty world");
   for (const bool with_sleepers : {true, false}) {
-    SceneDef scene;
-    scene.name = "spawning";
-    scene.world.threads = 1;
-    scene.bodies.push_back(floor_plane());
-    if (with_sleepers)
-      for (int i = 0; i < 100; ++i)
-        for (int j = 0; j < 100; ++j)
-          scene.bodies.push_back(box_at(Vec3(2.0 * i, 2.0 * j, 0.5)));
-    World world = make(scene);
-    for (int s = 0; s < 60; ++s)
+    World world = make(field_of_boxes(with_sleepers ? 100 : 0));
+    for (int s = 0; s < 60; ++s)  // past the sleep delay (0.5 s)
       world.step(dt);
     std::vector<BodyId> spawned;
     std::vector<double> total, narrow, solve;
@@ -260,8 +259,8 @@ int main(int argc, char** argv) {
         spawned.erase(spawned.begin());
       }
       world.step(dt);
-      total.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                                .count());
+      total.push_back(
+          1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       narrow.push_back(1e3 * world.last_step().time.narrow_phase);
       solve.push_back(1e3 * world.last_step().time.solve);
     }
@@ -271,8 +270,9 @@ int main(int argc, char** argv) {
             std::to_string(m.last.solver_bodies) + " solver bodies (make, remove, step)");
   }
 
-  header("Removing static pedestals from under sleepers (each wakes the box on it): a world of "
-         "1,000 against one of 10,000");
+  header(
+      "Removing static pedestals from under sleepers (each wakes the box on it): a world of "
+      "1,000 against one of 10,000");
   for (const int side : {32, 100}) {
     SceneDef scene;
     scene.name = "pedestals";

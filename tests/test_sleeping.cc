@@ -1,6 +1,8 @@
 // Sleeping: resting islands stop costing anything, and wake when touched or undermined.
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "scene_runner.h"
 
 namespace tumble::testing {
@@ -245,6 +247,12 @@ TEST(Sleeping, KeptRestingCellsGiveTheSweepAndPrunePairs) {
   };
   World grid = build_world(BroadPhaseMethod::kHashGrid);
   World sap = build_world(BroadPhaseMethod::kSweepAndPrune);
+  auto step_both = [&](const std::string& when) {
+    ASSERT_TRUE(grid.step(1.0 / 60));
+    ASSERT_TRUE(sap.step(1.0 / 60));
+    ASSERT_EQ(grid.last_step().pairs, sap.last_step().pairs) << when;
+    ASSERT_EQ(state_hash(grid), state_hash(sap)) << when;
+  };
   std::vector<BodyId> dropped;
   for (int n = 0; n < 150; ++n) {
     if (n >= 60 && n % 3 == 0) {
@@ -270,10 +278,7 @@ TEST(Sleeping, KeptRestingCellsGiveTheSweepAndPrunePairs) {
         ASSERT_TRUE(sap.remove_body(id));
       }
     }
-    ASSERT_TRUE(grid.step(1.0 / 60));
-    ASSERT_TRUE(sap.step(1.0 / 60));
-    ASSERT_EQ(grid.last_step().pairs, sap.last_step().pairs) << "step " << n;
-    ASSERT_EQ(state_hash(grid), state_hash(sap)) << "step " << n;
+    ASSERT_NO_FATAL_FAILURE(step_both("step " + std::to_string(n)));
   }
   // Then, once everything sleeps, boxes dropped in the open and removed while they fall: the
   // resting bodies do not change at all, so nothing is listed again, and a removed box must leave
@@ -295,10 +300,7 @@ TEST(Sleeping, KeptRestingCellsGiveTheSweepAndPrunePairs) {
       ASSERT_TRUE(grid.remove_body(falling));
       ASSERT_TRUE(sap.remove_body(falling));
     }
-    ASSERT_TRUE(grid.step(1.0 / 60));
-    ASSERT_TRUE(sap.step(1.0 / 60));
-    ASSERT_EQ(grid.last_step().pairs, sap.last_step().pairs) << "open step " << n;
-    ASSERT_EQ(state_hash(grid), state_hash(sap)) << "open step " << n;
+    ASSERT_NO_FATAL_FAILURE(step_both("open step " + std::to_string(n)));
   }
 }
 
