@@ -200,6 +200,10 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     level_.resize(n, kDeadSlot);
   }
 
+  // Resting bodies never pair with one another: with nothing moving there is nothing to find (and
+  // no thread team to start).
+  if (moving.empty()) return;
+
   // (1) The moving bodies' cells, each on its own level.
   moving_unbounded_.clear();
   moving_on_grid_.clear();
