@@ -336,12 +336,14 @@ TUMBLE_INLINE Wide solve_friction(const ContactPack& pack, PackPoint& point, Wid
   const Wide squared = new1 * new1 + new2 * new2;
   const WideMask outside_cone = mask & (squared > limit * limit);
   if (any(outside_cone)) {
-    for (int k = 0; k < kWideLanes; ++k) {
-      if (!outside_cone[k]) continue;
-      const double scale = limit[k] / std::sqrt(squared[k]);
-      new1[k] *= scale;
-      new2[k] *= scale;
-    }
+    // Every lane's root and quotient at once (correctly rounded, so each lane's are the scalar
+    // solver's), kept where the lane is outside the cone: branching lane by lane cost more.
+    Wide root;
+    for (int k = 0; k < kWideLanes; ++k)
+      root[k] = std::sqrt(squared[k]);
+    const Wide scale = limit / root;
+    new1 = select(outside_cone, new1 * scale, new1);
+    new2 = select(outside_cone, new2 * scale, new2);
   }
   point.tangent_impulse1 = select(mask, new1, old1);
   point.tangent_impulse2 = select(mask, new2, old2);
