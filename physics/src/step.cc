@@ -971,7 +971,7 @@ void World::update_sleep(double dt) {
     }
   }
   if (fell_asleep) {
-    std::erase_if(awake_, [&](std::uint32_t slot) { return bodies_[slot].body.asleep; });
+    awake_stale_ = true;  // the sleepers leave the moving set
     ++resting_version_;
   }
   stats_.sleeping_bodies = static_cast<std::uint32_t>(sleeping_count_);

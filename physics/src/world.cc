@@ -292,11 +292,11 @@ std::uint32_t World::wake_island(std::uint32_t island) {
     ++woken;
     --sleeping_count_;
     join_awake(next);
-    ++resting_version_;
     const std::uint32_t slot = next;
     next = sleeper_next_[slot];
     sleeper_next_[slot] = kNoSlot;
   }
+  if (woken > 0) ++resting_version_;
   return woken;
 }
 
@@ -306,16 +306,24 @@ void World::join_awake(std::uint32_t slot) {
 }
 
 void World::leave_awake(std::uint32_t slot) {
-  const auto at = std::find(awake_.begin(), awake_.end(), slot);
-  TUMBLE_ASSERT(at != awake_.end());
-  awake_.erase(at);  // erasing keeps the order
+  // Left in place: the next awake_slots() drops every slot that stopped moving in one pass, so a
+  // batch of removals costs one pass over the set instead of a search each.
+  TUMBLE_ASSERT(std::find(awake_.begin(), awake_.end(), slot) != awake_.end());
+  awake_stale_ = true;
 }
 
 std::span<const std::uint32_t> World::awake_slots() {
+  if (awake_stale_)
+    std::erase_if(awake_, [&](std::uint32_t slot) {
+      return !bodies_[slot].alive || !bodies_[slot].body.is_moving();
+    });
   if (!awake_sorted_) {
     std::sort(awake_.begin(), awake_.end());
     awake_sorted_ = true;
   }
+  // A slot freed and given to a new moving body before this pass is listed twice.
+  if (awake_stale_) awake_.erase(std::unique(awake_.begin(), awake_.end()), awake_.end());
+  awake_stale_ = false;
   return awake_;
 }
 

@@ -161,9 +161,10 @@ class World {
   // The moving bodies' slots (dynamic and awake), so that a step visits them and not every slot:
   // bodies join when they are made or wake, and leave when they fall asleep or are removed. The
   // step wants them in slot order (it numbers its solver bodies so, and islands by their lowest
-  // body); joining may break the order, which the next step restores.
+  // body); joining may break the order, which the next step restores. Bodies removed or made to
+  // rest leave it lazily (awake_stale_): awake_slots() drops them.
   std::vector<std::uint32_t> awake_;
-  bool awake_sorted_ = true;
+  bool awake_sorted_ = true, awake_stale_ = false;
   std::size_t sleeping_count_ = 0;  // bodies in sleeper_head_'s sets
   // Bodies that do not move (statics, sleepers) keep their bounds, and the broad phase their
   // cells, until one of them changes: every change to them (made, removed, moved, asleep, woken)
@@ -176,7 +177,7 @@ class World {
   std::vector<std::uint32_t> recent_sleepers_, near_scratch_;
   void join_awake(std::uint32_t slot);
   void leave_awake(std::uint32_t slot);
-  // The step's view of awake_: sorted (restoring the order joins broke).
+  // The step's view of awake_: only moving bodies, each once, in slot order.
   std::span<const std::uint32_t> awake_slots();
   std::size_t live_count_ = 0;
   std::vector<Aabb> bounds_;
