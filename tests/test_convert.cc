@@ -5,6 +5,10 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "convert.h"
 
@@ -99,6 +103,83 @@ TEST(Convert, FrameKeepsOnlyWhatTheSubscriberAskedFor) {
   EXPECT_EQ(some.positions(0), 20);
   EXPECT_EQ(some.linear_velocities_size(), 3);
   EXPECT_EQ(some.step(), 7u);
+}
+
+// Every field of the message carries the engine's counter of the same name: each counter gets its
+// own value, and every field, found by name, must hold it (a field added to the message without
+// its conversion stays 0 and fails).
+TEST(Convert, StepStatsCarryEveryCounter) {
+  StepStats s;
+  std::vector<std::pair<std::string, double>> expected;
+  double next = 1;
+  const auto set = [&](const char* name, auto& field) {
+    field = static_cast<std::remove_reference_t<decltype(field)>>(next);
+    expected.emplace_back(name, next);
+    next += 1;
+  };
+  set("step", s.step);
+  set("pairs", s.pairs);
+  set("manifolds", s.manifolds);
+  set("contact_points", s.contact_points);
+  set("islands", s.islands);
+  set("exact_islands", s.exact_islands);
+  set("iterative_islands", s.iterative_islands);
+  set("coloured_islands", s.coloured_islands);
+  set("colours", s.colours);
+  set("overflow_manifolds", s.overflow_manifolds);
+  set("packed_manifolds", s.packed_manifolds);
+  set("reused_manifolds", s.reused_manifolds);
+  set("exact_fallbacks", s.exact_fallbacks);
+  set("exact_oversized", s.exact_oversized);
+  set("lemke_pivots", s.lemke_pivots);
+  set("stiffened_islands", s.stiffened_islands);
+  set("stiffness_capped", s.stiffness_capped);
+  set("velocity_iterations", s.velocity_iterations);
+  set("residual", s.residual);
+  set("sleeping_bodies", s.sleeping_bodies);
+  set("woken_bodies", s.woken_bodies);
+  set("solver_bodies", s.solver_bodies);
+  set("swept_bodies", s.swept_bodies);
+  set("continuous_impacts", s.continuous_impacts);
+  set("continuous_limit_hits", s.continuous_limit_hits);
+  set("max_penetration", s.max_penetration);
+  set("gyroscopic_limit_hits", s.gyroscopic_limit_hits);
+  set("non_finite_bodies", s.non_finite_bodies);
+  set("slowed_bodies", s.slowed_bodies);
+  set("bodies_at_edge", s.bodies_at_edge);
+  set("broad_phase_seconds", s.time.broad_phase);
+  set("narrow_phase_seconds", s.time.narrow_phase);
+  set("prepare_seconds", s.time.prepare);
+  set("solve_seconds", s.time.solve);
+  set("correct_positions_seconds", s.time.correct_positions);
+  set("continuous_seconds", s.time.continuous);
+  set("total_seconds", s.time.total);
+
+  v1::StepStats out;
+  stats_to_proto(s, &out);
+  const google::protobuf::Descriptor* descriptor = out.GetDescriptor();
+  const google::protobuf::Reflection* reflection = out.GetReflection();
+  EXPECT_EQ(descriptor->field_count(), static_cast<int>(expected.size()))
+      << "a field of tumble.v1.StepStats that no engine counter is expected in";
+  for (const auto& [name, value] : expected) {
+    const google::protobuf::FieldDescriptor* field = descriptor->FindFieldByName(name);
+    ASSERT_NE(field, nullptr) << name << ": not in tumble.v1.StepStats";
+    double got = -1;
+    switch (field->cpp_type()) {
+      case google::protobuf::FieldDescriptor::CPPTYPE_UINT32:
+        got = reflection->GetUInt32(out, field);
+        break;
+      case google::protobuf::FieldDescriptor::CPPTYPE_UINT64:
+        got = static_cast<double>(reflection->GetUInt64(out, field));
+        break;
+      case google::protobuf::FieldDescriptor::CPPTYPE_DOUBLE:
+        got = reflection->GetDouble(out, field);
+        break;
+      default:
+        ADD_FAILURE() << name << ": an unexpected type";
+    }
+    EXPECT_EQ(got, value) << name;
+  }
 }
 
 }  // namespace
