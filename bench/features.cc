@@ -271,6 +271,29 @@ int main(int argc, char** argv) {
   }
 
   header(
+      "Waking among sleepers: every step one of 10,000 sleeping boxes is woken (it falls asleep "
+      "again 0.5 s later), against the same with none woken");
+  for (const bool poke : {true, false}) {
+    World world = make(field_of_boxes(100));
+    for (int s = 0; s < 60; ++s)  // past the sleep delay (0.5 s)
+      world.step(dt);
+    std::vector<double> total;
+    for (long s = 0; s < steps; ++s) {
+      const auto start = std::chrono::steady_clock::now();
+      // Slot 0 is the floor; boxes are woken in a stride, so that a woken one is asleep again
+      // before its turn comes back.
+      if (poke) world.wake(world.id_at(1 + static_cast<std::uint32_t>((s * 37) % 10000)));
+      world.step(dt);
+      total.push_back(
+          1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    const Measured m{median(total), 0, 0, world.last_step()};
+    row(poke ? "one woken a step" : "none woken", m,
+        std::to_string(m.last.sleeping_bodies) + " sleeping, " +
+            std::to_string(m.last.solver_bodies) + " solver bodies (wake, step)");
+  }
+
+  header(
       "Removing static pedestals from under sleepers (each wakes the box on it): a world of "
       "1,000 against one of 10,000");
   for (const int side : {32, 100}) {

@@ -302,6 +302,27 @@ TEST(Sleeping, KeptRestingCellsGiveTheSweepAndPrunePairs) {
     }
     ASSERT_NO_FATAL_FAILURE(step_both("open step " + std::to_string(n)));
   }
+  // Then one sleeper woken by hand every step, which falls asleep again half a second later, and
+  // boxes dropped onto sleepers that woke and fell asleep again since the grid last listed every
+  // resting body: the grid relists only the bodies that changed (World's resting log), and must
+  // still know every sleeper.
+  for (int n = 0; n < 150; ++n) {
+    const BodyId poked = grid.id_at(1 + (n * 5) % 144);
+    if (poked.is_valid()) {
+      ASSERT_TRUE(grid.wake(poked));
+      ASSERT_TRUE(sap.wake(poked));
+    }
+    if (n >= 45 && n % 6 == 0) {
+      const BodyId below = grid.id_at(1 + ((n - 40) * 5) % 144);
+      if (below.is_valid() && grid.body(below).asleep()) {
+        BodyDef box;
+        box.position = grid.body(below).position() + Vec3(0.1, -0.1, 1.2);
+        const BodyId a = grid.create_body(box).value();
+        ASSERT_EQ(sap.create_body(box).value(), a);
+      }
+    }
+    ASSERT_NO_FATAL_FAILURE(step_both("poked step " + std::to_string(n)));
+  }
 }
 
 }  // namespace tumble::testing

@@ -177,6 +177,67 @@ void HashGrid::list_resting(const BroadPhaseInput& input) {
   resting_version_ = input.resting_version;
 }
 
+void HashGrid::update_resting(const BroadPhaseInput& input) {
+  const auto& bounds = input.bounds;
+  const std::size_t n = bounds.size();
+  level_.resize(n, kDeadSlot);
+  changed_.resize(n, 0);
+  for (std::uint32_t slot : input.resting_changes)
+    changed_[slot] = 1;
+  // What the changed slots had listed goes; what they have now comes back below.
+  const auto changed = [&](std::uint32_t slot) { return changed_[slot] != 0; };
+  std::erase_if(resting_entries_, [&](const Entry& entry) { return changed(entry.body()); });
+  std::erase_if(resting_, changed);
+  std::erase_if(resting_unbounded_, changed);
+  for (std::uint64_t levels = resting_occupied_; levels != 0; levels &= levels - 1)
+    std::erase_if(resting_on_level_[std::countr_zero(levels)], changed);
+  joined_.clear();
+  bool unbounded_joined = false;
+  for (std::uint32_t slot : input.resting_changes) {
+    if (!changed_[slot]) continue;  // listed twice
+    changed_[slot] = 0;
+    level_[slot] = kDeadSlot;
+    if (is_dead(bounds[slot]) || input.movable[slot]) continue;
+    if (off_grid(bounds[slot], base_)) {
+      level_[slot] = kMeetsEveryone;
+      resting_unbounded_.push_back(slot);
+      unbounded_joined = true;
+    } else {
+      joined_.push_back(slot);
+    }
+  }
+  if (unbounded_joined) std::sort(resting_unbounded_.begin(), resting_unbounded_.end());
+  // The lists stay in slot order, as list_resting makes them.
+  std::sort(joined_.begin(), joined_.end());
+  std::uint64_t joined_levels = 0;
+  list_cells(bounds, joined_, 1, &joined_entries_, &joined_levels);
+  merge_buffer_.resize(resting_entries_.size() + joined_entries_.size());
+  std::merge(resting_entries_.begin(), resting_entries_.end(), joined_entries_.begin(),
+             joined_entries_.end(), merge_buffer_.begin());
+  resting_entries_.swap(merge_buffer_);
+  joined_merged_.resize(resting_.size() + joined_.size());
+  std::merge(resting_.begin(), resting_.end(), joined_.begin(), joined_.end(),
+             joined_merged_.begin());
+  resting_.swap(joined_merged_);
+  std::size_t kept_on_level[kMaxLevels];
+  for (int level = 0; level < kMaxLevels; ++level)
+    kept_on_level[level] = resting_on_level_[level].size();
+  for (std::uint32_t slot : joined_)
+    resting_on_level_[level_[slot]].push_back(slot);
+  for (std::uint64_t levels = joined_levels; levels != 0; levels &= levels - 1) {
+    const int level = std::countr_zero(levels);
+    auto& on_level = resting_on_level_[level];
+    const auto kept_end = on_level.begin() + static_cast<std::ptrdiff_t>(kept_on_level[level]);
+    joined_merged_.resize(on_level.size());
+    std::merge(on_level.begin(), kept_end, kept_end, on_level.end(), joined_merged_.begin());
+    std::copy(joined_merged_.begin(), joined_merged_.end(), on_level.begin());
+  }
+  resting_occupied_ = 0;
+  for (int level = 0; level < kMaxLevels; ++level)
+    if (!resting_on_level_[level].empty()) resting_occupied_ |= 1ull << level;
+  resting_version_ = input.resting_version;
+}
+
 void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
   const auto& bounds = input.bounds;
@@ -194,7 +255,14 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     moving = moving_found_;
   }
   if (input.resting_version == 0 || input.resting_version != resting_version_) {
-    list_resting(input);
+    // A few changes are relisted alone; many, and the base cell is chosen afresh with the rest.
+    const bool kept_since = input.changes_since != 0 && resting_version_ != 0 &&
+                            resting_version_ >= input.changes_since;
+    if (kept_since &&
+        4 * input.resting_changes.size() <= resting_.size() + resting_unbounded_.size())
+      update_resting(input);
+    else
+      list_resting(input);
   } else if (level_.size() != n) {
     // Slots made since hold moving bodies, or none: the kept cells stand.
     level_.resize(n, kDeadSlot);

@@ -44,6 +44,12 @@ struct BroadPhaseInput {
   // went, or became movable or not: while it stays, the grid keeps those bodies' cells from the
   // last call (slots added since must be movable or dead). 0: list them every call.
   std::uint64_t resting_version = 0;
+  // The slots whose resting state or bounds changed since version `changes_since` (one the caller
+  // gave an earlier call; versions only grow), when the caller kept them all: a grid that kept the
+  // cells of that version or a later one relists these slots alone. A slot may appear more than
+  // once. changes_since 0: no list.
+  std::span<const std::uint32_t> resting_changes = {};
+  std::uint64_t changes_since = 0;
 };
 
 class HashGrid {
@@ -72,6 +78,8 @@ class HashGrid {
                   std::vector<Entry>* out, std::uint64_t* occupied);
   // Chooses the base cell and lists the resting bodies' cells.
   void list_resting(const BroadPhaseInput& input);
+  // Relists the resting cells of input.resting_changes' slots alone, on the kept base cell.
+  void update_resting(const BroadPhaseInput& input);
 
   std::vector<std::vector<Entry>> thread_entries_, thread_scratch_;
   std::vector<std::vector<BodyPair>> thread_pairs_;
@@ -81,6 +89,11 @@ class HashGrid {
   std::vector<double> sizes_;
   std::vector<std::uint32_t> moving_found_, moving_on_grid_, moving_unbounded_;
   std::vector<std::uint32_t> resting_, resting_unbounded_;
+  // update_resting's scratch: a flag by slot (all zero between calls), the slots that came to
+  // rest, their cells.
+  std::vector<std::uint8_t> changed_;
+  std::vector<std::uint32_t> joined_, joined_merged_;
+  std::vector<Entry> joined_entries_;
   // The resting bodies of each level, for a moving body that would cover more cells of that level
   // than it has bodies.
   std::vector<std::vector<std::uint32_t>> resting_on_level_;

@@ -964,6 +964,7 @@ void World::update_sleep(double dt) {
       body.asleep = true;
       body.sleep_island = island;
       link_sleeper(slot, island);
+      resting_changed(slot);
       if (sleepers_indexed_) recent_sleepers_.push_back(slot);
       body.linear_velocity.setZero();
       body.angular_velocity.setZero();
@@ -972,7 +973,6 @@ void World::update_sleep(double dt) {
   }
   if (fell_asleep) {
     awake_stale_ = true;  // the sleepers leave the moving set
-    ++resting_version_;
   }
   stats_.sleeping_bodies = static_cast<std::uint32_t>(sleeping_count_);
 }

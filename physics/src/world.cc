@@ -134,6 +134,8 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
   }
   std::vector<BodyId> ids;
   ids.reserve(made.size());
+  // The resting log's bound (resting_changed), so that steps never grow it.
+  resting_log_.reserve(256 + (bodies_.size() + made.size()) / 4);
   for (Body& body : made) {
     std::uint32_t index;
     if (!free_slots_.empty()) {
@@ -153,7 +155,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     if (slot.body.is_moving())
       join_awake(index);
     else
-      ++resting_version_;
+      resting_changed(index);
     ids.push_back({index, slot.generation});
     ++live_count_;
   }
@@ -168,7 +170,7 @@ Status World::remove_body(BodyId id) {
   if (slot.body.is_moving())
     leave_awake(id.index);
   else
-    ++resting_version_;
+    resting_changed(id.index);
   // The step's per-slot data forget it (bounds kept for moving bodies are not visited again).
   if (id.index < bounds_.size()) {
     bounds_[id.index] = Aabb();
@@ -249,7 +251,7 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
     if (motion.angular_velocity) body.angular_velocity = *motion.angular_velocity;
   }
   body.update_world_inertia();
-  if (body.is_static()) ++resting_version_;  // (a sleeper wakes below, which counts too)
+  if (body.is_static()) resting_changed(id.index);  // (a sleeper wakes below, which counts too)
   if (body.is_static())
     wake_around(body);  // and what it now touches
   else if (body.asleep)
@@ -292,12 +294,30 @@ std::uint32_t World::wake_island(std::uint32_t island) {
     ++woken;
     --sleeping_count_;
     join_awake(next);
+    resting_changed(next);
     const std::uint32_t slot = next;
     next = sleeper_next_[slot];
     sleeper_next_[slot] = kNoSlot;
   }
-  if (woken > 0) ++resting_version_;
   return woken;
+}
+
+void World::resting_changed(std::uint32_t slot) {
+  ++resting_version_;
+  if (resting_log_dropped_) return;
+  // Bounded by the capacity reserved as bodies are made (256 and a quarter of the slots): past it,
+  // redoing every resting body costs about as much.
+  if (resting_log_.size() >= resting_log_.capacity()) {
+    resting_all_changed();
+    return;
+  }
+  resting_log_.push_back(slot);
+}
+
+void World::resting_all_changed() {
+  ++resting_version_;
+  resting_log_dropped_ = true;
+  resting_log_.clear();
 }
 
 void World::join_awake(std::uint32_t slot) {
@@ -362,11 +382,14 @@ void World::compute_bounds(double dt) {
       settings_.collision.margin + (dt > 0 ? settings_.solver.speculative_distance : 0.0);
   if (base_margin != bounds_margin_) {
     bounds_margin_ = base_margin;
-    ++resting_version_;
+    resting_all_changed();
   }
-  // Bodies that do not move keep last time's bounds while none of them changed. Slots made since
-  // hold moving bodies (a resting one changes the version), which are visited below, or none.
-  const bool all = bounds_version_ != resting_version_;
+  // Bodies that do not move keep last time's bounds while none of them changed, and all but the
+  // logged ones when the log holds every change since these bounds. Slots made since hold moving
+  // bodies (a resting one is logged), which are visited below, or none.
+  const bool changed = bounds_version_ != resting_version_;
+  const bool logged = !resting_log_dropped_ && bounds_version_ >= resting_logged_from_;
+  const bool all = changed && !logged;
   bounds_version_ = resting_version_;
   bounds_.resize(bodies_.size());
   movable_.resize(bodies_.size());
@@ -415,6 +438,9 @@ void World::compute_bounds(double dt) {
     const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
     for_indices(threads, n > 256, n, [&](std::int64_t i) { bound(static_cast<std::uint32_t>(i)); });
   } else {
+    if (changed)
+      for (std::uint32_t slot : resting_log_)
+        bound(slot);
     const std::int64_t n = static_cast<std::int64_t>(awake.size());
     for_indices(threads, n > 256, n, [&](std::int64_t k) { bound(awake[k]); });
   }
@@ -434,6 +460,10 @@ void World::run_broad_phase() {
   input.moving = awake_slots();
   input.moving_listed = true;
   input.resting_version = resting_version_;
+  if (!resting_log_dropped_) {
+    input.resting_changes = resting_log_;
+    input.changes_since = resting_logged_from_;
+  }
   BroadPhaseMethod method = settings_.broad_phase;
   if (method == BroadPhaseMethod::kAuto)
     method = live_count_ < kSweepAndPruneBelow ? BroadPhaseMethod::kSweepAndPrune
@@ -445,6 +475,10 @@ void World::run_broad_phase() {
     sweep_and_prune(input, &pairs_);
   else
     scratch_->grid.find_pairs(input, &pairs_);
+  // The bounds (compute_bounds comes first) and the grid have seen every change so far.
+  resting_log_.clear();
+  resting_logged_from_ = resting_version_;
+  resting_log_dropped_ = false;
 }
 
 std::span<const Contact> World::find_contacts() {

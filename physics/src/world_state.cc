@@ -141,6 +141,7 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
   for (BodySlotState& slot : state.slots)
     world.bodies_.push_back({std::move(slot.body), slot.generation, slot.alive});
   world.free_slots_ = std::move(state.free_slots);
+  world.resting_log_.reserve(256 + slot_count / 4);  // as create_bodies reserves it
   world.sleeper_head_.assign(slot_count, kNoSlot);
   world.sleeper_next_.assign(slot_count, kNoSlot);
   for (std::uint32_t i = 0; i < slot_count; ++i) {

@@ -171,6 +171,16 @@ class World {
   // bumps resting_version_; bounds_ were computed at bounds_version_ with bounds_margin_.
   std::uint64_t resting_version_ = 1, bounds_version_ = 0;
   double bounds_margin_ = -1;
+  // The slots of those changes since version resting_logged_from_ (the broad phase's last), while
+  // they are few: the bounds and the grid's cells are then redone for these slots alone. Versions
+  // only grow, so any consumer that saw resting_logged_from_ or later finds every change since in
+  // the log. Past its bound (or before the first broad phase) the log is dropped and every
+  // resting body is redone.
+  std::vector<std::uint32_t> resting_log_;
+  std::uint64_t resting_logged_from_ = 0;
+  bool resting_log_dropped_ = true;
+  void resting_changed(std::uint32_t slot);
+  void resting_all_changed();
   // Whether the hash grid's resting cells and recent_sleepers_ (bodies fallen asleep since the grid
   // last listed them) hold every sleeper, so that wake_around asks them instead of every slot.
   bool sleepers_indexed_ = false;
