@@ -31,6 +31,32 @@ Json shape_json(const v1::Shape& shape) {
   }
 }
 
+// Every field of the step's statistics under its proto name: counters as integers, times and
+// measures as numbers. Read through the message's descriptor, so a field added to StepStats is
+// printed without a change here.
+Json stats_json(const v1::StepStats& stats) {
+  Json out = Json::object();
+  const google::protobuf::Descriptor* descriptor = stats.GetDescriptor();
+  const google::protobuf::Reflection* reflection = stats.GetReflection();
+  for (int i = 0; i < descriptor->field_count(); ++i) {
+    const google::protobuf::FieldDescriptor* field = descriptor->field(i);
+    switch (field->cpp_type()) {
+      case google::protobuf::FieldDescriptor::CPPTYPE_UINT32:
+        out[field->name()] = reflection->GetUInt32(stats, field);
+        break;
+      case google::protobuf::FieldDescriptor::CPPTYPE_UINT64:
+        out[field->name()] = reflection->GetUInt64(stats, field);
+        break;
+      case google::protobuf::FieldDescriptor::CPPTYPE_DOUBLE:
+        out[field->name()] = reflection->GetDouble(stats, field);
+        break;
+      default:
+        break;  // StepStats holds numbers only
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string frame_to_json_line(const v1::Frame& frame) {
@@ -71,6 +97,7 @@ std::string frame_to_json_line(const v1::Frame& frame) {
     line["added"] = std::move(added);
   }
   if (frame.removed_size() > 0) line["removed"] = slice(frame.removed(), 0, frame.removed_size());
+  if (frame.has_stats()) line["stats"] = stats_json(frame.stats());
   return line.dump();
 }
 

@@ -8,11 +8,13 @@
 namespace tumble::client {
 
 // {"step", "time", "dropped", "bodies": [{"id", "p": [x,y,z], "q": [w,x,y,z], "v", "w"}],
-//  "contacts": [{"a", "b", "p", "n", "depth", "impulse"}], "added": [...], "removed": [...]}
-// Velocities and contacts appear when the frame has them. Numbers round-trip exactly.
+//  "contacts": [{"a", "b", "p", "n", "depth", "impulse"}], "added": [...], "removed": [...],
+//  "stats": {every field of tumble.v1.StepStats by name}}
+// Velocities, contacts and statistics appear when the frame has them. Numbers round-trip exactly.
 std::string frame_to_json_line(const v1::Frame& frame);
 
-// "step,time,id,x,y,z,qw,qx,qy,qz" (and ",vx,vy,vz,wx,wy,wz" with velocities).
+// "step,time,id,x,y,z,qw,qx,qy,qz" (and ",vx,vy,vz,wx,wy,wz" with velocities): a row per body,
+// so contacts and statistics have no place in it (the CLI refuses to ask for them with CSV).
 std::string csv_header(bool velocities);
 std::string frame_to_csv_rows(const v1::Frame& frame, bool velocities);
 

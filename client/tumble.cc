@@ -236,6 +236,11 @@ int main(int argc, char** argv) {
     return 0;
   }
 
+  if (*stream && stream_options.format == "csv" &&
+      (stream_options.contacts || stream_options.stats))
+    return fail("stream", Status::error("--contacts and --stats need --format jsonl: a CSV row "
+                                        "holds one body's pose"));
+
   Result<client::Client> connected = client::Client::connect(connection);
   if (!connected) return fail("--tls-ca", connected.status());
   client::Client& client = connected.value();

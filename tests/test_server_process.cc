@@ -120,6 +120,15 @@ TEST(ServerProcess, CliCommandsHealthSnapshotRecordAndReplay) {
   const Output cut = run(std::string(TUMBLE_CLI_BINARY) + " replay " + dir / "run.rec");
   EXPECT_EQ(std::count(cut.text.begin(), cut.text.end(), '\n'), 5);  // 4 frames and a warning
   EXPECT_NE(cut.text.find("cut short"), std::string::npos);
+  // CSV has a row per body: asking it for contacts or statistics is refused, by name.
+  for (const char* extra : {"--contacts", "--stats"}) {
+    const Output refused_csv = run(tumble + "stream --format csv --frames 1 " + extra);
+    EXPECT_NE(refused_csv.code, 0) << extra;
+    EXPECT_NE(refused_csv.text.find("--format jsonl"), std::string::npos) << refused_csv.text;
+  }
+  const Output with_stats = run(tumble + "stream --frames 1 --stats");
+  ASSERT_EQ(with_stats.code, 0) << with_stats.text;
+  EXPECT_NE(with_stats.text.find("\"solver_bodies\""), std::string::npos) << with_stats.text;
   const Output garbage = run(std::string(TUMBLE_CLI_BINARY) + " replay " + dir / "world.snapshot");
   EXPECT_NE(garbage.code, 0);
   EXPECT_NE(garbage.text.find("not a tumble recording"), std::string::npos) << garbage.text;
