@@ -13,11 +13,14 @@
 // Sleeping is off, so the whole scene is awake. Each round restores the state, takes two untimed
 // steps (the restored world's buffers warm up) and times STEPS more. Prints the mean time per step
 // of each stage per round, then each stage's minimum and median over the rounds, and the state's
-// hash after a round (the same in every round, and in two builds that change no bit).
+// hash after a round (the same in every round, and in two builds that change no bit); after the
+// first round, what a step of it solved (manifolds, contact points, sweeps summed over islands and
+// substeps), which says whether a change of time is a change of work.
 //
 // Comparing builds A and B: run them alternately, e.g.
 //   for r in 1 2 3; do A/bench_replay pile:16000; B/bench_replay pile:16000; done
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -33,6 +36,11 @@ using namespace tumble;
 
 struct Times {
   double broad = 0, narrow = 0, prepare = 0, solve = 0, total = 0;
+};
+
+// What one step of the round solved (the same every round): its size and how many sweeps.
+struct Work {
+  std::uint64_t points = 0, manifolds = 0, sweeps = 0;
 };
 
 int whole_argument(int argc, char** argv, int index, int fallback, int least, int most) {
@@ -94,8 +102,12 @@ int main(int argc, char** argv) {
     for (int warm = 0; warm < 2; ++warm)
       (void)world.step(dt);
     Times sum;
+    Work work;
     for (int i = 0; i < steps; ++i) {
       (void)world.step(dt);
+      work.points += world.last_step().contact_points;
+      work.manifolds += world.last_step().manifolds;
+      work.sweeps += world.last_step().velocity_iterations;
       const StageTimes& t = world.last_step().time;
       sum.broad += t.broad_phase;
       sum.narrow += t.narrow_phase;
@@ -110,6 +122,11 @@ int main(int argc, char** argv) {
     std::printf("%5d %7.3f %7.3f %7.3f %7.3f %7.3f  %016llx\n", round + 1, mean.broad, mean.narrow,
                 mean.prepare, mean.solve, mean.total,
                 static_cast<unsigned long long>(tumble::testing::state_hash(world)));
+    if (round == 0)
+      std::printf(
+          "      a step: %.0f manifolds, %.0f contact points, %.1f sweeps (velocity "
+          "iterations summed over islands and substeps)\n",
+          double(work.manifolds) / steps, double(work.points) / steps, double(work.sweeps) / steps);
   }
   const auto stage = [&](double Times::*field) {
     std::vector<double> values;
