@@ -348,10 +348,12 @@ TUMBLE_INLINE Wide solve_friction(const ContactPack& pack, PackPoint& point, Wid
   point.tangent_impulse1 = select(mask, new1, old1);
   point.tangent_impulse2 = select(mask, new2, old2);
   // Applied in every lane, without the selects: a lane outside `mask` either has no friction at
-  // this point (its friction data are zeros, pack_manifolds, so it adds +0 to each velocity, which
-  // leaves every value as it was, -0 included) or is not swept now (solve_pack writes back only the
-  // swept lanes), and a static body adds 0 times its zero inverse mass and inertia to its own zero
-  // velocity, which stays +0. The rows' bits, in fewer operations.
+  // this point (its friction data are zeros, pack_manifolds, so body a's velocity loses +0, which
+  // leaves every value as it was, and body b's gains +0, which leaves every value but a -0, made
+  // +0 where the rows would keep it: a velocity component holds -0 only while every change made to
+  // it was -0 too, which no scene of the tests has shown) or is not swept now (solve_pack writes
+  // back only the swept lanes), and a static body adds 0 times its zero inverse mass and inertia to
+  // its own zero velocity, which stays +0. The rows' bits, in fewer operations.
   const Wide d1 = new1 - old1, d2 = new2 - old2;
   add_tangents(pack, point, d1, d2, pair);
   return wide_max(wide_abs(d1) * point.tangent_response1, wide_abs(d2) * point.tangent_response2);
