@@ -40,6 +40,33 @@ Measured measure(World& world, double dt, long steps) {
   return {median(total), median(narrow), median(solve), world.last_step()};
 }
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// measure's medians, each step timed with what `before_step(s)` does to the world first (the
+// total column; the stage columns are the step's own).
+template <class Work>
+Measured measure_with(World& world, double dt, long steps, Work&& before_step) {
+  std::vector<double> total, narrow, solve;
+  for (long s = 0; s < steps; ++s) {
+    const auto start = std::chrono::steady_clock::now();
+    before_step(s);
+    world.step(dt);
+    total.push_back(1e3 * seconds_since(start));
+    narrow.push_back(1e3 * world.last_step().time.narrow_phase);
+    solve.push_back(1e3 * world.last_step().time.solve);
+  }
+  return {median(total), median(narrow), median(solve), world.last_step()};
+}
+
+// "N sleeping, M solver bodies" and what the row did, for the sleeper blocks' rows.
+std::string sleepers_note(const StepStats& last, const char* what) {
+  std::string note = std::to_string(last.sleeping_bodies) + " sleeping, " +
+                     std::to_string(last.solver_bodies) + " solver bodies";
+  return *what != '\0' ? note + " " + what : note;
+}
+
 World make(const SceneDef& scene) {
   return make_world(scene).value();
 }
@@ -95,6 +122,14 @@ SceneDef field_of_boxes(int side) {
     for (int j = 0; j < side; ++j)
       scene.bodies.push_back(box_at(Vec3(2.0 * i, 2.0 * j, 0.5)));
   return scene;
+}
+
+// field_of_boxes(side) stepped past the sleep delay (0.5 s): every box asleep.
+World asleep_field(int side, double dt) {
+  World world = make(field_of_boxes(side));
+  for (int s = 0; s < 60; ++s)
+    world.step(dt);
+  return world;
 }
 
 }  // namespace
@@ -236,61 +271,39 @@ int main(int argc, char** argv) {
       world.step(dt);
     const Measured m = measure(world, dt, steps);
     row(with_sleepers ? "10,000 asleep, 1 falling" : "1 falling, alone", m,
-        std::to_string(m.last.sleeping_bodies) + " sleeping, " +
-            std::to_string(m.last.solver_bodies) + " solver bodies");
+        sleepers_note(m.last, ""));
   }
 
   header(
       "Spawning: a box made every step (and removed 30 steps later) among 10,000 sleepers, "
       "against the same in an empty world");
   for (const bool with_sleepers : {true, false}) {
-    World world = make(field_of_boxes(with_sleepers ? 100 : 0));
-    for (int s = 0; s < 60; ++s)  // past the sleep delay (0.5 s)
-      world.step(dt);
+    World world = asleep_field(with_sleepers ? 100 : 0, dt);
     std::vector<BodyId> spawned;
-    std::vector<double> total, narrow, solve;
-    for (long s = 0; s < steps; ++s) {
+    const Measured m = measure_with(world, dt, steps, [&](long s) {
       // Dropped beside the field, so that no sleeper wakes: what is measured is the spawning.
-      const auto start = std::chrono::steady_clock::now();
       spawned.push_back(
           world.create_body(box_at(Vec3(-10.0 - 2.0 * (s % 31), -10.0, 5.0))).value());
       if (spawned.size() > 30) {
         world.remove_body(spawned.front());
         spawned.erase(spawned.begin());
       }
-      world.step(dt);
-      total.push_back(
-          1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      narrow.push_back(1e3 * world.last_step().time.narrow_phase);
-      solve.push_back(1e3 * world.last_step().time.solve);
-    }
-    const Measured m{median(total), median(narrow), median(solve), world.last_step()};
+    });
     row(with_sleepers ? "10,000 asleep" : "empty", m,
-        std::to_string(m.last.sleeping_bodies) + " sleeping, " +
-            std::to_string(m.last.solver_bodies) + " solver bodies (make, remove, step)");
+        sleepers_note(m.last, "(make, remove, step)"));
   }
 
   header(
       "Waking among sleepers: every step one of 10,000 sleeping boxes is woken (it falls asleep "
       "again 0.5 s later), against the same with none woken");
   for (const bool poke : {true, false}) {
-    World world = make(field_of_boxes(100));
-    for (int s = 0; s < 60; ++s)  // past the sleep delay (0.5 s)
-      world.step(dt);
-    std::vector<double> total;
-    for (long s = 0; s < steps; ++s) {
-      const auto start = std::chrono::steady_clock::now();
+    World world = asleep_field(100, dt);
+    const Measured m = measure_with(world, dt, steps, [&](long s) {
       // Slot 0 is the floor; boxes are woken in a stride, so that a woken one is asleep again
       // before its turn comes back.
       if (poke) world.wake(world.id_at(1 + static_cast<std::uint32_t>((s * 37) % 10000)));
-      world.step(dt);
-      total.push_back(
-          1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    }
-    const Measured m{median(total), 0, 0, world.last_step()};
-    row(poke ? "one woken a step" : "none woken", m,
-        std::to_string(m.last.sleeping_bodies) + " sleeping, " +
-            std::to_string(m.last.solver_bodies) + " solver bodies (wake, step)");
+    });
+    row(poke ? "one woken a step" : "none woken", m, sleepers_note(m.last, "(wake, step)"));
   }
 
   header(
@@ -313,8 +326,7 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     for (int k = 0; k < removals; ++k)
       world.remove_body(world.id_at(1 + 2 * k));
-    const double us =
-        1e6 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double us = 1e6 * seconds_since(start);
     std::printf("  %-44s %9.3f us per removal, %u sleeping before\n",
                 (std::to_string(side * side) + " boxes on pedestals").c_str(), us / removals,
                 world.last_step().sleeping_bodies);
@@ -338,13 +350,13 @@ int main(int argc, char** argv) {
     const auto removed = std::chrono::steady_clock::now();
     world.step(dt);
     const auto stepped = std::chrono::steady_clock::now();
-    std::printf("  %-44s %9.3f us per removal, next step %.3f ms (%u solver bodies)\n",
-                (std::to_string(side * side) + " awake, " + std::to_string(doomed.size()) +
-                 " removed")
-                    .c_str(),
-                1e6 * std::chrono::duration<double>(removed - start).count() / doomed.size(),
-                1e3 * std::chrono::duration<double>(stepped - removed).count(),
-                world.last_step().solver_bodies);
+    std::printf(
+        "  %-44s %9.3f us per removal, next step %.3f ms (%u solver bodies)\n",
+        (std::to_string(side * side) + " awake, " + std::to_string(doomed.size()) + " removed")
+            .c_str(),
+        1e6 * std::chrono::duration<double>(removed - start).count() / doomed.size(),
+        1e3 * std::chrono::duration<double>(stepped - removed).count(),
+        world.last_step().solver_bodies);
   }
   return 0;
 }
