@@ -61,6 +61,16 @@ tumble::Status override_limits(const std::vector<std::string>& options,
 
 int main(int argc, char** argv) {
   using namespace tumble;
+  // SIGINT and SIGTERM are blocked in every thread (threads inherit the mask) and taken by the
+  // main thread with sigwait, so shutting down runs as ordinary code, not in a signal handler.
+  // This comes first: creating gRPC credentials starts gRPC's own threads, and a thread started
+  // before the mask would take SIGTERM's default action and kill the server mid-shutdown.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
   CLI::App app{"Tumble's simulation server: steps a world and serves it over gRPC."};
   std::string listen = "127.0.0.1:50051", scene_name, scene_file;
   int threads = 0;
@@ -132,14 +142,6 @@ int main(int argc, char** argv) {
     options.pem_key_cert_pairs.push_back({key.value(), cert.value()});
     credentials = grpc::SslServerCredentials(options);
   }
-
-  // SIGINT and SIGTERM are blocked in every thread (threads inherit the mask) and taken by the
-  // main thread with sigwait, so shutting down runs as ordinary code, not in a signal handler.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
   Result<SceneDef> scene = chosen_scene(scene_file, scene_name);
   if (!scene) {

@@ -65,7 +65,8 @@ struct Server {
     int status = 0;
     ASSERT_EQ(waitpid(pid, &status, 0), pid);
     reaped = true;
-    // Once in a full `make test` (2026-11-24) the server ended by a signal here; say which.
+    // A server ended by a signal let one of its threads take SIGTERM's default action
+    // (EveryThreadBlocksTheStopSignals); say which signal.
     ASSERT_TRUE(WIFEXITED(status)) << "ended by signal "
                                    << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     *exit_code = WEXITSTATUS(status);

@@ -73,6 +73,40 @@ TEST(ServerProcess, ServesOverLoopbackAndStopsOnSigterm) {
   EXPECT_TRUE(reader->Finish().ok());
 }
 
+// The stop signals are meant for the main thread's sigwait. A thread that does not block them
+// (one started before the mask, as gRPC starts its own when credentials are made) would take
+// SIGTERM's default action and kill the server instead of stopping it: CI saw that race once.
+TEST(ServerProcess, EveryThreadBlocksTheStopSignals) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start());
+  {
+    auto stub = connect(server.address);
+    grpc::ClientContext context;
+    tumble::v1::GetInfoResponse info;
+    ASSERT_TRUE(stub->GetInfo(&context, {}, &info).ok());
+  }
+  const unsigned long long stop_bits = (1ull << (SIGINT - 1)) | (1ull << (SIGTERM - 1));
+  int threads = 0;
+  for (const auto& task : fs::directory_iterator("/proc/" + std::to_string(server.pid) + "/task")) {
+    // The main thread waits in sigwait, which unblocks the awaited signals while it waits.
+    if (task.path().filename() == std::to_string(server.pid)) continue;
+    std::ifstream status(task.path() / "status");
+    std::string line;
+    while (std::getline(status, line))
+      if (line.rfind("SigBlk:", 0) == 0) {
+        const unsigned long long blocked = std::stoull(line.substr(7), nullptr, 16);
+        EXPECT_EQ(blocked & stop_bits, stop_bits) << "thread " << task.path().filename() << ": "
+                                                  << line;
+        ++threads;
+      }
+  }
+  EXPECT_GT(threads, 1);
+  int code = -1;
+  std::string last;
+  server.stop(&code, &last);
+  EXPECT_EQ(code, 0);
+}
+
 TEST(ServerProcess, CliCommandsHealthSnapshotRecordAndReplay) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
