@@ -67,8 +67,8 @@ struct Server {
     reaped = true;
     // A server ended by a signal let one of its threads take SIGTERM's default action
     // (EveryThreadBlocksTheStopSignals); say which signal.
-    ASSERT_TRUE(WIFEXITED(status)) << "ended by signal "
-                                   << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    ASSERT_TRUE(WIFEXITED(status))
+        << "ended by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     *exit_code = WEXITSTATUS(status);
     char line[256] = {};
     if (fgets(line, sizeof line, out) != nullptr) *last_line = line;

@@ -95,8 +95,8 @@ TEST(ServerProcess, EveryThreadBlocksTheStopSignals) {
     while (std::getline(status, line))
       if (line.rfind("SigBlk:", 0) == 0) {
         const unsigned long long blocked = std::stoull(line.substr(7), nullptr, 16);
-        EXPECT_EQ(blocked & stop_bits, stop_bits) << "thread " << task.path().filename() << ": "
-                                                  << line;
+        EXPECT_EQ(blocked & stop_bits, stop_bits)
+            << "thread " << task.path().filename() << ": " << line;
         ++threads;
       }
   }
