@@ -40,7 +40,7 @@ struct Times {
 
 // What one step of the round solved (the same every round): its size and how many sweeps.
 struct Work {
-  std::uint64_t points = 0, manifolds = 0, sweeps = 0;
+  std::uint64_t points = 0, manifolds = 0, sweeps = 0, islands = 0, exact_islands = 0, pivots = 0;
 };
 
 int whole_argument(int argc, char** argv, int index, int fallback, int least, int most) {
@@ -108,6 +108,9 @@ int main(int argc, char** argv) {
       work.points += world.last_step().contact_points;
       work.manifolds += world.last_step().manifolds;
       work.sweeps += world.last_step().velocity_iterations;
+      work.islands += world.last_step().islands;
+      work.exact_islands += world.last_step().exact_islands;
+      work.pivots += world.last_step().lemke_pivots;
       const StageTimes& t = world.last_step().time;
       sum.broad += t.broad_phase;
       sum.narrow += t.narrow_phase;
@@ -125,8 +128,11 @@ int main(int argc, char** argv) {
     if (round == 0)
       std::printf(
           "      a step: %.0f manifolds, %.0f contact points, %.1f sweeps (velocity "
-          "iterations summed over islands and substeps)\n",
-          double(work.manifolds) / steps, double(work.points) / steps, double(work.sweeps) / steps);
+          "iterations summed over islands and substeps); %.0f islands, %.0f of them exact, "
+          "%.0f Lemke pivots\n",
+          double(work.manifolds) / steps, double(work.points) / steps, double(work.sweeps) / steps,
+          double(work.islands) / steps, double(work.exact_islands) / steps,
+          double(work.pivots) / steps);
   }
   const auto stage = [&](double Times::*field) {
     std::vector<double> values;

@@ -1,9 +1,12 @@
 // Box-box contacts against an exact separating-axis reference, on 100k random pairs drawn from the
 // hard cases: generic overlaps, exact face-to-face touching, parallel edges, near-degenerate
-// orientations, tiny depths, size ratios up to 1:1000, and positions 1e5 m from the origin.
+// orientations, tiny depths, size ratios up to 1:1000, and positions 1e5 m from the origin; and
+// faces of many sides, whose clipped polygon outgrows the clipper's stack buffers.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "physics/collision.h"
 #include "test_support.h"
@@ -177,6 +180,36 @@ TEST(BoxCollision, RestingBoxGivesFourPointsWithStableIds) {
       found |= first.points[k].feature_id == second.points[j].feature_id;
     EXPECT_TRUE(found) << "point " << k;
   }
+}
+
+// Two 40-sided prisms face to face, one turned by a fraction of a side: their faces' overlap has
+// 80 corners, more than the clipper keeps on the stack, so its buffers move to the heap (twice,
+// the second time with the polygon already there). The manifold is still the overlap's extent.
+TEST(BoxCollision, ManySidedFacesClipToFourSpreadPoints) {
+  constexpr int kSides = 40;
+  std::vector<Vec3> points;
+  for (int k = 0; k < kSides; ++k) {
+    const double angle = 2 * M_PI * k / kSides;
+    for (double z : {-0.25, 0.25})
+      points.push_back(Vec3(std::cos(angle), std::sin(angle), z));
+  }
+  const Shape prism = Shape::create(HullDef{points}).value();
+  Pose pa, pb;
+  pb.orientation = Quat(Eigen::AngleAxisd(M_PI / kSides, Vec3::UnitZ()));
+  pb.position = Vec3(0, 0, 0.5 - 0.01);
+  ContactManifold m;
+  collide(prism, pa, prism, pb, {}, &m);
+  ASSERT_EQ(m.count, 4);
+  EXPECT_TRUE(m.normal.isApprox(Vec3::UnitZ(), 1e-12));
+  double widest = 0;
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR(m.points[k].depth, 0.01, 1e-12) << k;
+    EXPECT_LE(m.points[k].point_b.head<2>().norm(), 1 + 1e-12) << k;
+    for (int j = 0; j < k; ++j)
+      widest = std::max(widest, (m.points[k].point_b - m.points[j].point_b).norm());
+  }
+  // The overlap is a disc of radius about 0.997: two of the four points lie across it.
+  EXPECT_GT(widest, 1.95);
 }
 
 TEST(BoxCollision, CrossedEdgesGiveOnePointBetweenTheEdges) {

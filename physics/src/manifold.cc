@@ -4,12 +4,36 @@
 // long as the same incident vertex, or the same incident edge crossing the same side, makes it.
 #include "manifold.h"
 
+#include <algorithm>
 #include <limits>
 
 namespace tumble {
 namespace {
 
 constexpr std::uint32_t kEdgeTag = 0x80000;
+
+// Clips the polygon `in` (n vertices) against the half-space side . x <= side_offset into `out`,
+// which has room for 2 n (each edge gives at most its first vertex and a crossing: a convex
+// polygon gains at most one vertex, but rounding can leave one slightly concave); returns the
+// count. `side_index` names the crossings.
+std::size_t clip_against_side(const ClipVertex* in, std::size_t n, const Vec3& side,
+                              double side_offset, std::uint32_t side_index, ClipVertex* out) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const ClipVertex& a = in[i];
+    const ClipVertex& b = in[i + 1 == n ? 0 : i + 1];
+    const double da = side.dot(a.point) - side_offset;
+    const double db = side.dot(b.point) - side_offset;
+    if (da <= 0) out[count++] = a;
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+      const double t = da / (da - db);
+      // The crossing is named by the incident edge (its first vertex's tag) and the side.
+      out[count++] = {a.point + t * (b.point - a.point),
+                      kEdgeTag | ((a.tag & 0xFF) << 8) | side_index};
+    }
+  }
+  return count;
+}
 
 }  // namespace
 
@@ -31,51 +55,65 @@ std::uint32_t most_opposed_face(const PlacedPolyhedron& incident, const Vec3& no
 void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t reference_face,
                        const PlacedPolyhedron& incident, std::uint32_t incident_face,
                        bool reference_is_a, double margin, ContactManifold* out) {
-  thread_local std::vector<ClipVertex> polygon, clipped;
-  thread_local std::vector<ContactPoint> candidates;
-  polygon.clear();
   const auto& inc_face = incident.polyhedron->faces[incident_face];
-  for (std::uint32_t k = 0; k < inc_face.count; ++k)
-    polygon.push_back({incident.point(incident.polyhedron->face_vertices[inc_face.first + k]), k});
-
   const auto& ref_face = reference.polyhedron->faces[reference_face];
+  // Box faces and most hull faces clip on the stack; a polygon that could outgrow it moves to
+  // this thread's buffers, which only grow.
+  constexpr std::size_t kOnStack = 32;
+  ClipVertex stack_polygon[kOnStack], stack_clipped[kOnStack];
+  ClipVertex* polygon = stack_polygon;
+  ClipVertex* clipped = stack_clipped;
+  std::size_t capacity = kOnStack;
+  thread_local std::vector<ClipVertex> heap_polygon, heap_clipped;
+  const auto make_room = [&](std::size_t size, std::size_t needed) {
+    if (needed <= capacity) return;
+    // The polygon may already live in the buffers that are about to grow: keep it aside first.
+    const std::vector<ClipVertex> kept(polygon, polygon + size);
+    heap_polygon.resize(std::max(needed, heap_polygon.size()));
+    heap_clipped.resize(heap_polygon.size());
+    std::copy(kept.begin(), kept.end(), heap_polygon.begin());
+    polygon = heap_polygon.data();
+    clipped = heap_clipped.data();
+    capacity = heap_polygon.size();
+  };
+  std::size_t size = inc_face.count;
+  make_room(0, size);
+  for (std::uint32_t k = 0; k < inc_face.count; ++k)
+    polygon[k] = {incident.point(incident.polyhedron->face_vertices[inc_face.first + k]), k};
+
   const Vec3 n = reference.face_normal(reference_face);
   const double offset = reference.face_offset(reference_face);
-  for (std::uint32_t k = 0; k < ref_face.count && !polygon.empty(); ++k) {
-    const Vec3 p = reference.point(reference.polyhedron->face_vertices[ref_face.first + k]);
-    const Vec3 q = reference.point(
-        reference.polyhedron->face_vertices[ref_face.first + (k + 1) % ref_face.count]);
+  const std::uint32_t* ref_vertices = &reference.polyhedron->face_vertices[ref_face.first];
+  const Vec3 first_corner = reference.point(ref_vertices[0]);
+  Vec3 p = first_corner;
+  for (std::uint32_t k = 0; k < ref_face.count && size > 0; ++k) {
+    const Vec3 q = k + 1 < ref_face.count ? reference.point(ref_vertices[k + 1]) : first_corner;
     const Vec3 side = (q - p).cross(n);  // outward for a counter-clockwise loop
-    const double side_offset = side.dot(p);
-    clipped.clear();
-    for (std::size_t i = 0; i < polygon.size(); ++i) {
-      const ClipVertex& a = polygon[i];
-      const ClipVertex& b = polygon[(i + 1) % polygon.size()];
-      const double da = side.dot(a.point) - side_offset;
-      const double db = side.dot(b.point) - side_offset;
-      if (da <= 0) clipped.push_back(a);
-      if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
-        const double t = da / (da - db);
-        // The crossing is named by the incident edge (its first vertex's tag) and the side.
-        clipped.push_back(
-            {a.point + t * (b.point - a.point), kEdgeTag | ((a.tag & 0xFF) << 8) | k});
-      }
-    }
+    make_room(size, 2 * size);
+    size = clip_against_side(polygon, size, side, side.dot(p), k, clipped);
     std::swap(polygon, clipped);
+    p = q;
   }
 
-  candidates.clear();
-  for (const ClipVertex& v : polygon) {
+  // At most one candidate per clipped vertex, or the deepest vertex alone.
+  ContactPoint stack_candidates[kOnStack];
+  thread_local std::vector<ContactPoint> heap_candidates;
+  ContactPoint* candidates = stack_candidates;
+  if (size + 1 > kOnStack) {
+    if (heap_candidates.size() < size + 1) heap_candidates.resize(size + 1);
+    candidates = heap_candidates.data();
+  }
+  std::size_t candidate_count = 0;
+  for (const ClipVertex& v : std::span(polygon, size)) {
     const double separation = n.dot(v.point) - offset;
     if (separation > margin) continue;
-    ContactPoint c;
+    ContactPoint& c = candidates[candidate_count++];
     const Vec3 on_reference = v.point - separation * n;
     c.point_a = reference_is_a ? on_reference : v.point;
     c.point_b = reference_is_a ? v.point : on_reference;
     c.depth = -separation;
     c.feature_id = feature_id(reference_is_a ? kFeatureFaceA : kFeatureFaceB, reference_face,
                               incident_face, v.tag);
-    candidates.push_back(c);
   }
   // The incident body's deepest vertex fixes the pair's depth. In deep overlaps the incident face
   // can lie wholly outside the reference face's prism; that vertex is then the one contact.
@@ -84,14 +122,14 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   const Vec3 v = incident.point(deepest);
   const double deepest_separation = n.dot(v) - offset;
   out->depth = -deepest_separation;
-  if (candidates.empty() && deepest_separation <= margin) {
+  if (candidate_count == 0 && deepest_separation <= margin) {
     const Vec3 on_reference = v - deepest_separation * n;
-    candidates.push_back(
-        {reference_is_a ? on_reference : v, reference_is_a ? v : on_reference, -deepest_separation,
-         feature_id(kFeatureVertex, reference_face, deepest, reference_is_a ? 1 : 2)});
+    candidates[candidate_count++] = {
+        reference_is_a ? on_reference : v, reference_is_a ? v : on_reference, -deepest_separation,
+        feature_id(kFeatureVertex, reference_face, deepest, reference_is_a ? 1 : 2)};
   }
   out->normal = reference_is_a ? n : Vec3(-n);
-  reduce_points(candidates, out->normal, out);
+  reduce_points(std::span(candidates, candidate_count), out->normal, out);
 }
 
 void reduce_points(std::span<const ContactPoint> candidates, const Vec3& normal,
