@@ -6,11 +6,41 @@
 
 #include <algorithm>
 #include <limits>
+#include <new>
 
 namespace tumble {
 namespace {
 
 constexpr std::uint32_t kEdgeTag = 0x80000;
+
+constexpr std::size_t kOnStack = 32;
+
+// Where clip_face_contact's polygon and its clipped copy live: first on its stack, then, for a
+// polygon that could outgrow `capacity`, in this thread's buffers, which only grow.
+struct ClipSpace {
+  ClipVertex* polygon;
+  ClipVertex* clipped;
+  std::size_t capacity;
+
+  [[gnu::noinline]] void move_to_heap(std::size_t size, std::size_t needed) {
+    thread_local std::vector<ClipVertex> heap_polygon, heap_clipped;
+    // The polygon may already live in the buffers that are about to grow: keep it aside first.
+    const std::vector<ClipVertex> kept(polygon, polygon + size);
+    heap_polygon.resize(std::max(needed, heap_polygon.size()));
+    heap_clipped.resize(heap_polygon.size());
+    std::copy(kept.begin(), kept.end(), heap_polygon.begin());
+    polygon = heap_polygon.data();
+    clipped = heap_clipped.data();
+    capacity = heap_polygon.size();
+  }
+};
+
+// This thread's room for `count` candidate points, for faces too large for the stack.
+[[gnu::noinline]] ContactPoint* heap_candidates(std::size_t count) {
+  thread_local std::vector<ContactPoint> candidates;
+  if (candidates.size() < count) candidates.resize(count);
+  return candidates.data();
+}
 
 // Clips the polygon `in` (n vertices) against the half-space side . x <= side_offset into `out`,
 // which has room for 2 n (each edge gives at most its first vertex and a crossing: a convex
@@ -19,11 +49,15 @@ constexpr std::uint32_t kEdgeTag = 0x80000;
 std::size_t clip_against_side(const ClipVertex* in, std::size_t n, const Vec3& side,
                               double side_offset, std::uint32_t side_index, ClipVertex* out) {
   std::size_t count = 0;
+  // Each vertex's distance is measured once: as the end of one edge, then as the start of the next.
+  const double d_first = side.dot(in[0].point) - side_offset;
+  double db = d_first;
   for (std::size_t i = 0; i < n; ++i) {
     const ClipVertex& a = in[i];
-    const ClipVertex& b = in[i + 1 == n ? 0 : i + 1];
-    const double da = side.dot(a.point) - side_offset;
-    const double db = side.dot(b.point) - side_offset;
+    const bool last = i + 1 == n;
+    const ClipVertex& b = in[last ? 0 : i + 1];
+    const double da = db;
+    db = last ? d_first : side.dot(b.point) - side_offset;
     if (da <= 0) out[count++] = a;
     if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
       const double t = da / (da - db);
@@ -58,23 +92,13 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   const auto& inc_face = incident.polyhedron->faces[incident_face];
   const auto& ref_face = reference.polyhedron->faces[reference_face];
   // Box faces and most hull faces clip on the stack; a polygon that could outgrow it moves to
-  // this thread's buffers, which only grow.
-  constexpr std::size_t kOnStack = 32;
+  // this thread's buffers (ClipSpace::move_to_heap).
   ClipVertex stack_polygon[kOnStack], stack_clipped[kOnStack];
-  ClipVertex* polygon = stack_polygon;
-  ClipVertex* clipped = stack_clipped;
-  std::size_t capacity = kOnStack;
-  thread_local std::vector<ClipVertex> heap_polygon, heap_clipped;
+  ClipSpace space{stack_polygon, stack_clipped, kOnStack};
+  ClipVertex*& polygon = space.polygon;
+  ClipVertex*& clipped = space.clipped;
   const auto make_room = [&](std::size_t size, std::size_t needed) {
-    if (needed <= capacity) return;
-    // The polygon may already live in the buffers that are about to grow: keep it aside first.
-    const std::vector<ClipVertex> kept(polygon, polygon + size);
-    heap_polygon.resize(std::max(needed, heap_polygon.size()));
-    heap_clipped.resize(heap_polygon.size());
-    std::copy(kept.begin(), kept.end(), heap_polygon.begin());
-    polygon = heap_polygon.data();
-    clipped = heap_clipped.data();
-    capacity = heap_polygon.size();
+    if (needed > space.capacity) space.move_to_heap(size, needed);
   };
   std::size_t size = inc_face.count;
   make_room(0, size);
@@ -95,25 +119,25 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
     p = q;
   }
 
-  // At most one candidate per clipped vertex, or the deepest vertex alone.
-  ContactPoint stack_candidates[kOnStack];
-  thread_local std::vector<ContactPoint> heap_candidates;
-  ContactPoint* candidates = stack_candidates;
-  if (size + 1 > kOnStack) {
-    if (heap_candidates.size() < size + 1) heap_candidates.resize(size + 1);
-    candidates = heap_candidates.data();
-  }
+  // At most one candidate per clipped vertex, or the deepest vertex alone. The stack's slots are
+  // left unset (ContactPoint's member initialisers would zero all 32 on every call): each one used
+  // is made whole where it is written.
+  union StackCandidates {
+    StackCandidates() {}
+    ContactPoint slots[kOnStack];
+  } stack_candidates;
+  ContactPoint* candidates =
+      size + 1 > kOnStack ? heap_candidates(size + 1) : stack_candidates.slots;
   std::size_t candidate_count = 0;
   for (const ClipVertex& v : std::span(polygon, size)) {
     const double separation = n.dot(v.point) - offset;
     if (separation > margin) continue;
-    ContactPoint& c = candidates[candidate_count++];
     const Vec3 on_reference = v.point - separation * n;
-    c.point_a = reference_is_a ? on_reference : v.point;
-    c.point_b = reference_is_a ? v.point : on_reference;
-    c.depth = -separation;
-    c.feature_id = feature_id(reference_is_a ? kFeatureFaceA : kFeatureFaceB, reference_face,
-                              incident_face, v.tag);
+    new (&candidates[candidate_count++])
+        ContactPoint{reference_is_a ? on_reference : v.point,
+                     reference_is_a ? v.point : on_reference, -separation,
+                     feature_id(reference_is_a ? kFeatureFaceA : kFeatureFaceB, reference_face,
+                                incident_face, v.tag)};
   }
   // The incident body's deepest vertex fixes the pair's depth. In deep overlaps the incident face
   // can lie wholly outside the reference face's prism; that vertex is then the one contact.
@@ -124,7 +148,7 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   out->depth = -deepest_separation;
   if (candidate_count == 0 && deepest_separation <= margin) {
     const Vec3 on_reference = v - deepest_separation * n;
-    candidates[candidate_count++] = {
+    new (&candidates[candidate_count++]) ContactPoint{
         reference_is_a ? on_reference : v, reference_is_a ? v : on_reference, -deepest_separation,
         feature_id(kFeatureVertex, reference_face, deepest, reference_is_a ? 1 : 2)};
   }
