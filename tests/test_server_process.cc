@@ -35,14 +35,19 @@ std::unique_ptr<tumble::v1::World::Stub> connect(const std::string& address) {
   return tumble::v1::World::NewStub(channel);
 }
 
+// The server's answer to GetInfo; false when the call failed.
+bool get_info(tumble::v1::World::Stub& stub, tumble::v1::GetInfoResponse* info) {
+  grpc::ClientContext context;
+  return stub.GetInfo(&context, {}, info).ok();
+}
+
 TEST(ServerProcess, ServesOverLoopbackAndStopsOnSigterm) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start());
   auto stub = connect(server.address);
   {
-    grpc::ClientContext context;
     tumble::v1::GetInfoResponse info;
-    ASSERT_TRUE(stub->GetInfo(&context, {}, &info).ok());
+    ASSERT_TRUE(get_info(*stub, &info));
     EXPECT_EQ(info.body_count(), 51u);  // the default scene
   }
   {  // the command-line client: spawn a box, then one frame as a JSON line that holds it
@@ -79,12 +84,8 @@ TEST(ServerProcess, ServesOverLoopbackAndStopsOnSigterm) {
 TEST(ServerProcess, EveryThreadBlocksTheStopSignals) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start());
-  {
-    auto stub = connect(server.address);
-    grpc::ClientContext context;
-    tumble::v1::GetInfoResponse info;
-    ASSERT_TRUE(stub->GetInfo(&context, {}, &info).ok());
-  }
+  tumble::v1::GetInfoResponse info;
+  ASSERT_TRUE(get_info(*connect(server.address), &info));  // a call served: the server is up
   const unsigned long long stop_bits = (1ull << (SIGINT - 1)) | (1ull << (SIGTERM - 1));
   int threads = 0;
   for (const auto& task : fs::directory_iterator("/proc/" + std::to_string(server.pid) + "/task")) {
@@ -186,9 +187,8 @@ TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
   tumble::v1::RestoreResponse response;
   const grpc::Status status = stub->Restore(&context, request, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
-  grpc::ClientContext info_context;
   tumble::v1::GetInfoResponse info;
-  ASSERT_TRUE(stub->GetInfo(&info_context, {}, &info).ok());
+  ASSERT_TRUE(get_info(*stub, &info));
   EXPECT_EQ(info.body_count(), 51u);
 }
 
