@@ -182,10 +182,8 @@ TEST(BoxCollision, RestingBoxGivesFourPointsWithStableIds) {
   }
 }
 
-// Two 40-sided prisms face to face, one turned by a fraction of a side: their faces' overlap has
-// 80 corners, more than the clipper keeps on the stack, so its buffers move to the heap (twice,
-// the second time with the polygon already there). The manifold is still the overlap's extent.
-TEST(BoxCollision, ManySidedFacesClipToFourSpreadPoints) {
+// A prism of 40 sides (80 corners), more than the clippers keep on the stack.
+Shape many_sided_prism() {
   constexpr int kSides = 40;
   std::vector<Vec3> points;
   for (int k = 0; k < kSides; ++k) {
@@ -193,23 +191,52 @@ TEST(BoxCollision, ManySidedFacesClipToFourSpreadPoints) {
     for (double z : {-0.25, 0.25})
       points.push_back(Vec3(std::cos(angle), std::sin(angle), z));
   }
-  const Shape prism = Shape::create(HullDef{points}).value();
+  return Shape::create(HullDef{points}).value();
+}
+
+// The widest distance between two of a manifold's points.
+double widest_spread(const ContactManifold& m) {
+  double widest = 0;
+  for (int k = 0; k < m.count; ++k)
+    for (int j = 0; j < k; ++j)
+      widest = std::max(widest, (m.points[k].point_b - m.points[j].point_b).norm());
+  return widest;
+}
+
+// Two such prisms face to face, one turned by half a side: their faces' overlap has 80 corners,
+// so the clipper's polygon moves to the heap (twice, the second time with the polygon already
+// there). The manifold is still the overlap's extent.
+TEST(BoxCollision, ManySidedFacesClipToFourSpreadPoints) {
+  const Shape prism = many_sided_prism();
   Pose pa, pb;
-  pb.orientation = Quat(Eigen::AngleAxisd(M_PI / kSides, Vec3::UnitZ()));
+  pb.orientation = Quat(Eigen::AngleAxisd(M_PI / 40, Vec3::UnitZ()));
   pb.position = Vec3(0, 0, 0.5 - 0.01);
   ContactManifold m;
   collide(prism, pa, prism, pb, {}, &m);
   ASSERT_EQ(m.count, 4);
   EXPECT_TRUE(m.normal.isApprox(Vec3::UnitZ(), 1e-12));
-  double widest = 0;
   for (int k = 0; k < 4; ++k) {
     EXPECT_NEAR(m.points[k].depth, 0.01, 1e-12) << k;
     EXPECT_LE(m.points[k].point_b.head<2>().norm(), 1 + 1e-12) << k;
-    for (int j = 0; j < k; ++j)
-      widest = std::max(widest, (m.points[k].point_b - m.points[j].point_b).norm());
   }
   // The overlap is a disc of radius about 0.997: two of the four points lie across it.
-  EXPECT_GT(widest, 1.95);
+  EXPECT_GT(widest_spread(m), 1.95);
+}
+
+// The same prism sunk 1 cm into the ground: 40 corners touch, more candidates than the stack holds.
+TEST(BoxCollision, ManyCornersOnTheGroundReduceToFourSpreadPoints) {
+  const Shape prism = many_sided_prism();
+  const Shape ground = Shape::create(HalfSpaceDef{}).value();
+  Pose on_ground;
+  on_ground.position = Vec3(0, 0, 0.25 - 0.01);
+  ContactManifold m;
+  collide(prism, on_ground, ground, Pose{}, {}, &m);
+  ASSERT_EQ(m.count, 4);
+  EXPECT_TRUE(m.normal.isApprox(-Vec3::UnitZ(), 1e-12));
+  EXPECT_NEAR(m.depth, 0.01, 1e-12);
+  for (int k = 0; k < 4; ++k)
+    EXPECT_NEAR(m.points[k].depth, 0.01, 1e-12) << k;
+  EXPECT_GT(widest_spread(m), 1.95);
 }
 
 TEST(BoxCollision, CrossedEdgesGiveOnePointBetweenTheEdges) {

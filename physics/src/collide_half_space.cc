@@ -1,6 +1,8 @@
 // Anything against the ground half-space (solid z <= 0 of its frame): every vertex or core end
 // below the plane (or within the margin above it) is a contact; more than four are reduced.
 #include <limits>
+#include <new>
+#include <span>
 
 #include "manifold.h"
 #include "narrow_phase.h"
@@ -11,13 +13,16 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
                                  double margin, ContactManifold* out) {
   out->count = 0;
   out->normal = -Vec3::UnitZ();  // from A into the ground
-  thread_local std::vector<ContactPoint> candidates;
-  candidates.clear();
+  // At most one candidate per vertex (a sphere has one, a capsule two).
+  CandidateSlots stack_candidates;
+  ContactPoint* candidates = candidate_room(
+      stack_candidates, a.polyhedron() != nullptr ? a.polyhedron()->vertices.size() : 2);
+  std::size_t count = 0;
   auto consider = [&](const Vec3& core, double radius, std::uint64_t id) {
     const double depth = radius - core.z();
     if (depth < -margin) return;
     const Vec3 on_a = core - Vec3(0, 0, radius);
-    candidates.push_back({on_a, Vec3(core.x(), core.y(), 0), depth, id});
+    new (&candidates[count++]) ContactPoint{on_a, Vec3(core.x(), core.y(), 0), depth, id};
   };
   switch (a.type()) {
     case ShapeType::kSphere:
@@ -38,7 +43,7 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
         const double z = up.dot(vertices[i]) + translation.z();
         if (-z < -margin) continue;
         const Vec3 v = rotation * vertices[i] + translation;
-        candidates.push_back({v, Vec3(v.x(), v.y(), 0), -z, kFeatureVertex | i});
+        new (&candidates[count++]) ContactPoint{v, Vec3(v.x(), v.y(), 0), -z, kFeatureVertex | i};
       }
       break;
     }
@@ -46,9 +51,10 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
       return kCollisionOk;
   }
   out->depth = -std::numeric_limits<double>::infinity();
-  for (const ContactPoint& c : candidates)
+  const std::span<const ContactPoint> found(candidates, count);
+  for (const ContactPoint& c : found)
     out->depth = std::max(out->depth, c.depth);
-  reduce_points(candidates, out->normal, out);
+  reduce_points(found, out->normal, out);
   return kCollisionOk;
 }
 

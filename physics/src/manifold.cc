@@ -13,7 +13,7 @@ namespace {
 
 constexpr std::uint32_t kEdgeTag = 0x80000;
 
-constexpr std::size_t kOnStack = 32;
+constexpr std::size_t kPolygonOnStack = 32;
 
 // Where clip_face_contact's polygon and its clipped copy live: first on its stack, then, for a
 // polygon that could outgrow `capacity`, in this thread's buffers, which only grow.
@@ -34,13 +34,6 @@ struct ClipSpace {
     capacity = heap_polygon.size();
   }
 };
-
-// This thread's room for `count` candidate points, for faces too large for the stack.
-[[gnu::noinline]] ContactPoint* heap_candidates(std::size_t count) {
-  thread_local std::vector<ContactPoint> candidates;
-  if (candidates.size() < count) candidates.resize(count);
-  return candidates.data();
-}
 
 // Clips the polygon `in` (n vertices) against the half-space side . x <= side_offset into `out`,
 // which has room for 2 n (each edge gives at most its first vertex and a crossing: a convex
@@ -71,6 +64,12 @@ std::size_t clip_against_side(const ClipVertex* in, std::size_t n, const Vec3& s
 
 }  // namespace
 
+ContactPoint* thread_candidate_room(std::size_t count) {
+  thread_local std::vector<ContactPoint> room;
+  if (room.size() < count) room.resize(count);
+  return room.data();
+}
+
 std::uint32_t most_opposed_face(const PlacedPolyhedron& incident, const Vec3& normal) {
   const Vec3 local = incident.rotation.transpose() * normal;
   std::uint32_t best = 0;
@@ -93,8 +92,8 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   const auto& ref_face = reference.polyhedron->faces[reference_face];
   // Box faces and most hull faces clip on the stack; a polygon that could outgrow it moves to
   // this thread's buffers (ClipSpace::move_to_heap).
-  ClipVertex stack_polygon[kOnStack], stack_clipped[kOnStack];
-  ClipSpace space{stack_polygon, stack_clipped, kOnStack};
+  ClipVertex stack_polygon[kPolygonOnStack], stack_clipped[kPolygonOnStack];
+  ClipSpace space{stack_polygon, stack_clipped, kPolygonOnStack};
   ClipVertex*& polygon = space.polygon;
   ClipVertex*& clipped = space.clipped;
   const auto make_room = [&](std::size_t size, std::size_t needed) {
@@ -119,15 +118,9 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
     p = q;
   }
 
-  // At most one candidate per clipped vertex, or the deepest vertex alone. The stack's slots are
-  // left unset (ContactPoint's member initialisers would zero all 32 on every call): each one used
-  // is made whole where it is written.
-  union StackCandidates {
-    StackCandidates() {}
-    ContactPoint slots[kOnStack];
-  } stack_candidates;
-  ContactPoint* candidates =
-      size + 1 > kOnStack ? heap_candidates(size + 1) : stack_candidates.slots;
+  // At most one candidate per clipped vertex, or the deepest vertex alone.
+  CandidateSlots stack_candidates;
+  ContactPoint* candidates = candidate_room(stack_candidates, size + 1);
   std::size_t candidate_count = 0;
   for (const ClipVertex& v : std::span(polygon, size)) {
     const double separation = n.dot(v.point) - offset;

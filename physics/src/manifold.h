@@ -14,6 +14,20 @@ struct ClipVertex {
   std::uint32_t tag;  // which incident vertex, or which incident edge crossed which side plane
 };
 
+// Room for a manifold's candidate points before reduce_points: up to kCandidatesOnStack on the
+// caller's stack, left unset (ContactPoint's member initialisers would zero every slot on every
+// call; each slot used is made whole where it is written), more in this thread's buffer, which
+// only grows.
+constexpr std::size_t kCandidatesOnStack = 32;
+union CandidateSlots {
+  CandidateSlots() {}
+  ContactPoint slots[kCandidatesOnStack];
+};
+ContactPoint* thread_candidate_room(std::size_t count);
+inline ContactPoint* candidate_room(CandidateSlots& stack, std::size_t count) {
+  return count <= kCandidatesOnStack ? stack.slots : thread_candidate_room(count);
+}
+
 // Feature ids: kind in the top bits so that points made by different routes never share an id.
 enum FeatureKind : std::uint64_t {
   kFeatureFaceA = 1ull << 60,
