@@ -22,6 +22,11 @@ struct ClipSpace {
   ClipVertex* clipped;
   std::size_t capacity;
 
+  // Room for `needed` vertices, keeping the polygon's first `size`.
+  void make_room(std::size_t size, std::size_t needed) {
+    if (needed > capacity) move_to_heap(size, needed);
+  }
+
   [[gnu::noinline]] void move_to_heap(std::size_t size, std::size_t needed) {
     thread_local std::vector<ClipVertex> heap_polygon, heap_clipped;
     // The polygon may already live in the buffers that are about to grow: keep it aside first.
@@ -94,15 +99,10 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   // this thread's buffers (ClipSpace::move_to_heap).
   ClipVertex stack_polygon[kPolygonOnStack], stack_clipped[kPolygonOnStack];
   ClipSpace space{stack_polygon, stack_clipped, kPolygonOnStack};
-  ClipVertex*& polygon = space.polygon;
-  ClipVertex*& clipped = space.clipped;
-  const auto make_room = [&](std::size_t size, std::size_t needed) {
-    if (needed > space.capacity) space.move_to_heap(size, needed);
-  };
   std::size_t size = inc_face.count;
-  make_room(0, size);
+  space.make_room(0, size);
   for (std::uint32_t k = 0; k < inc_face.count; ++k)
-    polygon[k] = {incident.point(incident.polyhedron->face_vertices[inc_face.first + k]), k};
+    space.polygon[k] = {incident.point(incident.polyhedron->face_vertices[inc_face.first + k]), k};
 
   const Vec3 n = reference.face_normal(reference_face);
   const double offset = reference.face_offset(reference_face);
@@ -112,9 +112,9 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   for (std::uint32_t k = 0; k < ref_face.count && size > 0; ++k) {
     const Vec3 q = k + 1 < ref_face.count ? reference.point(ref_vertices[k + 1]) : first_corner;
     const Vec3 side = (q - p).cross(n);  // outward for a counter-clockwise loop
-    make_room(size, 2 * size);
-    size = clip_against_side(polygon, size, side, side.dot(p), k, clipped);
-    std::swap(polygon, clipped);
+    space.make_room(size, 2 * size);
+    size = clip_against_side(space.polygon, size, side, side.dot(p), k, space.clipped);
+    std::swap(space.polygon, space.clipped);
     p = q;
   }
 
@@ -122,7 +122,7 @@ void clip_face_contact(const PlacedPolyhedron& reference, std::uint32_t referenc
   CandidateSlots stack_candidates;
   ContactPoint* candidates = candidate_room(stack_candidates, size + 1);
   std::size_t candidate_count = 0;
-  for (const ClipVertex& v : std::span(polygon, size)) {
+  for (const ClipVertex& v : std::span(space.polygon, size)) {
     const double separation = n.dot(v.point) - offset;
     if (separation > margin) continue;
     const Vec3 on_reference = v.point - separation * n;
