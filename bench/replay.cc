@@ -41,6 +41,7 @@ struct Times {
 // What one step of the round solved (the same every round): its size and how many sweeps.
 struct Work {
   std::uint64_t points = 0, manifolds = 0, sweeps = 0, islands = 0, exact_islands = 0, pivots = 0;
+  std::uint64_t coloured_islands = 0, colours = 0, overflow_manifolds = 0;
 };
 
 int whole_argument(int argc, char** argv, int index, int fallback, int least, int most) {
@@ -111,6 +112,9 @@ int main(int argc, char** argv) {
       work.islands += world.last_step().islands;
       work.exact_islands += world.last_step().exact_islands;
       work.pivots += world.last_step().lemke_pivots;
+      work.coloured_islands += world.last_step().coloured_islands;
+      work.colours += world.last_step().colours;
+      work.overflow_manifolds += world.last_step().overflow_manifolds;
       const StageTimes& t = world.last_step().time;
       sum.broad += t.broad_phase;
       sum.narrow += t.narrow_phase;
@@ -129,10 +133,13 @@ int main(int argc, char** argv) {
       std::printf(
           "      a step: %.0f manifolds, %.0f contact points, %.1f sweeps (velocity "
           "iterations summed over islands and substeps); %.0f islands, %.0f of them exact, "
-          "%.0f Lemke pivots\n",
+          "%.0f Lemke pivots;\n"
+          "      %.1f islands coloured for the team with %.1f colours, %.1f manifolds in their "
+          "serial overflow\n",
           double(work.manifolds) / steps, double(work.points) / steps, double(work.sweeps) / steps,
           double(work.islands) / steps, double(work.exact_islands) / steps,
-          double(work.pivots) / steps);
+          double(work.pivots) / steps, double(work.coloured_islands) / steps,
+          double(work.colours) / steps, double(work.overflow_manifolds) / steps);
   }
   const auto stage = [&](double Times::*field) {
     std::vector<double> values;

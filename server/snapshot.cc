@@ -285,6 +285,7 @@ void put_contact_pairs(const std::vector<ContactPairRecord>& pairs, pb::ContactP
     out->add_feature_first(r.feature_first);
     out->add_feature_second(r.feature_second);
     out->add_count(static_cast<std::uint32_t>(r.count));
+    out->add_colour(r.colour);
     for (int i = 0; i < r.count; ++i) {
       const ContactPointRecord& p = r.points[i];
       out->add_feature(p.feature);
@@ -307,12 +308,16 @@ Result<std::vector<ContactPairRecord>> take_contact_pairs(const pb::ContactPairs
       in.feature_kind_size() != n || in.feature_first_size() != n ||
       in.feature_second_size() != n || in.count_size() != n)
     return Status::error("array lengths do not match");
+  if (in.colour_size() != 0 && in.colour_size() != n)
+    return Status::error("colour: must be empty or one per pair");
   std::int64_t points = 0;
   for (int k = 0; k < n; ++k) {
     if (in.count(k) < 1 || in.count(k) > 4)
       return Status::error("count[" + std::to_string(k) + "]: must be 1 to 4");
     if (in.feature_kind(k) > 3)
       return Status::error("feature_kind[" + std::to_string(k) + "]: must be 0 to 3");
+    if (in.colour_size() != 0 && in.colour(k) > kNoContactColour)
+      return Status::error("colour[" + std::to_string(k) + "]: must be below 256");
     points += in.count(k);
   }
   if (in.feature_size() != points || in.local_a_size() != 3 * points ||
@@ -332,6 +337,7 @@ Result<std::vector<ContactPairRecord>> take_contact_pairs(const pb::ContactPairs
     r.feature_first = in.feature_first(k);
     r.feature_second = in.feature_second(k);
     r.count = static_cast<int>(in.count(k));
+    if (in.colour_size() != 0) r.colour = static_cast<std::uint8_t>(in.colour(k));
     for (int i = 0; i < r.count; ++i, ++point)
       r.points[i] = {in.feature(point), vec3_at(in.local_a(), point), in.normal_impulse(point),
                      vec3_at(in.friction_impulse(), point)};

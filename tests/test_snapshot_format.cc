@@ -2,6 +2,8 @@
 // `warm_start`) is still read, its impulses grouped by pair and matched to the points again.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "scene_runner.h"
 #include "snapshot.h"
 #include "tumble/v1/snapshot.pb.h"
@@ -54,12 +56,43 @@ TEST(SnapshotFormat, RecordsRoundTrip) {
     EXPECT_EQ(after[k].relative_orientation.coeffs(), before[k].relative_orientation.coeffs());
     EXPECT_EQ(after[k].feature_kind, before[k].feature_kind);
     EXPECT_EQ(after[k].feature_first, before[k].feature_first);
+    EXPECT_EQ(after[k].colour, before[k].colour);
     ASSERT_EQ(after[k].count, before[k].count);
     for (int i = 0; i < before[k].count; ++i) {
       EXPECT_EQ(after[k].points[i].local_a, before[k].points[i].local_a);
       EXPECT_EQ(after[k].points[i].normal_impulse, before[k].points[i].normal_impulse);
     }
   }
+}
+
+// Colours came after the records: a snapshot without them reads as pairs to colour anew; a
+// colour that is not one is refused, naming it.
+TEST(SnapshotFormat, SnapshotsWithoutColoursReadAndBadColoursAreRefused) {
+  const server::SavedWorld saved = landed_pile();
+  std::set<std::uint8_t> colours;
+  for (const ContactPairRecord& record : saved.state.contact_pairs)
+    colours.insert(record.colour);
+  ASSERT_GT(colours.size(), 1u);  // so that the round trip above compares something
+  v1::snapshot::WorldSnapshot snapshot;
+  ASSERT_TRUE(snapshot.ParseFromString(server::encode_snapshot(saved)));
+  snapshot.mutable_contact_pairs()->clear_colour();
+  const Result<server::SavedWorld> read = server::decode_snapshot(snapshot.SerializeAsString());
+  ASSERT_TRUE(read) << read.error();
+  for (const ContactPairRecord& record : read.value().state.contact_pairs)
+    EXPECT_EQ(record.colour, kNoContactColour);
+  Result<World> resumed = World::from_state(saved.settings, read.value().state);
+  ASSERT_TRUE(resumed) << resumed.error();
+  EXPECT_TRUE(resumed.value().step(saved.dt));
+
+  ASSERT_TRUE(snapshot.ParseFromString(server::encode_snapshot(saved)));
+  snapshot.mutable_contact_pairs()->set_colour(1, 300);
+  Result<server::SavedWorld> bad = server::decode_snapshot(snapshot.SerializeAsString());
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().find("colour[1]"), std::string::npos) << bad.error();
+  snapshot.mutable_contact_pairs()->mutable_colour()->RemoveLast();
+  bad = server::decode_snapshot(snapshot.SerializeAsString());
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().find("colour"), std::string::npos) << bad.error();
 }
 
 TEST(SnapshotFormat, OlderSnapshotsImpulsesAreMatchedAgain) {

@@ -2,6 +2,9 @@
 // refused with the field named.
 #include <gtest/gtest.h>
 
+#include <map>
+#include <set>
+
 #include "scene_runner.h"
 
 namespace tumble::testing {
@@ -59,6 +62,40 @@ TEST(WorldState, WarmStartCacheChangesTheRun) {
   EXPECT_NE(state_hash(cold), state_hash(original));
 }
 
+// A touching pair keeps the solver's colour it was given when it started touching (the record
+// carries it); a state without colours (an older snapshot's) steps on and colours its pairs anew.
+TEST(WorldState, TouchingPairsKeepTheirColoursFromStepToStep) {
+  World world = busy_world();
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint8_t> last;
+  std::size_t kept = 0;
+  std::set<std::uint8_t> seen;
+  for (int step = 0; step < 60; ++step) {
+    ASSERT_TRUE(world.step(kDt));
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint8_t> now;
+    for (const ContactPairRecord& record : world.save_state().contact_pairs) {
+      ASSERT_LT(record.colour, kContactColours);
+      now[{record.a.index, record.b.index}] = record.colour;
+      seen.insert(record.colour);
+      const auto before = last.find({record.a.index, record.b.index});
+      if (before == last.end()) continue;
+      EXPECT_EQ(record.colour, before->second) << "step " << step;
+      ++kept;
+    }
+    last = std::move(now);
+  }
+  EXPECT_GT(kept, 1000u);
+  EXPECT_GT(seen.size(), 3u);
+
+  WorldStateData uncoloured = world.save_state();
+  for (ContactPairRecord& record : uncoloured.contact_pairs)
+    record.colour = kNoContactColour;
+  World resumed = World::from_state(world.settings(), std::move(uncoloured)).value();
+  ASSERT_TRUE(resumed.step(kDt));
+  ASSERT_FALSE(resumed.save_state().contact_pairs.empty());
+  for (const ContactPairRecord& record : resumed.save_state().contact_pairs)
+    EXPECT_LT(record.colour, kContactColours);
+}
+
 TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   const World original = busy_world();
   const WorldStateData good = original.save_state();
@@ -98,6 +135,9 @@ TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   s = good;
   s.contact_pairs[1].count = 5;
   refused(s, "contact_pairs[1].count");
+  s = good;
+  s.contact_pairs[1].colour = kContactColours;
+  refused(s, "contact_pairs[1].colour");
   s = good;
   s.time = -1;
   refused(s, "time");

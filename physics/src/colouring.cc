@@ -5,34 +5,58 @@
 
 namespace tumble {
 
-void colour_manifolds(std::span<const std::uint32_t> island_links,
-                      std::span<const IslandLink> links, std::span<const std::uint8_t> dynamic,
-                      ColouringScratch* scratch, Colouring* out) {
+namespace {
+
+// The colours already held at a manifold's moving bodies.
+std::uint64_t taken_at(const IslandLink& link, std::span<const std::uint8_t> dynamic,
+                       std::span<const std::uint64_t> used) {
+  return (dynamic[link.a] ? used[link.a] : 0) | (dynamic[link.b] ? used[link.b] : 0);
+}
+
+void take(const IslandLink& link, std::span<const std::uint8_t> dynamic,
+          std::span<std::uint64_t> used, int colour) {
+  const std::uint64_t bit = std::uint64_t{1} << colour;
+  if (dynamic[link.a]) used[link.a] |= bit;
+  if (dynamic[link.b]) used[link.b] |= bit;
+}
+
+}  // namespace
+
+void keep_manifold_colours(std::span<const IslandLink> links, std::span<const std::uint8_t> dynamic,
+                           std::span<const std::uint8_t> kept, ColouringScratch* scratch,
+                           std::span<std::uint8_t> colours) {
   std::vector<std::uint64_t>& used = scratch->used;
   if (used.size() < dynamic.size()) used.resize(dynamic.size(), 0);
+  // Kept colours first, so that a new pair never takes a colour an older one still holds.
+  for (std::size_t m = 0; m < links.size(); ++m) {
+    colours[m] = kNoColour;
+    const int colour = kept[m];
+    if (colour >= kMaxColours || (taken_at(links[m], dynamic, used) >> colour & 1) != 0) continue;
+    take(links[m], dynamic, used, colour);
+    colours[m] = kept[m];
+  }
+  for (std::size_t m = 0; m < links.size(); ++m) {
+    if (colours[m] != kNoColour) continue;
+    const int colour = std::countr_one(taken_at(links[m], dynamic, used));
+    if (colour >= kMaxColours) continue;
+    take(links[m], dynamic, used, colour);
+    colours[m] = static_cast<std::uint8_t>(colour);
+  }
+  for (const IslandLink& link : links)
+    used[link.a] = used[link.b] = 0;
+}
+
+void colour_manifolds(std::span<const std::uint32_t> island_links,
+                      std::span<const std::uint8_t> colours, ColouringScratch* scratch,
+                      Colouring* out) {
   std::vector<std::uint8_t>& colour_of = scratch->colour_of;
   colour_of.resize(island_links.size());
   constexpr int kOverflow = kMaxColours;
   std::array<std::uint32_t, kMaxColours + 1> count{};
-
   for (std::size_t k = 0; k < island_links.size(); ++k) {
-    const IslandLink& link = links[island_links[k]];
-    const bool moving_a = dynamic[link.a] != 0, moving_b = dynamic[link.b] != 0;
-    const std::uint64_t taken = (moving_a ? used[link.a] : 0) | (moving_b ? used[link.b] : 0);
-    int colour = std::countr_one(taken);
-    if (colour >= kMaxColours) {
-      colour = kOverflow;
-    } else {
-      const std::uint64_t bit = std::uint64_t{1} << colour;
-      if (moving_a) used[link.a] |= bit;
-      if (moving_b) used[link.b] |= bit;
-    }
-    colour_of[k] = static_cast<std::uint8_t>(colour);
-    ++count[colour];
-  }
-  for (std::uint32_t manifold : island_links) {
-    used[links[manifold].a] = 0;
-    used[links[manifold].b] = 0;
+    const std::uint8_t colour = colours[island_links[k]];
+    colour_of[k] = colour < kMaxColours ? colour : kOverflow;
+    ++count[colour_of[k]];
   }
   // Small colours cost a barrier each for little work: they join the overflow.
   std::array<std::uint8_t, kMaxColours + 1> final_colour{};

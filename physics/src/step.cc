@@ -615,6 +615,8 @@ void World::prepare_contacts(double dt) {
   s.row_begin[0] = 0;
   s.links.resize(manifolds);
   s.touching.resize(manifolds);
+  s.kept_colours.resize(manifolds);
+  s.colours.resize(manifolds);
   double deepest = 0;
   for (std::size_t m = 0; m < manifolds; ++m) {
     const Contact& contact = contacts_[m];
@@ -623,7 +625,14 @@ void World::prepare_contacts(double dt) {
     s.touching[m] = contact.manifold.depth > -settings_.solver.slop;
     stats_.reused_manifolds += s.reused[m];
     deepest = std::max(deepest, contact.manifold.depth);
+    const std::uint32_t previous = s.previous_pair[m];
+    s.kept_colours[m] = previous == kNoRecord ? kNoColour : s.pairs[previous].colour;
   }
+  // A pair keeps the colour it was given when it started touching (colouring.h); its record
+  // carries it to the next step.
+  keep_manifold_colours(s.links, s.dynamic, s.kept_colours, &s.colouring_scratch, s.colours);
+  for (std::size_t m = 0; m < manifolds; ++m)
+    s.next_pairs[m].colour = s.colours[m];
   s.rows.resize(s.row_begin[manifolds]);
   s.cold_rows.resize(s.rows.size());
   s.blocks.resize(manifolds);
@@ -732,8 +741,8 @@ void World::prepare_contacts(double dt) {
   for (std::size_t i = 0; i < islands; ++i) {
     const std::uint32_t links = s.islands.link_begin[i + 1] - s.islands.link_begin[i];
     if (links >= kColouredIsland && s.reports[i].solver != IslandSolver::kExact) {
-      colour_manifolds(std::span(s.islands.links).subspan(s.islands.link_begin[i], links), s.links,
-                       s.dynamic, &s.colouring_scratch, &s.colouring);
+      colour_manifolds(std::span(s.islands.links).subspan(s.islands.link_begin[i], links),
+                       s.colours, &s.colouring_scratch, &s.colouring);
       s.team_islands.push_back(static_cast<std::uint32_t>(i));
     } else {
       s.single_islands.push_back(static_cast<std::uint32_t>(i));

@@ -60,6 +60,8 @@ struct StepScratch {
   std::vector<std::uint32_t> row_begin;   // rows of manifold m: [row_begin[m], row_begin[m+1])
   std::vector<IslandLink> links;          // one per manifold
   std::vector<std::uint8_t> touching;     // per manifold: apart by less than the slop
+  // Per manifold: its pair's colour last step and this step's (colouring.h).
+  std::vector<std::uint8_t> kept_colours, colours;
   Islands islands;
   std::vector<std::uint32_t> island_rows;  // row ids, island by island
   std::vector<std::uint32_t> island_row_begin;

@@ -69,6 +69,9 @@ Status check_contact_pair(const ContactPairRecord& record, std::span<const BodyS
     return Status::error("relative pose: must be finite, with a unit quaternion");
   if (record.feature_kind > PolytopeFeature::kEdges)
     return Status::error("feature_kind: must be 0 to 3");
+  if (record.colour >= kContactColours && record.colour != kNoContactColour)
+    return Status::error("colour: must be below " + std::to_string(kContactColours) + ", or " +
+                         std::to_string(kNoContactColour) + " for none");
   const BodySlotState& a = slots[record.a.index];
   const BodySlotState& b = slots[record.b.index];
   const bool current = a.alive && b.alive && a.generation == record.a.generation &&

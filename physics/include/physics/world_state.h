@@ -24,6 +24,10 @@ struct ContactPointRecord {
   Vec3 friction_impulse = Vec3::Zero();  // N s, world
 };
 
+// The graph colours a touching pair can hold (the solver's, colouring.h), and "none yet".
+constexpr int kContactColours = 48;
+constexpr std::uint8_t kNoContactColour = 0xff;
+
 // A touching pair of bodies as the last step left it, kept from step to step: one record per
 // manifold, which holds its impulses between steps. For two polytopes it also names the feature
 // (a face of either, or a pair of edges) the separating-axis test chose, and where B was in A's
@@ -40,6 +44,10 @@ struct ContactPairRecord {
   std::uint32_t feature_first = 0, feature_second = 0;
   int count = 0;  // 1..4
   std::array<ContactPointRecord, 4> points;
+  // Given when the pair started touching and kept while it touches, so that the solver visits a
+  // resting pile's manifolds in the same order every step: below kContactColours, or
+  // kNoContactColour (none free then, or an older snapshot: the next step colours it).
+  std::uint8_t colour = kNoContactColour;
 };
 
 struct BodySlotState {
