@@ -51,10 +51,10 @@ struct ColouringScratch {
 
 // This step's colour of every manifold (`links`, one per manifold): `kept[m]` is the colour its
 // pair had last step (kNoColour if none). A kept colour stays unless one of the manifold's moving
-// bodies already holds it this step (two kept colours can meet at a body
-// that did not move last step: asleep then, or made dynamic since); then, and for every manifold
-// without one, the lowest colour free at both moving bodies, in manifold order, or kNoColour when
-// all kMaxColours are taken. `dynamic` marks moving bodies; static ones never conflict.
+// bodies already holds it this step (two kept colours can meet at a body that did not move last
+// step: asleep then, or made dynamic since); then, and for every manifold without one, the
+// lowest colour free at both moving bodies, in manifold order, or kNoColour when all kMaxColours
+// are taken. `dynamic` marks moving bodies; static ones never conflict.
 void keep_manifold_colours(std::span<const IslandLink> links, std::span<const std::uint8_t> dynamic,
                            std::span<const std::uint8_t> kept, ColouringScratch* scratch,
                            std::span<std::uint8_t> colours);
