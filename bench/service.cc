@@ -41,7 +41,7 @@ Row measure(const SceneDef& scene, double real_time_factor, int subscribers, boo
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
-  builder.RegisterService(&service);
+  service.register_on(builder);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   const std::string address = "127.0.0.1:" + std::to_string(port);
 

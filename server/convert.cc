@@ -202,12 +202,9 @@ WorldSettings RunChange::applied_to(WorldSettings settings) const {
 Result<RunChange> run_change_from_proto(const v1::RunSettings& settings, double max_time_step) {
   RunChange change;
   if (settings.has_dt()) {
-    if (!(settings.dt() > 0 && std::isfinite(settings.dt())))
-      return Status::error("dt: must be finite and > 0");
-    if (settings.dt() > max_time_step)
-      return Status::error("dt: " + std::to_string(settings.dt()) +
-                           " s is above limits.max_time_step (" + std::to_string(max_time_step) +
-                           " s)");
+    WorldLimits limits;
+    limits.max_time_step = max_time_step;
+    if (Status s = check_time_step(settings.dt(), limits); !s) return s;
     change.dt = settings.dt();
   }
   if (settings.has_real_time_factor()) {

@@ -111,15 +111,25 @@ void StreamHub::end_all() {
     link->end();
 }
 
-FrameStream::FrameStream(StreamHub& hub, WorldHost& host, FrameOptions options, double max_rate)
-    : hub_(hub),
-      host_(host),
-      options_(std::move(options)),
-      min_interval_(max_rate > 0 ? 1 / max_rate : 0.0),
-      mailbox_(host.subscribe()),
-      link_(std::make_shared<StreamLink>()) {
-  link_->hub = &hub;
-  link_->stream = this;
+FrameStream::FrameStream(StreamHub& hub, WorldHost& host, const ReadRequest& read,
+                         std::size_t max_bytes, const std::string& method)
+    : RequestReader(max_bytes, method), hub_(hub), host_(host), read_(read) {}
+
+void FrameStream::on_request(std::string bytes) {
+  double max_rate = 0;
+  if (grpc::Status refused = read_(bytes, &options_, &max_rate); !refused.ok()) {
+    Finish(refused);
+    return;
+  }
+  min_interval_ = std::chrono::duration<double>(max_rate > 0 ? 1 / max_rate : 0.0);
+  {
+    std::lock_guard lock(mutex_);
+    started_ = true;
+    mailbox_ = host_.subscribe();
+    link_ = std::make_shared<StreamLink>();
+    link_->hub = &hub_;
+    link_->stream = this;
+  }
   hub_.add(link_);
   mailbox_->set_listener(link_);
   link_->frame_arrived();  // the host's newest frame is already waiting
@@ -132,13 +142,14 @@ void FrameStream::offer() {
   if (!delivery) return;
   dropped_ += delivery->dropped;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_sent_ < min_interval_) {
+  if (sent_any_ && now - last_sent_ < min_interval_) {
     ++dropped_;  // over this subscriber's rate; the next step brings a newer frame
     return;
   }
   encode(*delivery->frame, dropped_);
   dropped_ = 0;
   last_sent_ = now;
+  sent_any_ = true;
   writing_ = true;
   StartWrite(&buffer_);
 }
@@ -158,15 +169,18 @@ void FrameStream::encode(const FrameData& data, std::uint64_t dropped) {
         if (std::binary_search(options_.ids.begin(), options_.ids.end(), id)) current.push_back(id);
     }
     std::sort(current.begin(), current.end());
-    if (data.epoch != epoch_) {  // a new world: every body it had before is gone
-      for (std::uint64_t wire : known_)
-        own.add_removed(wire);
-      known_.clear();
-      epoch_ = data.epoch;
-    }
+    // A new world (a scene loaded, a snapshot restored): every body it holds is described again,
+    // whether or not its id was known (a restored snapshot gives bodies back their ids), and
+    // only the ids it no longer has are removed. So no id is ever both removed and added in one
+    // frame, and a subscriber may apply the two lists in either order.
+    const bool new_world = data.epoch != epoch_;
+    epoch_ = data.epoch;
     std::vector<std::uint64_t> added, removed;
-    std::set_difference(current.begin(), current.end(), known_.begin(), known_.end(),
-                        std::back_inserter(added));
+    if (new_world)
+      added = current;
+    else
+      std::set_difference(current.begin(), current.end(), known_.begin(), known_.end(),
+                          std::back_inserter(added));
     std::set_difference(known_.begin(), known_.end(), current.begin(), current.end(),
                         std::back_inserter(removed));
     for (std::uint64_t wire : added) {
@@ -198,6 +212,8 @@ void FrameStream::OnWriteDone(bool ok) {
 
 void FrameStream::end() {
   std::lock_guard lock(mutex_);
+  // Before the request is read, the read itself ends the call (a cancelled read fails).
+  if (!started_) return;
   finishing_ = true;
   final_status_ = grpc::Status::OK;
   if (!writing_) finish_locked(final_status_);
@@ -214,12 +230,14 @@ void FrameStream::finish_locked(const grpc::Status& status) {
 }
 
 void FrameStream::OnDone() {
-  {
-    std::lock_guard lock(link_->mutex);
-    link_->stream = nullptr;
+  if (link_ != nullptr) {
+    {
+      std::lock_guard lock(link_->mutex);
+      link_->stream = nullptr;
+    }
+    host_.unsubscribe(mailbox_);
+    hub_.remove(link_);
   }
-  host_.unsubscribe(mailbox_);
-  hub_.remove(link_);
   delete this;
 }
 

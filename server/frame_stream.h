@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "call_gate.h"
 #include "convert.h"
 #include "world_host.h"
 
@@ -26,6 +27,9 @@ namespace tumble::server {
 
 class FrameStream;
 class StreamHub;
+
+// Hz: the lowest max_rate a subscription may ask for (0 asks for every step).
+inline constexpr double kMinStreamRate = 1e-3;
 
 // Between a stream and those who call it from other threads (the mailbox on the stepping thread,
 // the hub): it outlives the stream, and forgets it under its lock when the stream is done.
@@ -62,10 +66,14 @@ class StreamHub {
   std::thread thread_;
 };
 
-class FrameStream final : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
+class FrameStream final : public RequestReader {
  public:
-  // Subscribes to `host`.
-  FrameStream(StreamHub& hub, WorldHost& host, FrameOptions options, double max_rate);
+  // What a request asks for, or why it is refused.
+  using ReadRequest =
+      std::function<grpc::Status(const std::string& bytes, FrameOptions*, double* max_rate)>;
+  // Reads the request (at most `max_bytes`), then subscribes to `host`.
+  FrameStream(StreamHub& hub, WorldHost& host, const ReadRequest& read, std::size_t max_bytes,
+              const std::string& method);
   // Ends the stream with OK after the write in flight (the server is shutting down).
   void end();
 
@@ -74,6 +82,7 @@ class FrameStream final : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
   void OnDone() override;
 
  private:
+  void on_request(std::string bytes) override;
   // Starts a write of the newest frame when none is in flight.
   void offer();
   void finish_locked(const grpc::Status& status);
@@ -83,6 +92,8 @@ class FrameStream final : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
   friend struct StreamLink;
   StreamHub& hub_;
   WorldHost& host_;
+  const ReadRequest& read_;
+  bool started_ = false;  // the request was read and the subscription made
   FrameOptions options_;
   std::chrono::duration<double> min_interval_;
   std::shared_ptr<FrameMailbox> mailbox_;
@@ -95,13 +106,7 @@ class FrameStream final : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
   std::vector<std::uint64_t> known_;  // ids this subscriber has descriptions of, sorted
   std::shared_ptr<const Catalogue> known_catalogue_;
   std::chrono::steady_clock::time_point last_sent_{};
-};
-
-// A stream refused before it starts (bad options, no token): finishes at once with `status`.
-class RefusedStream final : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
- public:
-  explicit RefusedStream(const grpc::Status& status) { Finish(status); }
-  void OnDone() override { delete this; }
+  bool sent_any_ = false;  // the first frame (describing every body) goes whatever the rate
 };
 
 }  // namespace tumble::server

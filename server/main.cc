@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
   std::size_t max_bodies = 100000;
   bool paused = false;
   std::string token, tls_cert, tls_key;
-  int max_message_mb = 256;
+  int max_message_mb = 64;
   std::vector<std::string> limit_options;
   bool dds = false;
   std::uint32_t dds_domain = 0;
@@ -187,15 +187,18 @@ int main(int argc, char** argv) {
   }
 #endif
   server::WorldService service(
-      host, {.max_bodies = max_bodies, .token = token, .world = scene.value().world.limits},
+      host,
+      {.max_bodies = max_bodies,
+       .token = token,
+       .world = scene.value().world.limits,
+       .max_message_bytes = static_cast<std::size_t>(max_message_mb) << 20},
       scene.value());
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort(listen, credentials, &port);
-  builder.SetMaxReceiveMessageSize(max_message_mb << 20);
-  builder.RegisterService(&service);
+  service.register_on(builder);
   std::unique_ptr<grpc::Server> grpc_server = builder.BuildAndStart();
   if (grpc_server == nullptr || port == 0) {
     std::fprintf(stderr, "tumble-server: --listen: cannot listen on %s\n", listen.c_str());

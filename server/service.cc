@@ -53,15 +53,81 @@ Status find_bodies(const HostedWorld& hosted,
   return Status::ok();
 }
 
+// The first id listed a second time, named.
+grpc::Status refuse_repeats(const google::protobuf::RepeatedField<std::uint64_t>& ids) {
+  std::vector<std::uint64_t> sorted(ids.begin(), ids.end());
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) return grpc::Status::OK;
+  std::set<std::uint64_t> seen;
+  for (int i = 0; i < ids.size(); ++i)
+    if (!seen.insert(ids[i]).second) return invalid("ids[" + std::to_string(i) + "]: listed twice");
+  return grpc::Status::OK;
+}
+
 }  // namespace
 
 WorldService::WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene)
-    : host_(host), limits_(limits), scene_(std::move(scene)) {}
+    : host_(host),
+      limits_(limits),
+      scene_(std::move(scene)),
+      read_stream_([this](const std::string& bytes, FrameOptions* options, double* max_rate) {
+        return read_stream_request(bytes, options, max_rate);
+      }),
+      gate_(make_gate()) {}
 
-grpc::Status WorldService::authorize(const grpc::ServerContextBase* context) const {
+template <class Request, class Response>
+CallGate::Unary WorldService::unary(grpc::Status (WorldService::*serve)(const Request&,
+                                                                        Response*)) {
+  return {Request::descriptor(), [this, serve](const std::string& bytes, std::string* out) {
+            Request request;
+            if (!request.ParseFromString(bytes))
+              return invalid("request: not a " + Request::descriptor()->full_name());
+            Response response;
+            grpc::Status status = (this->*serve)(request, &response);
+            if (status.ok()) response.SerializeToString(out);
+            return status;
+          }};
+}
+
+CallGate WorldService::make_gate() {
+  std::vector<std::pair<std::string, CallGate::Unary>> methods = {
+      {"SpawnBodies", unary(&WorldService::spawn_bodies)},
+      {"RemoveBodies", unary(&WorldService::remove_bodies)},
+      {"SetBodyState", unary(&WorldService::set_body_state)},
+      {"ApplyImpulse", unary(&WorldService::apply_impulse)},
+      {"GetBodies", unary(&WorldService::get_bodies)},
+      {"LoadScene", unary(&WorldService::load_scene)},
+      {"Control", unary(&WorldService::control)},
+      {"GetInfo", unary(&WorldService::get_info)},
+      {"Snapshot", unary(&WorldService::snapshot)},
+      {"Restore", unary(&WorldService::restore)}};
+  std::vector<std::pair<std::string, CallGate::StartStream>> streams = {
+      {"StreamFrames", [this](std::size_t max_bytes) -> grpc::ServerGenericBidiReactor* {
+         if (shutting_down_) return new RefusedCall(grpc::Status::OK);
+         return new FrameStream(streams_, host_, read_stream_, max_bytes, "StreamFrames");
+       }}};
+  return CallGate(
+      v1::World::service_full_name(),
+      {.max_bodies = limits_.max_bodies, .max_message_bytes = limits_.max_message_bytes},
+      [this](const grpc::ServerContextBase& context) { return authorize(context); },
+      std::move(methods), std::move(streams));
+}
+
+void WorldService::register_on(grpc::ServerBuilder& builder) {
+  builder.RegisterService(this);
+  builder.RegisterCallbackGenericService(&gate_);
+  builder.SetMaxReceiveMessageSize(static_cast<int>(gate_.bounds().largest()));
+  // gRPC (1.51) inflates a compressed request whole before it checks the size: 190 KB of gzip
+  // becomes 190 MB in memory. Compressed requests are refused (UNIMPLEMENTED, naming the
+  // algorithm) when their headers arrive, before any of the message is read.
+  builder.SetCompressionAlgorithmSupportStatus(GRPC_COMPRESS_DEFLATE, false);
+  builder.SetCompressionAlgorithmSupportStatus(GRPC_COMPRESS_GZIP, false);
+}
+
+grpc::Status WorldService::authorize(const grpc::ServerContextBase& context) const {
   if (limits_.token.empty()) return grpc::Status::OK;
   const std::string expected = "Bearer " + limits_.token;
-  const auto& metadata = context->client_metadata();
+  const auto& metadata = context.client_metadata();
   const auto found = metadata.find("authorization");
   bool same = found != metadata.end() && found->second.size() == expected.size();
   if (same) {
@@ -78,8 +144,8 @@ grpc::Status WorldService::authorize(const grpc::ServerContextBase* context) con
 
 grpc::Status WorldService::replace_world(SceneDef scene, std::vector<std::uint64_t>* ids) {
   scene.world.limits = limits_.world;
-  if (scene.dt > limits_.world.max_time_step)
-    return invalid("scene: dt " + std::to_string(scene.dt) + " s is above limits.max_time_step");
+  if (Status t = check_time_step(scene.dt, limits_.world); !t)
+    return invalid("scene: " + t.message());
   if (scene.bodies.size() > limits_.max_bodies)
     return too_many("scene: " + std::to_string(scene.bodies.size()) + " bodies, more than the " +
                     std::to_string(limits_.max_bodies) + " allowed");
@@ -110,14 +176,12 @@ grpc::Status WorldService::reset_world() {
   return replace_world(scene, &ids);
 }
 
-grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
-                                       const v1::SpawnBodiesRequest* request,
-                                       v1::SpawnBodiesResponse* response) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+grpc::Status WorldService::spawn_bodies(const v1::SpawnBodiesRequest& request,
+                                        v1::SpawnBodiesResponse* response) {
   std::vector<BodyDef> defs;
-  defs.reserve(request->bodies_size());
-  for (int i = 0; i < request->bodies_size(); ++i) {
-    Result<BodyDef> def = body_from_proto(request->bodies(i));
+  defs.reserve(request.bodies_size());
+  for (int i = 0; i < request.bodies_size(); ++i) {
+    Result<BodyDef> def = body_from_proto(request.bodies(i));
     if (!def) return invalid("bodies[" + std::to_string(i) + "]." + def.error());
     defs.push_back(std::move(def).value());
   }
@@ -132,7 +196,7 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
     if (!made) return made.status();
     hosted.ids.sync(world);
     for (std::size_t i = 0; i < made.value().size(); ++i) {
-      hosted.set_colour(made.value()[i], request->bodies(static_cast<int>(i)).color());
+      hosted.set_colour(made.value()[i], request.bodies(static_cast<int>(i)).color());
       ids.push_back(hosted.ids.wire(made.value()[i]));
     }
     return Status::ok();
@@ -143,36 +207,31 @@ grpc::Status WorldService::SpawnBodies(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::RemoveBodies(grpc::ServerContext* context,
-                                        const v1::RemoveBodiesRequest* request,
-                                        v1::RemoveBodiesResponse*) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
-  std::set<std::uint64_t> seen;
-  for (int i = 0; i < request->ids_size(); ++i)
-    if (!seen.insert(request->ids(i)).second)
-      return invalid("ids[" + std::to_string(i) + "]: listed twice");
+grpc::Status WorldService::remove_bodies(const v1::RemoveBodiesRequest& request,
+                                         v1::RemoveBodiesResponse*) {
+  if (grpc::Status twice = refuse_repeats(request.ids()); !twice.ok()) return twice;
   return to_grpc(host_.apply([&](HostedWorld& hosted) {
     // Every id is checked before anything is removed: all or nothing.
     std::vector<BodyId> ids;
-    if (Status found = find_bodies(hosted, request->ids(), &ids); !found) return found;
+    if (Status found = find_bodies(hosted, request.ids(), &ids); !found) return found;
     for (BodyId id : ids)
       hosted.world.remove_body(id);
     return Status::ok();
   }));
 }
 
-grpc::Status WorldService::GetBodies(grpc::ServerContext* context,
-                                     const v1::GetBodiesRequest* request,
-                                     v1::GetBodiesResponse* response) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+grpc::Status WorldService::get_bodies(const v1::GetBodiesRequest& request,
+                                      v1::GetBodiesResponse* response) {
+  // An id asked for twice would be answered twice: the reply could grow past any bound.
+  if (grpc::Status twice = refuse_repeats(request.ids()); !twice.ok()) return twice;
   Status read = Status::ok();
   host_.inspect([&](const HostedWorld& hosted) {
     const World& world = hosted.world;
     std::vector<BodyId> ids;
-    if (request->ids_size() == 0) {
+    if (request.ids_size() == 0) {
       for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
         if (world.id_at(slot).is_valid()) ids.push_back(world.id_at(slot));
-    } else if (Status found = find_bodies(hosted, request->ids(), &ids); !found) {
+    } else if (Status found = find_bodies(hosted, request.ids(), &ids); !found) {
       read = found;
       return;
     }
@@ -247,12 +306,10 @@ BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
 
 }  // namespace
 
-grpc::Status WorldService::SetBodyState(grpc::ServerContext* context,
-                                        const v1::SetBodyStateRequest* request,
-                                        v1::SetBodyStateResponse*) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+grpc::Status WorldService::set_body_state(const v1::SetBodyStateRequest& request,
+                                          v1::SetBodyStateResponse*) {
   return apply_batch(
-      host_, "updates", request->updates(),
+      host_, "updates", request.updates(),
       [](const World& world, BodyId id, const v1::BodyStateUpdate& u) {
         return world.check_motion(id, motion_from_proto(u));
       },
@@ -261,38 +318,38 @@ grpc::Status WorldService::SetBodyState(grpc::ServerContext* context,
       });
 }
 
-grpc::Status WorldService::ApplyImpulse(grpc::ServerContext* context,
-                                        const v1::ApplyImpulseRequest* request,
-                                        v1::ApplyImpulseResponse*) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
-  auto point_of = [](const v1::Impulse& i) {
-    return i.has_point() ? std::optional<Vec3>(vec(i.point())) : std::nullopt;
-  };
-  return apply_batch(
-      host_, "impulses", request->impulses(),
-      [&](const World& world, BodyId id, const v1::Impulse& i) {
-        const std::optional<Vec3> point = point_of(i);
-        return world.check_impulse(id, vec(i.impulse()), point ? &*point : nullptr);
-      },
-      [&](World& world, BodyId id, const v1::Impulse& i) {
-        const std::optional<Vec3> point = point_of(i);
-        world.apply_impulse(id, vec(i.impulse()), point ? &*point : nullptr);
-      });
+grpc::Status WorldService::apply_impulse(const v1::ApplyImpulseRequest& request,
+                                         v1::ApplyImpulseResponse*) {
+  return to_grpc(host_.apply([&](HostedWorld& hosted) {
+    std::vector<ImpulseAt> impulses;
+    impulses.reserve(request.impulses_size());
+    for (int i = 0; i < request.impulses_size(); ++i) {
+      const v1::Impulse& impulse = request.impulses(i);
+      const BodyId id = hosted.ids.find(impulse.id());
+      if (!hosted.world.contains(id))
+        return Status::not_found("impulses[" + std::to_string(i) + "].id: no body " +
+                                 std::to_string(impulse.id()));
+      impulses.push_back(
+          {id, vec(impulse.impulse()),
+           impulse.has_point() ? std::optional<Vec3>(vec(impulse.point())) : std::nullopt});
+    }
+    // Several impulses on one body add up, and are checked as their sum: all or nothing.
+    if (Status s = hosted.world.apply_impulses(impulses); !s) return s.within("impulses");
+    return Status::ok();
+  }));
 }
 
-grpc::Status WorldService::LoadScene(grpc::ServerContext* context,
-                                     const v1::LoadSceneRequest* request,
-                                     v1::LoadSceneResponse* response) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+grpc::Status WorldService::load_scene(const v1::LoadSceneRequest& request,
+                                      v1::LoadSceneResponse* response) {
   Result<SceneDef> scene = Status::error("source: required (scene_json or builtin)");
-  if (request->has_scene_json())
-    scene = parse_scene(request->scene_json());
-  else if (request->has_builtin())
-    scene = standard_scene(request->builtin(), limits_.max_bodies);
+  if (request.has_scene_json())
+    scene = parse_scene(request.scene_json());
+  else if (request.has_builtin())
+    scene = standard_scene(request.builtin(), limits_.max_bodies);
   if (!scene) {
-    const char* field = request->has_scene_json() ? "scene_json: "
-                        : request->has_builtin()  ? "builtin: "
-                                                  : "";
+    const char* field = request.has_scene_json() ? "scene_json: "
+                        : request.has_builtin()  ? "builtin: "
+                                                 : "";
     return invalid(field + scene.error());
   }
   std::vector<std::uint64_t> ids;
@@ -307,19 +364,17 @@ grpc::Status WorldService::LoadScene(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::ControlRequest* request,
+grpc::Status WorldService::control(const v1::ControlRequest& request,
                                    v1::ControlResponse* response) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
   // Checked whole before anything changes, the world's settings against the world as it is.
-  Result<RunChange> change =
-      run_change_from_proto(request->settings(), limits_.world.max_time_step);
+  Result<RunChange> change = run_change_from_proto(request.settings(), limits_.world.max_time_step);
   if (!change) return invalid("settings." + change.error());
   Status acceptable = Status::ok();
   host_.inspect([&](const HostedWorld& hosted) {
     acceptable = validate(change.value().applied_to(hosted.world.settings()));
   });
   if (!acceptable) return invalid("settings." + acceptable.message());
-  if (request->action_case() == v1::ControlRequest::kReset && request->reset()) {
+  if (request.action_case() == v1::ControlRequest::kReset && request.reset()) {
     host_.pause();
     if (grpc::Status reset = reset_world(); !reset.ok()) return reset;
   }
@@ -335,15 +390,15 @@ grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::Contr
   if (!changed) return invalid("settings." + changed.message());
   if (change.value().dt) host_.set_dt(*change.value().dt);
   if (change.value().real_time_factor) host_.set_real_time_factor(*change.value().real_time_factor);
-  switch (request->action_case()) {
+  switch (request.action_case()) {
     case v1::ControlRequest::kPlay:
-      if (request->play()) host_.play();
+      if (request.play()) host_.play();
       break;
     case v1::ControlRequest::kPause:
-      if (request->pause()) host_.pause();
+      if (request.pause()) host_.pause();
       break;
     case v1::ControlRequest::kStep:
-      host_.step(request->step());
+      host_.step(request.step());
       break;
     default:
       break;
@@ -355,9 +410,7 @@ grpc::Status WorldService::Control(grpc::ServerContext* context, const v1::Contr
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::GetInfo(grpc::ServerContext* context, const v1::GetInfoRequest*,
-                                   v1::GetInfoResponse* response) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+grpc::Status WorldService::get_info(const v1::GetInfoRequest&, v1::GetInfoResponse* response) {
   const HostStatus status = host_.status();
   response->set_version(TUMBLE_VERSION);
   response->set_step(status.step);
@@ -372,9 +425,7 @@ grpc::Status WorldService::GetInfo(grpc::ServerContext* context, const v1::GetIn
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::Snapshot(grpc::ServerContext* context, const v1::SnapshotRequest*,
-                                    v1::SnapshotResponse* response) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
+grpc::Status WorldService::snapshot(const v1::SnapshotRequest&, v1::SnapshotResponse* response) {
   SavedWorld saved;
   host_.inspect([&](const HostedWorld& hosted) {
     saved = {hosted.world.settings(), hosted.world.save_state(), hosted.dt,
@@ -387,10 +438,9 @@ grpc::Status WorldService::Snapshot(grpc::ServerContext* context, const v1::Snap
   return grpc::Status::OK;
 }
 
-grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::RestoreRequest* request,
+grpc::Status WorldService::restore(const v1::RestoreRequest& request,
                                    v1::RestoreResponse* response) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return denied;
-  Result<SavedWorld> saved = decode_snapshot(request->state());
+  Result<SavedWorld> saved = decode_snapshot(request.state());
   if (!saved) return invalid("state." + saved.error());
   SavedWorld& s = saved.value();
   std::size_t live = 0;
@@ -401,8 +451,7 @@ grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::Resto
                     std::to_string(limits_.max_bodies) + " allowed");
   const std::uint64_t step = s.state.step;
   s.settings.limits = limits_.world;
-  if (!(s.dt > 0) || s.dt > limits_.world.max_time_step)
-    return invalid("state.dt: must be > 0 and at most limits.max_time_step");
+  if (Status t = check_time_step(s.dt, limits_.world); !t) return invalid("state." + t.message());
   // Checked whole before the running world is touched.
   Result<World> restored = World::from_state(s.settings, std::move(s.state));
   if (!restored) return invalid("state." + restored.error());
@@ -428,27 +477,22 @@ grpc::Status WorldService::Restore(grpc::ServerContext* context, const v1::Resto
   return grpc::Status::OK;
 }
 
-grpc::ServerWriteReactor<grpc::ByteBuffer>* WorldService::StreamFrames(
-    grpc::CallbackServerContext* context, const grpc::ByteBuffer* request_bytes) {
-  if (grpc::Status denied = authorize(context); !denied.ok()) return new RefusedStream(denied);
-  std::vector<grpc::Slice> slices;
+grpc::Status WorldService::read_stream_request(const std::string& bytes, FrameOptions* options,
+                                               double* max_rate) const {
   v1::StreamFramesRequest request;
-  std::string bytes;
-  if (request_bytes->Dump(&slices).ok())
-    for (const grpc::Slice& slice : slices)
-      bytes.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
-  if (!request.ParseFromString(bytes))
-    return new RefusedStream(invalid("request: not a StreamFramesRequest"));
-  if (!(request.max_rate() >= 0) || !std::isfinite(request.max_rate()))
-    return new RefusedStream(invalid("max_rate: must be finite and >= 0"));
-  if (shutting_down_) return new RefusedStream(grpc::Status::OK);
-  FrameOptions options;
-  options.velocities = request.velocities();
-  options.contacts = request.contacts();
-  options.stats = request.stats();
-  options.ids.assign(request.ids().begin(), request.ids().end());
-  std::sort(options.ids.begin(), options.ids.end());
-  return new FrameStream(streams_, host_, std::move(options), request.max_rate());
+  if (!request.ParseFromString(bytes)) return invalid("request: not a StreamFramesRequest");
+  // A rate below one frame in about 17 minutes would never send even the first frame.
+  if (!(request.max_rate() == 0 || request.max_rate() >= kMinStreamRate) ||
+      !std::isfinite(request.max_rate()))
+    return invalid("max_rate: must be 0 (every step) or finite and at least " +
+                   std::to_string(kMinStreamRate) + " Hz");
+  options->velocities = request.velocities();
+  options->contacts = request.contacts();
+  options->stats = request.stats();
+  options->ids.assign(request.ids().begin(), request.ids().end());
+  std::sort(options->ids.begin(), options->ids.end());
+  *max_rate = request.max_rate();
+  return grpc::Status::OK;
 }
 
 }  // namespace tumble::server

@@ -10,6 +10,7 @@
 
 #include <mutex>
 
+#include "call_gate.h"
 #include "frame_stream.h"
 #include "scenes/scene.h"
 #include "tumble/v1/world.grpc.pb.h"
@@ -25,37 +26,29 @@ struct ServiceLimits {
   // What every world this server holds accepts (docs/SCENES.md, "Limits"): imposed on scenes
   // loaded and snapshots restored, whatever limits they carry, so a client cannot widen them.
   WorldLimits world;
+  // The largest request (--max-message-mb): the bound of Restore and LoadScene, and the cap of
+  // every other method's bound (request_bounds.h).
+  std::size_t max_message_bytes = 64u << 20;
 };
 
-// StreamFrames uses gRPC's callback API on raw bytes (frame_stream.h); the rest is synchronous.
-class WorldService final
-    : public v1::World::WithRawCallbackMethod_StreamFrames<v1::World::Service> {
+// Every method is generic: the CallGate (call_gate.h) receives the calls, checks the token before
+// reading a request, bounds and scans it, and hands it to the methods below. The typed service
+// is registered too, for its name (reflection lists it).
+using GatedWorldService =
+    v1::World::WithGenericMethod_SpawnBodies<v1::World::WithGenericMethod_RemoveBodies<
+        v1::World::WithGenericMethod_SetBodyState<v1::World::WithGenericMethod_ApplyImpulse<
+            v1::World::WithGenericMethod_GetBodies<v1::World::WithGenericMethod_LoadScene<
+                v1::World::WithGenericMethod_Control<v1::World::WithGenericMethod_GetInfo<
+                    v1::World::WithGenericMethod_StreamFrames<v1::World::WithGenericMethod_Snapshot<
+                        v1::World::WithGenericMethod_Restore<v1::World::Service>>>>>>>>>>>;
+
+class WorldService final : public GatedWorldService {
  public:
   // `scene`: what the host's world was made from, and what Control's reset goes back to.
   WorldService(WorldHost& host, ServiceLimits limits, SceneDef scene);
 
-  grpc::Status SpawnBodies(grpc::ServerContext*, const v1::SpawnBodiesRequest*,
-                           v1::SpawnBodiesResponse*) override;
-  grpc::Status RemoveBodies(grpc::ServerContext*, const v1::RemoveBodiesRequest*,
-                            v1::RemoveBodiesResponse*) override;
-  grpc::Status GetBodies(grpc::ServerContext*, const v1::GetBodiesRequest*,
-                         v1::GetBodiesResponse*) override;
-  grpc::Status SetBodyState(grpc::ServerContext*, const v1::SetBodyStateRequest*,
-                            v1::SetBodyStateResponse*) override;
-  grpc::Status ApplyImpulse(grpc::ServerContext*, const v1::ApplyImpulseRequest*,
-                            v1::ApplyImpulseResponse*) override;
-  grpc::Status LoadScene(grpc::ServerContext*, const v1::LoadSceneRequest*,
-                         v1::LoadSceneResponse*) override;
-  grpc::Status Control(grpc::ServerContext*, const v1::ControlRequest*,
-                       v1::ControlResponse*) override;
-  grpc::Status GetInfo(grpc::ServerContext*, const v1::GetInfoRequest*,
-                       v1::GetInfoResponse*) override;
-  grpc::Status Snapshot(grpc::ServerContext*, const v1::SnapshotRequest*,
-                        v1::SnapshotResponse*) override;
-  grpc::Status Restore(grpc::ServerContext*, const v1::RestoreRequest*,
-                       v1::RestoreResponse*) override;
-  grpc::ServerWriteReactor<grpc::ByteBuffer>* StreamFrames(grpc::CallbackServerContext*,
-                                                           const grpc::ByteBuffer*) override;
+  // Registers the service and its gate on `builder`, and tells gRPC the largest request.
+  void register_on(grpc::ServerBuilder& builder);
 
   // Ends every stream (they end with OK after the frame in flight).
   void shut_down() {
@@ -64,7 +57,24 @@ class WorldService final
   }
 
  private:
-  grpc::Status authorize(const grpc::ServerContextBase* context) const;
+  grpc::Status spawn_bodies(const v1::SpawnBodiesRequest&, v1::SpawnBodiesResponse*);
+  grpc::Status remove_bodies(const v1::RemoveBodiesRequest&, v1::RemoveBodiesResponse*);
+  grpc::Status get_bodies(const v1::GetBodiesRequest&, v1::GetBodiesResponse*);
+  grpc::Status set_body_state(const v1::SetBodyStateRequest&, v1::SetBodyStateResponse*);
+  grpc::Status apply_impulse(const v1::ApplyImpulseRequest&, v1::ApplyImpulseResponse*);
+  grpc::Status load_scene(const v1::LoadSceneRequest&, v1::LoadSceneResponse*);
+  grpc::Status control(const v1::ControlRequest&, v1::ControlResponse*);
+  grpc::Status get_info(const v1::GetInfoRequest&, v1::GetInfoResponse*);
+  grpc::Status snapshot(const v1::SnapshotRequest&, v1::SnapshotResponse*);
+  grpc::Status restore(const v1::RestoreRequest&, v1::RestoreResponse*);
+  // A StreamFrames request's options, or why they are refused.
+  grpc::Status read_stream_request(const std::string& bytes, FrameOptions* options,
+                                   double* max_rate) const;
+  grpc::Status authorize(const grpc::ServerContextBase& context) const;
+  // One unary method for the gate: parses the request the gate checked, serves it, encodes.
+  template <class Request, class Response>
+  CallGate::Unary unary(grpc::Status (WorldService::*serve)(const Request&, Response*));
+  CallGate make_gate();
   StreamHub streams_;
   WorldHost& host_;
   ServiceLimits limits_;
@@ -75,6 +85,8 @@ class WorldService final
   std::mutex scene_mutex_;
   SceneDef scene_;  // the last scene loaded
   std::atomic<bool> shutting_down_{false};
+  FrameStream::ReadRequest read_stream_;
+  CallGate gate_;  // last: its workers stop first
 };
 
 }  // namespace tumble::server

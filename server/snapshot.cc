@@ -403,10 +403,7 @@ Result<SavedWorld> decode_snapshot(std::string_view bytes) {
   if (!settings) return settings.status().within("settings.");
   saved.settings = settings.value();
   saved.dt = in.dt();
-  if (!(saved.dt > 0) || !std::isfinite(saved.dt))
-    return Status::error("dt: must be finite and > 0");
-  if (saved.dt > saved.settings.limits.max_time_step)
-    return Status::error("dt: above settings.limits.max_time_step");
+  if (Status s = check_time_step(saved.dt, saved.settings.limits); !s) return s;
   WorldStateData& state = saved.state;
   state.slots.resize(in.slots_size());
   saved.colours.resize(in.slots_size(), 0);

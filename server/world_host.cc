@@ -84,7 +84,8 @@ void WorldHost::step(std::uint64_t steps) {
 }
 
 Status WorldHost::set_dt(double dt) {
-  if (!(dt > 0) || !std::isfinite(dt)) return Status::error("dt: must be finite and > 0");
+  if (!std::isfinite(dt) || !(dt >= kMinTimeStep))
+    return Status::error("dt: must be finite and at least the shortest step");
   std::lock_guard lock(mutex_);
   hosted_.dt = dt;
   return Status::ok();

@@ -31,7 +31,7 @@ class FuzzService {
       : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0),
         service_(host_, {.max_bodies = kMaxBodies, .token = "", .world = {}}, pile_scene(8)) {
     grpc::ServerBuilder builder;
-    builder.RegisterService(&service_);
+    service_.register_on(builder);
     server_ = builder.BuildAndStart();
     stub_ = v1::World::NewStub(server_->InProcessChannel(grpc::ChannelArguments()));
   }

@@ -22,7 +22,7 @@ class ServiceTest : public ::testing::Test {
       : host_(make_world(pile_scene(8)).value(), 1.0 / 60, 0),
         service_(host_, {.max_bodies = 100, .token = "", .world = {}}, pile_scene(8)) {
     grpc::ServerBuilder builder;
-    builder.RegisterService(&service_);
+    service_.register_on(builder);
     server_ = builder.BuildAndStart();
     stub_ = v1::World::NewStub(server_->InProcessChannel(grpc::ChannelArguments()));
   }
@@ -497,7 +497,7 @@ TEST(ServiceAuth, EveryCallNeedsTheBearerToken) {
   WorldHost host(make_world(pile_scene(8)).value(), 1.0 / 60, 0);
   WorldService service(host, {.max_bodies = 100, .token = "s3cret", .world = {}}, pile_scene(8));
   grpc::ServerBuilder builder;
-  builder.RegisterService(&service);
+  service.register_on(builder);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   auto stub = v1::World::NewStub(server->InProcessChannel(grpc::ChannelArguments()));
   for (const char* header : {"", "Bearer wrong", "Bearer s3cre", "s3cret"}) {

@@ -29,7 +29,7 @@ class LoopbackServer {
         service_(host_, {.max_bodies = 100000, .token = "", .world = {}}, scene) {
     grpc::ServerBuilder builder;
     builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port_);
-    builder.RegisterService(&service_);
+    service_.register_on(builder);
     server_ = builder.BuildAndStart();
   }
   ~LoopbackServer() {

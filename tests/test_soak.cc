@@ -36,7 +36,7 @@ class SoakServer {
       : host_(make_world(pile_scene(30)).value(), 1.0 / 60, 0),
         service_(host_, {.max_bodies = 1500, .token = "", .world = {}}, pile_scene(30)) {
     grpc::ServerBuilder builder;
-    builder.RegisterService(&service_);
+    service_.register_on(builder);
     server_ = builder.BuildAndStart();
     host_.play();
   }

@@ -61,6 +61,22 @@ constexpr LimitField kLimitFields[] = {
 
 }  // namespace
 
+Status check_time_step(double dt, const WorldLimits& limits) {
+  char message[128];
+  if (!std::isfinite(dt) || !(dt >= kMinTimeStep)) {
+    std::snprintf(message, sizeof message,
+                  "dt: %g s; it must be finite and at least %g s (the shortest step)", dt,
+                  kMinTimeStep);
+    return Status::error(message);
+  }
+  if (dt > limits.max_time_step) {
+    std::snprintf(message, sizeof message, "dt: %g s is above limits.max_time_step (%g s)", dt,
+                  limits.max_time_step);
+    return Status::error(message);
+  }
+  return Status::ok();
+}
+
 std::span<const LimitField> limit_fields() {
   return kLimitFields;
 }

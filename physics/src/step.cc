@@ -508,13 +508,7 @@ class TeamIsland {
 }  // namespace
 
 Status World::step(double dt) {
-  if (!(dt > 0) || !std::isfinite(dt)) return Status::error("dt: must be finite and > 0");
-  if (dt > settings_.limits.max_time_step) {
-    char message[96];
-    std::snprintf(message, sizeof message, "dt: %g s is above limits.max_time_step (%g s)", dt,
-                  settings_.limits.max_time_step);
-    return Status::error(message);
-  }
+  if (Status s = check_time_step(dt, settings_.limits); !s) return s;
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t step_index = stats_.step + 1;
   stats_ = StepStats{};

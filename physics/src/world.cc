@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 
 #include "broad_phase.h"
@@ -279,6 +280,40 @@ Status World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point) {
   body.sleep_timer = 0;
   std::tie(body.linear_velocity, body.angular_velocity) =
       velocities_after_impulse(body, impulse, point);
+  return Status::ok();
+}
+
+Status World::apply_impulses(std::span<const ImpulseAt> impulses) {
+  // The velocities each touched body would have after the entries so far, in the order the
+  // bodies first appear (so that waking them is in a fixed order), and where each is by slot.
+  std::vector<std::pair<std::uint32_t, std::pair<Vec3, Vec3>>> after;
+  std::unordered_map<std::uint32_t, std::size_t> where;
+  for (std::size_t i = 0; i < impulses.size(); ++i) {
+    const ImpulseAt& entry = impulses[i];
+    // The entry's path, made only for a refusal.
+    const auto at = [i] { return std::string(1, '[').append(std::to_string(i)).append("]."); };
+    if (!contains(entry.body)) return Status::not_found(at() + "body: no body with this id");
+    const Body& body = bodies_[entry.body.index].body;
+    if (body.is_static()) return Status::error(at() + "body: a static body does not move");
+    if (!is_finite(entry.impulse)) return Status::error(at() + "impulse: must be finite");
+    if (entry.point && !is_finite(*entry.point))
+      return Status::error(at() + "point: must be finite");
+    const auto [found, is_new] = where.try_emplace(entry.body.index, after.size());
+    if (is_new) after.push_back({entry.body.index, {body.linear_velocity, body.angular_velocity}});
+    auto& [v, w] = after[found->second].second;
+    v += body.inverse_mass * entry.impulse;
+    if (entry.point)
+      w += body.inverse_inertia_world * (*entry.point - body.position).cross(entry.impulse);
+    if (Status s = check_speeds(v, w, settings_.limits); !s)
+      return Status::error(at() + "impulse: with the impulses before it on the same body, it " +
+                           "would give " + s.message());
+  }
+  for (const auto& [slot, velocities] : after) {
+    Body& body = bodies_[slot].body;
+    if (body.asleep) wake_island(body.sleep_island);
+    body.sleep_timer = 0;
+    std::tie(body.linear_velocity, body.angular_velocity) = velocities;
+  }
   return Status::ok();
 }
 

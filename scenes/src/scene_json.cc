@@ -217,9 +217,7 @@ SceneDef read_scene(const Json& json) {
   solver.continuous_fraction = r.number("continuous_fraction", solver.continuous_fraction);
   if (const Json* limits = r.find("limits")) read_limits(*limits, &world.limits);
   if (Status s = validate(world); !s) throw FieldError{s.message()};
-  if (scene.dt > world.limits.max_time_step)
-    fail("dt",
-         "is above limits.max_time_step (" + std::to_string(world.limits.max_time_step) + " s)");
+  if (Status s = check_time_step(scene.dt, world.limits); !s) throw FieldError{s.message()};
 
   const Json* bodies = r.find("bodies");
   if (bodies != nullptr) {

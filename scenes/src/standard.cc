@@ -118,7 +118,33 @@ SceneDef bounce_scene(double height, double restitution) {
   return scene;
 }
 
+namespace {
+
+// A name as errors show it: a request may carry megabytes of it.
+std::string shown(std::string_view spec) {
+  constexpr std::size_t kShown = 64;
+  return spec.size() <= kShown ? std::string(spec)
+                               : std::string(spec.substr(0, kShown)) + "... (" +
+                                     std::to_string(spec.size()) + " characters)";
+}
+
+Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bodies);
+
+}  // namespace
+
 Result<SceneDef> standard_scene(std::string_view spec, std::size_t max_bodies) {
+  Result<SceneDef> made = build_standard_scene(spec, max_bodies);
+  // The scenes without a size are small, but a server may allow fewer bodies still.
+  if (made && made.value().bodies.size() > max_bodies)
+    return Status::error("scene '" + shown(spec) +
+                         "': " + std::to_string(made.value().bodies.size()) +
+                         " bodies, more than the " + std::to_string(max_bodies) + " allowed");
+  return made;
+}
+
+namespace {
+
+Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bodies) {
   std::string_view name = spec;
   std::optional<int> size;
   if (const std::size_t colon = spec.find(':'); colon != std::string_view::npos) {
@@ -128,18 +154,22 @@ Result<SceneDef> standard_scene(std::string_view spec, std::size_t max_bodies) {
     const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (error != std::errc() || end != digits.data() + digits.size() || value < 1 ||
         value > 1000000)
-      return Status::error("scene '" + std::string(spec) +
+      return Status::error("scene '" + shown(spec) +
                            "': the size after ':' must be an integer in [1, 1000000]");
     size = value;
   }
-  // Counted before anything is built, so a request for a huge scene costs nothing.
-  const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(0));
-  const std::uint64_t bodies = name == "pyramid" ? n * (n + 1) / 2 : n;
-  if (bodies > max_bodies)
-    return Status::error("scene '" + std::string(spec) + "': " + std::to_string(bodies) +
-                         " bodies, more than the " + std::to_string(max_bodies) + " allowed");
+  // Counted, ground included, before anything is built, so a request for a huge scene costs
+  // nothing.
+  if (name == "pile" || name == "pyramid" || name == "tower") {
+    const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(name == "pile" ? 1000 : 20));
+    const std::uint64_t bodies = (name == "pyramid" ? n * (n + 1) / 2 : n) + 1;
+    if (bodies > max_bodies)
+      return Status::error("scene '" + shown(spec) + "': " + std::to_string(bodies) +
+                           " bodies with the ground, more than the " + std::to_string(max_bodies) +
+                           " allowed");
+  }
   auto sized = [&](const char* what) -> Status {
-    if (size) return Status::error("scene '" + std::string(spec) + "': " + what + " takes no size");
+    if (size) return Status::error("scene '" + shown(spec) + "': " + what + " takes no size");
     return Status::ok();
   };
   if (name == "pile") return pile_scene(size.value_or(1000));
@@ -169,10 +199,12 @@ Result<SceneDef> standard_scene(std::string_view spec, std::size_t max_bodies) {
     if (Status s = sized("default"); !s) return s;
     return parse_scene(default_scene_json());
   }
-  return Status::error("scene '" + std::string(spec) +
+  return Status::error("scene '" + shown(spec) +
                        "': unknown; the standard scenes are pile, pyramid, tower, mass-ratio, "
                        "mass-ratio-inv, bullet, slide, spin, bounce, default");
 }
+
+}  // namespace
 
 Result<SceneDef> chosen_scene(const std::string& file, const std::string& standard) {
   if (!file.empty()) return load_scene_file(file);

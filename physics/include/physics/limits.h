@@ -30,6 +30,12 @@ struct WorldLimits {
   double max_time_step = 1;        // s, one call of World::step
 };
 
+// s: the shortest step a world takes. A shorter one advances nothing worth the cost (a step of
+// 5e-324 s leaves the clock where it was, and a server stepping it would spin for nothing).
+inline constexpr double kMinTimeStep = 1e-6;
+// dt finite and within [kMinTimeStep, limits.max_time_step]; the message starts with "dt: ".
+Status check_time_step(double dt, const WorldLimits& limits);
+
 // Each limit by the name scene files and command lines use ("max_size").
 struct LimitField {
   std::string_view name;

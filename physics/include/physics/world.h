@@ -55,6 +55,13 @@ struct BodyMotion {
   std::optional<Vec3> angular_velocity;  // rad/s, world
 };
 
+// One impulse of a batch (World::apply_impulses).
+struct ImpulseAt {
+  BodyId body;
+  Vec3 impulse = Vec3::Zero();  // N s, world
+  std::optional<Vec3> point;    // m, world; the centre of mass when empty
+};
+
 struct StepScratch;
 
 class World {
@@ -83,6 +90,10 @@ class World {
   // would be beyond the world's limits.
   Status check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) const;
   Status apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point);
+  // Impulses applied in order, all or nothing. Several on one body add up: each is checked with
+  // those before it on the same body, so the velocities the body ends with are within the limits.
+  // The message names the entry ("[3].impulse: ...").
+  Status apply_impulses(std::span<const ImpulseAt> impulses);
 
   // The whole state (settings apart: settings()), and a world made from one. from_state checks
   // everything (the state may come from a file or the network) and names what is wrong; a world
