@@ -46,9 +46,26 @@ void release_memory_after(std::size_t bytes) {
   if (bytes >= (1u << 20)) malloc_trim(0);
 }
 
-RequestReader::RequestReader(std::size_t max_bytes, std::string method)
-    : max_bytes_(max_bytes), method_(std::move(method)) {
-  StartRead(&request_);
+RequestReader::RequestReader(CallGate* gate, std::size_t max_bytes, std::string method)
+    : gate_(gate), max_bytes_(max_bytes), method_(std::move(method)) {
+  if (gate_ == nullptr || gate_->admit(this)) StartRead(&request_);
+}
+
+RequestReader::~RequestReader() {
+  done_with_request();
+}
+
+void RequestReader::done_with_request() {
+  if (gate_ != nullptr) gate_->release(max_bytes_);
+  gate_ = nullptr;
+}
+
+void RequestReader::OnCancel() {
+  if (gate_ != nullptr && gate_->forget(this)) {
+    Finish(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled before its request was read"));
+    return;
+  }
+  on_cancel();
 }
 
 void RequestReader::OnReadDone(bool ok) {
@@ -60,6 +77,7 @@ void RequestReader::OnReadDone(bool ok) {
   const std::size_t length = request_.Length();
   if (length > max_bytes_) {
     request_.Clear();
+    done_with_request();
     release_memory_after(length);
     Finish(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                         "request: " + std::to_string(length) + " bytes, more than the " +
@@ -78,11 +96,18 @@ void RequestReader::OnReadDone(bool ok) {
   on_request(std::move(bytes));
 }
 
+CallGate* charged(CallGate& gate, std::size_t max_bytes) {
+  return max_bytes >= (1u << 20) ? &gate : nullptr;
+}
+
 // One unary call: its request read, then scanned, parsed and served on a worker.
 class CallGate::UnaryCall final : public RequestReader {
  public:
   UnaryCall(CallGate& gate, const std::string& method, const Unary& unary, MethodBounds bounds)
-      : RequestReader(bounds.bytes, method), gate_(gate), unary_(unary), bounds_(bounds) {}
+      : RequestReader(charged(gate, bounds.bytes), bounds.bytes, method),
+        gate_(gate),
+        unary_(unary),
+        bounds_(bounds) {}
 
   void OnDone() override {
     gate_.unary_in_flight_.fetch_sub(1);
@@ -101,6 +126,7 @@ class CallGate::UnaryCall final : public RequestReader {
     if (status.ok()) status = unary_.serve(bytes, &answer);
     bytes.clear();
     bytes.shrink_to_fit();
+    done_with_request();
     release_memory_after(length);
     if (!status.ok()) {
       Finish(status);
@@ -128,6 +154,44 @@ class CallGate::UnaryCall final : public RequestReader {
   grpc::ByteBuffer response_;
 };
 
+bool CallGate::admit(RequestReader* reader) {
+  std::lock_guard lock(budget_mutex_);
+  // Alone, a call always goes (no bound exceeds the budget, but a call must never wait forever).
+  if (waiting_.empty() &&
+      (reserved_ == 0 || reserved_ + reader->max_bytes_ <= bounds_.in_flight_budget())) {
+    reserved_ += reader->max_bytes_;
+    return true;
+  }
+  waiting_.push_back(reader);
+  return false;
+}
+
+void CallGate::release(std::size_t bytes) {
+  std::vector<RequestReader*> admitted;
+  {
+    std::lock_guard lock(budget_mutex_);
+    reserved_ -= bytes;
+    while (!waiting_.empty() && (reserved_ == 0 || reserved_ + waiting_.front()->max_bytes_ <=
+                                                       bounds_.in_flight_budget())) {
+      reserved_ += waiting_.front()->max_bytes_;
+      admitted.push_back(waiting_.front());
+      waiting_.pop_front();
+    }
+  }
+  for (RequestReader* reader : admitted)
+    reader->StartRead(&reader->request_);
+}
+
+bool CallGate::forget(RequestReader* reader) {
+  std::lock_guard lock(budget_mutex_);
+  const auto found = std::find(waiting_.begin(), waiting_.end(), reader);
+  if (found == waiting_.end()) return false;
+  waiting_.erase(found);
+  // It never held any of the budget: its destructor gives back nothing.
+  reader->gate_ = nullptr;
+  return true;
+}
+
 CallGate::CallGate(std::string service, RequestBounds bounds, Authorize authorize,
                    std::vector<std::pair<std::string, Unary>> unary,
                    std::vector<std::pair<std::string, StartStream>> streams, int workers)
@@ -152,7 +216,7 @@ grpc::ServerGenericBidiReactor* CallGate::CreateReactor(
         grpc::Status(grpc::StatusCode::UNIMPLEMENTED, "no method " + method.substr(0, 200)));
   if (grpc::Status denied = authorize_(*context); !denied.ok()) return new RefusedCall(denied);
   const MethodBounds bounds = bounds_.of(name);
-  if (stream != streams_.end()) return stream->second(bounds.bytes);
+  if (stream != streams_.end()) return stream->second(charged(*this, bounds.bytes), bounds.bytes);
   if (unary_in_flight_.fetch_add(1) >= kMaxUnaryInFlight) {
     unary_in_flight_.fetch_sub(1);
     return new RefusedCall(grpc::Status(

@@ -43,17 +43,31 @@ class WorkerPool {
   std::vector<std::thread> threads_;
 };
 
+class CallGate;
+
 // Reads a call's one request message, refusing one past `max_bytes`, then hands its bytes to
-// on_request(). The base of every call the gate lets in.
+// on_request(). The base of every call the gate lets in. With a `gate`, the call holds
+// `max_bytes` of the gate's in-flight budget until it is done, and waits, unread, for room.
 class RequestReader : public grpc::ServerGenericBidiReactor {
+ public:
+  ~RequestReader() override;
+  void OnCancel() final;
+
  protected:
-  explicit RequestReader(std::size_t max_bytes, std::string method);
+  RequestReader(CallGate* gate, std::size_t max_bytes, std::string method);
   // Once, with the request's bytes; the reactor then writes and finishes as it sees fit.
   virtual void on_request(std::string bytes) = 0;
+  // The client cancelled, or the server is shutting down, after the read began.
+  virtual void on_cancel() {}
   void OnReadDone(bool ok) override;
   const std::string& method() const { return method_; }
+  // The request's bytes are gone: its share of the budget goes back (once; the destructor does
+  // it when this was not called).
+  void done_with_request();
 
  private:
+  friend class CallGate;
+  CallGate* gate_;
   std::size_t max_bytes_;
   std::string method_;
   grpc::ByteBuffer request_;
@@ -70,8 +84,10 @@ class CallGate final : public grpc::CallbackGenericService {
  public:
   // Serves one parsed-and-checked request: its bytes in, the response's bytes out.
   using Serve = std::function<grpc::Status(const std::string& request, std::string* response)>;
-  // Starts a streaming call whose request the reactor reads itself (a RequestReader).
-  using StartStream = std::function<grpc::ServerGenericBidiReactor*(std::size_t max_bytes)>;
+  // Starts a streaming call whose request the reactor reads itself (a RequestReader charged to
+  // `gate`'s budget when it is not null).
+  using StartStream =
+      std::function<grpc::ServerGenericBidiReactor*(CallGate* gate, std::size_t max_bytes)>;
   struct Unary {
     const google::protobuf::Descriptor* request;
     Serve serve;
@@ -88,6 +104,13 @@ class CallGate final : public grpc::CallbackGenericService {
       grpc::GenericCallbackServerContext* context) override;
 
   const RequestBounds& bounds() const { return bounds_; }
+
+  // The in-flight budget (RequestBounds::in_flight_budget): true when `reader`'s bytes fit now;
+  // otherwise it waits, and its read starts when calls before it are done.
+  bool admit(RequestReader* reader);
+  void release(std::size_t bytes);
+  // Takes back a waiting reader (cancelled before its read began); false if it was not waiting.
+  bool forget(RequestReader* reader);
   // Unary calls read and not yet answered, beyond which new ones are refused as busy.
   static constexpr int kMaxUnaryInFlight = 1024;
 
@@ -99,8 +122,15 @@ class CallGate final : public grpc::CallbackGenericService {
   std::vector<std::pair<std::string, Unary>> unary_;
   std::vector<std::pair<std::string, StartStream>> streams_;
   std::atomic<int> unary_in_flight_{0};
+  std::mutex budget_mutex_;
+  std::size_t reserved_ = 0;
+  std::deque<RequestReader*> waiting_;
   WorkerPool workers_;
 };
+
+// The gate whose budget a request of `max_bytes` is charged to: requests of a megabyte or more;
+// small ones (GetInfo, Control) never wait behind large ones.
+CallGate* charged(CallGate& gate, std::size_t max_bytes);
 
 // Gives freed memory back to the system after a request of `bytes` (large ones only: the walk
 // over the heap is not free).

@@ -111,13 +111,15 @@ void StreamHub::end_all() {
     link->end();
 }
 
-FrameStream::FrameStream(StreamHub& hub, WorldHost& host, const ReadRequest& read,
+FrameStream::FrameStream(StreamHub& hub, WorldHost& host, const ReadRequest& read, CallGate* gate,
                          std::size_t max_bytes, const std::string& method)
-    : RequestReader(max_bytes, method), hub_(hub), host_(host), read_(read) {}
+    : RequestReader(gate, max_bytes, method), hub_(hub), host_(host), read_(read) {}
 
 void FrameStream::on_request(std::string bytes) {
   double max_rate = 0;
-  if (grpc::Status refused = read_(bytes, &options_, &max_rate); !refused.ok()) {
+  const grpc::Status refused = read_(bytes, &options_, &max_rate);
+  done_with_request();  // a stream holds its options, not its request
+  if (!refused.ok()) {
     Finish(refused);
     return;
   }
@@ -219,7 +221,7 @@ void FrameStream::end() {
   if (!writing_) finish_locked(final_status_);
 }
 
-void FrameStream::OnCancel() {
+void FrameStream::on_cancel() {
   end();
 }
 

@@ -72,13 +72,13 @@ class FrameStream final : public RequestReader {
   using ReadRequest =
       std::function<grpc::Status(const std::string& bytes, FrameOptions*, double* max_rate)>;
   // Reads the request (at most `max_bytes`), then subscribes to `host`.
-  FrameStream(StreamHub& hub, WorldHost& host, const ReadRequest& read, std::size_t max_bytes,
-              const std::string& method);
+  FrameStream(StreamHub& hub, WorldHost& host, const ReadRequest& read, CallGate* gate,
+              std::size_t max_bytes, const std::string& method);
   // Ends the stream with OK after the write in flight (the server is shutting down).
   void end();
 
   void OnWriteDone(bool ok) override;
-  void OnCancel() override;
+  void on_cancel() override;
   void OnDone() override;
 
  private:

@@ -5,6 +5,7 @@
 #include <google/protobuf/wire_format_lite.h>
 
 #include <algorithm>
+#include <vector>
 
 namespace tumble::server {
 namespace {
@@ -77,6 +78,7 @@ Result<std::size_t> packed_count(CodedInputStream* in, const FieldDescriptor& fi
 struct Scanner {
   std::size_t max_parsed, max_top_entries;
   WireScan found;
+  std::vector<std::pair<const FieldDescriptor*, std::size_t>> top_counts;
 
   Status charge(std::size_t bytes) {
     found.parsed_bytes += bytes;
@@ -86,11 +88,16 @@ struct Scanner {
           StatusCode::kResourceExhausted);
     return Status::ok();
   }
-  Status count_top(std::size_t entries) {
-    found.top_entries += entries;
-    if (max_top_entries != 0 && found.top_entries > max_top_entries)
-      return Status::error("more than " + std::to_string(max_top_entries) + " entries",
-                           StatusCode::kResourceExhausted);
+  Status count_top(const FieldDescriptor& field, std::size_t entries) {
+    auto counted = std::find_if(top_counts.begin(), top_counts.end(),
+                                [&](const auto& entry) { return entry.first == &field; });
+    if (counted == top_counts.end()) counted = top_counts.insert(counted, {&field, 0});
+    counted->second += entries;
+    found.top_entries = std::max(found.top_entries, counted->second);
+    if (max_top_entries != 0 && counted->second > max_top_entries)
+      return Status::error(
+          field.name() + ": more than " + std::to_string(max_top_entries) + " entries",
+          StatusCode::kResourceExhausted);
     return Status::ok();
   }
 
@@ -117,7 +124,7 @@ struct Scanner {
               !s)
             return s;
           if (top)
-            if (Status s = count_top(1); !s) return s;
+            if (Status s = count_top(*field, 1); !s) return s;
           const auto limit = in->PushLimit(static_cast<int>(length));
           if (Status s = message(in, *field->message_type(), depth + 1); !s) return s;
           in->PopLimit(limit);
@@ -128,20 +135,20 @@ struct Scanner {
           if (!entries) return entries.status();
           if (Status s = charge(2 * scalar_size(*field) * entries.value()); !s) return s;
           if (top)
-            if (Status s = count_top(entries.value()); !s) return s;
+            if (Status s = count_top(*field, entries.value()); !s) return s;
           continue;
         }
         // Strings and bytes: their own length, and a string object.
         if (Status s = charge(length + 32); !s) return s;
         if (top)
-          if (Status s = count_top(1); !s) return s;
+          if (Status s = count_top(*field, 1); !s) return s;
         if (!in->Skip(static_cast<int>(length))) return Status::error("cut short");
         continue;
       }
       if (field != nullptr && field->is_repeated()) {
         if (Status s = charge(2 * scalar_size(*field)); !s) return s;
         if (top)
-          if (Status s = count_top(1); !s) return s;
+          if (Status s = count_top(*field, 1); !s) return s;
       }
       // Unknown fields are kept by the parser: charged at their size.
       if (field == nullptr)
@@ -187,7 +194,7 @@ Result<WireScan> scan_wire(std::string_view bytes, const Descriptor& type,
   in.SetRecursionLimit(64);
   // A limit over the whole input, so that the end of every message is a limit reached.
   in.PushLimit(static_cast<int>(bytes.size()));
-  Scanner scanner{max_parsed_bytes, max_top_entries, {}};
+  Scanner scanner{max_parsed_bytes, max_top_entries, {}, {}};
   if (Status s = scanner.charge(empty_size(type)); !s) return s;
   if (Status s = scanner.message(&in, type, 0); !s) return s;
   return scanner.found;

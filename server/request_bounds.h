@@ -35,18 +35,21 @@ struct RequestBounds {
   MethodBounds of(std::string_view method) const;
   // The largest bound of any method: what gRPC itself is told to accept.
   std::size_t largest() const;
+  // The request bytes all calls being read or served may hold together: four of the largest.
+  // A call whose bound does not fit waits, unread, until calls before it are done.
+  std::size_t in_flight_budget() const { return 4 * largest(); }
 };
 
 // What a scan of a message's wire bytes found.
 struct WireScan {
   std::size_t parsed_bytes = 0;  // about what the parsed message takes in memory, an upper bound
-  std::size_t top_entries = 0;   // entries of the top-level repeated fields, all of them together
+  std::size_t top_entries = 0;   // entries of the largest top-level repeated field
 };
 
 // Scans `bytes` as a `type` message without building it. Refuses bytes that are not such a
-// message, and stops (refusing) as soon as the parsed form would exceed `max_parsed_bytes` or the
-// top-level entries `max_top_entries` (0: no bound), so the scan's own cost is linear in the
-// bytes and it allocates nothing.
+// message, and stops (refusing) as soon as the parsed form would exceed `max_parsed_bytes` or a
+// top-level repeated field would hold more than `max_top_entries` (0: no bound), naming the
+// field, so the scan's own cost is linear in the bytes.
 Result<WireScan> scan_wire(std::string_view bytes, const google::protobuf::Descriptor& type,
                            std::size_t max_parsed_bytes, std::size_t max_top_entries);
 

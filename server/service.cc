@@ -8,6 +8,7 @@
 #include "scenes/scene.h"
 #include "scenes/standard.h"
 #include "snapshot.h"
+#include "tumble/v1/snapshot.pb.h"
 
 namespace tumble::server {
 namespace {
@@ -102,9 +103,10 @@ CallGate WorldService::make_gate() {
       {"Snapshot", unary(&WorldService::snapshot)},
       {"Restore", unary(&WorldService::restore)}};
   std::vector<std::pair<std::string, CallGate::StartStream>> streams = {
-      {"StreamFrames", [this](std::size_t max_bytes) -> grpc::ServerGenericBidiReactor* {
+      {"StreamFrames",
+       [this](CallGate* gate, std::size_t max_bytes) -> grpc::ServerGenericBidiReactor* {
          if (shutting_down_) return new RefusedCall(grpc::Status::OK);
-         return new FrameStream(streams_, host_, read_stream_, max_bytes, "StreamFrames");
+         return new FrameStream(streams_, host_, read_stream_, gate, max_bytes, "StreamFrames");
        }}};
   return CallGate(
       v1::World::service_full_name(),
@@ -117,6 +119,14 @@ void WorldService::register_on(grpc::ServerBuilder& builder) {
   builder.RegisterService(this);
   builder.RegisterCallbackGenericService(&gate_);
   builder.SetMaxReceiveMessageSize(static_cast<int>(gate_.bounds().largest()));
+  // A stream's flow-control window stays at HTTP/2's 64 KiB until its request is read (gRPC's
+  // bandwidth probe would grow it to megabytes): a client without the token can push no more
+  // than that before it is refused. Reading a request opens the window to its whole size, so
+  // large requests still arrive at full speed.
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  // Bytes still arriving for a refused call are read off the socket and dropped 1 MiB at a time
+  // (gRPC's default grows its reads to 4 MiB).
+  builder.AddChannelArgument(GRPC_ARG_TCP_MAX_READ_CHUNK_SIZE, 1 << 20);
   // gRPC (1.51) inflates a compressed request whole before it checks the size: 190 KB of gzip
   // becomes 190 MB in memory. Compressed requests are refused (UNIMPLEMENTED, naming the
   // algorithm) when their headers arrive, before any of the message is read.
@@ -343,14 +353,14 @@ grpc::Status WorldService::load_scene(const v1::LoadSceneRequest& request,
                                       v1::LoadSceneResponse* response) {
   Result<SceneDef> scene = Status::error("source: required (scene_json or builtin)");
   if (request.has_scene_json())
-    scene = parse_scene(request.scene_json());
+    scene = parse_scene(request.scene_json(), limits_.max_bodies);
   else if (request.has_builtin())
     scene = standard_scene(request.builtin(), limits_.max_bodies);
   if (!scene) {
     const char* field = request.has_scene_json() ? "scene_json: "
                         : request.has_builtin()  ? "builtin: "
                                                  : "";
-    return invalid(field + scene.error());
+    return to_grpc(scene.status().within(field));
   }
   std::vector<std::uint64_t> ids;
   if (grpc::Status replaced = replace_world(scene.value(), &ids); !replaced.ok()) return replaced;
@@ -440,15 +450,21 @@ grpc::Status WorldService::snapshot(const v1::SnapshotRequest&, v1::SnapshotResp
 
 grpc::Status WorldService::restore(const v1::RestoreRequest& request,
                                    v1::RestoreResponse* response) {
+  // The snapshot's slots (live or free) are counted, and what decoding it would take is
+  // bounded, before it is decoded: every slot costs memory and every step's time.
+  const Result<WireScan> scan =
+      scan_wire(request.state(), *v1::snapshot::WorldSnapshot::descriptor(),
+                parsed_bound(request.state().size()), limits_.max_bodies);
+  if (!scan) {
+    const std::string what = "state: " + scan.error();
+    return scan.status().code() == StatusCode::kResourceExhausted
+               ? too_many(what + " (slots, live or free, count against the " +
+                          std::to_string(limits_.max_bodies) + " bodies allowed)")
+               : invalid("state: not a snapshot (" + scan.error() + ")");
+  }
   Result<SavedWorld> saved = decode_snapshot(request.state());
   if (!saved) return invalid("state." + saved.error());
   SavedWorld& s = saved.value();
-  std::size_t live = 0;
-  for (const BodySlotState& slot : s.state.slots)
-    live += slot.alive ? 1 : 0;
-  if (live > limits_.max_bodies)
-    return too_many("state: " + std::to_string(live) + " bodies, more than the " +
-                    std::to_string(limits_.max_bodies) + " allowed");
   const std::uint64_t step = s.state.step;
   s.settings.limits = limits_.world;
   if (Status t = check_time_step(s.dt, limits_.world); !t) return invalid("state." + t.message());

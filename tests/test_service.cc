@@ -470,7 +470,7 @@ TEST_F(SnapshotTest, BadSnapshotsAreRefusedAndChangeNothing) {
   EXPECT_EQ(bodies().SerializeAsString(), before);
 }
 
-TEST_F(SnapshotTest, StreamForgetsTheOldWorldAfterARestore) {
+TEST_F(SnapshotTest, AfterARestoreTheStreamDescribesEveryBodyAndRemovesOnlyThoseGone) {
   const std::string saved = snapshot().state();
   v1::SpawnBodiesRequest spawn;
   *spawn.add_bodies() = ball(6);
@@ -485,10 +485,18 @@ TEST_F(SnapshotTest, StreamForgetsTheOldWorldAfterARestore) {
   EXPECT_EQ(frame.added_size(), 10);
   ASSERT_TRUE(restore(saved).ok());
   ASSERT_TRUE(reader->Read(&frame));
-  // Same ids again, but a new world: all ten are gone, nine are described afresh.
-  EXPECT_EQ(frame.removed_size(), 10);
+  // A new world with the same ids: the nine it holds are described afresh, and only the ball it
+  // lacks is removed. No id is both removed and added, so a client may apply the two lists in
+  // either order without losing a body (it did: all ten were listed as removed too).
+  ASSERT_EQ(frame.removed_size(), 1);
+  EXPECT_EQ(frame.removed(0), spawned.ids(0));
   EXPECT_EQ(frame.added_size(), 9);
   EXPECT_EQ(frame.ids_size(), 9);
+  std::set<std::uint64_t> added;
+  for (const v1::BodyDescription& d : frame.added())
+    added.insert(d.id());
+  for (std::uint64_t id : frame.ids())
+    EXPECT_TRUE(added.count(id)) << id;
   context.TryCancel();
   reader->Finish();
 }

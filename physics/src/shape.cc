@@ -264,10 +264,55 @@ ShapeState Shape::state() const {
 
 namespace {
 
+// A stored polyhedron (from a snapshot) must be the hull its vertices make, as a built one is:
+// every vertex of a face's loop on the face's plane, every vertex on or behind every face, every
+// vertex on some face, and the stored volume, centroid and extents its own. The references are
+// in range (check_polyhedron checked them first). O(vertices x faces): at most 1024 x 2044.
+Status check_polyhedron_geometry(const ConvexPolyhedron& p) {
+  double scale = 0;
+  for (const Vec3& v : p.vertices)
+    scale = std::max(scale, v.cwiseAbs().maxCoeff());
+  // Qhull merges nearly coplanar facets; their vertices sit within rounding of the plane.
+  const double tolerance = 1e-6 * scale;
+  std::vector<std::uint8_t> on_a_face(p.vertices.size(), 0);
+  for (std::size_t i = 0; i < p.faces.size(); ++i) {
+    const ConvexPolyhedron::Face& face = p.faces[i];
+    for (std::uint32_t k = 0; k < face.count; ++k) {
+      const std::uint32_t v = p.face_vertices[face.first + k];
+      on_a_face[v] = 1;
+      if (std::abs(face.normal.dot(p.vertices[v]) - face.offset) > tolerance)
+        return Status::error("polyhedron.faces[" + std::to_string(i) +
+                             "]: a vertex of its loop is off its plane");
+    }
+    for (std::size_t v = 0; v < p.vertices.size(); ++v)
+      if (face.normal.dot(p.vertices[v]) - face.offset > tolerance)
+        return Status::error("polyhedron.vertices[" + std::to_string(v) + "]: outside faces[" +
+                             std::to_string(i) + "] (the polyhedron is not convex)");
+  }
+  for (std::size_t v = 0; v < p.vertices.size(); ++v)
+    if (on_a_face[v] == 0)
+      return Status::error("polyhedron.vertices[" + std::to_string(v) + "]: on no face");
+  const PolyhedronIntegrals integrals = integrate_polyhedron(p);
+  if (!(std::abs(integrals.volume - p.volume) <= 1e-9 * std::abs(integrals.volume)))
+    return Status::error("polyhedron.volume: not the volume its faces enclose");
+  if (!((integrals.centroid - p.centroid).cwiseAbs().maxCoeff() <= 1e-9 * scale))
+    return Status::error("polyhedron.centroid: not the centroid of its faces");
+  return Status::ok();
+}
+
 Status check_polyhedron(const ConvexPolyhedron& p) {
   const std::size_t vertex_count = p.vertices.size(), face_count = p.faces.size();
   if (vertex_count < 4 || face_count < 4 || p.edges.size() < 6)
     return Status::error("polyhedron: needs at least 4 vertices, 4 faces and 6 edges");
+  // As many vertices as a built hull may have, and no more faces and edges than a polyhedron of
+  // that many vertices has (Euler: F <= 2V - 4, E <= 3V - 6), each edge in two face loops.
+  if (vertex_count > kMaxHullPoints)
+    return Status::error("polyhedron.vertices: " + std::to_string(vertex_count) +
+                         ", more than the " + std::to_string(kMaxHullPoints) + " a hull may have");
+  if (face_count > 2 * vertex_count - 4 || p.edges.size() > 3 * vertex_count - 6)
+    return Status::error("polyhedron: more faces or edges than its vertices can make");
+  if (p.face_vertices.size() != 2 * p.edges.size())
+    return Status::error("polyhedron.face_vertices: must hold every edge twice");
   for (std::size_t i = 0; i < vertex_count; ++i)
     if (!is_finite(p.vertices[i]))
       return Status::error("polyhedron.vertices[" + std::to_string(i) + "]: must be finite");
@@ -293,7 +338,7 @@ Status check_polyhedron(const ConvexPolyhedron& p) {
   if (!is_finite(p.centroid)) return Status::error("polyhedron.centroid: must be finite");
   if (!(p.volume > 0) || !std::isfinite(p.volume))
     return Status::error("polyhedron.volume: must be finite and > 0");
-  return Status::ok();
+  return check_polyhedron_geometry(p);
 }
 
 }  // namespace
@@ -321,6 +366,10 @@ Result<Shape> Shape::from_state(const ShapeState& state) {
       Shape shape;
       shape.type_ = ShapeType::kHull;
       shape.polyhedron_ = state.polyhedron;
+      // The broad phase bounds a hull by its vertices; the stored extents must say the same.
+      const Vec3 extents = 0.5 * shape.local_bounds().extent();
+      if (!((extents - state.half_extents).cwiseAbs().maxCoeff() <= 1e-9 * extents.maxCoeff()))
+        return Status::error("half_extents: not half the extent of the hull's vertices");
       shape.half_extents_ = state.half_extents;
       shape.update_radii();
       return shape;

@@ -274,9 +274,78 @@ Json body_json(const BodyDef& def) {
   return out;
 }
 
+// Counts what a scene's JSON holds without building it: the entries of the top-level "bodies"
+// array and every value. The document a parse builds takes tens of bytes per value, so a scene
+// is refused on these counts before it is built.
+class SceneCounter final : public nlohmann::json_sax<Json> {
+ public:
+  std::size_t bodies = 0, values = 0;
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override { return open(); }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override {
+    const bool opens_bodies = depth_ == 1 && last_key_is_bodies_;
+    if (!open()) return false;
+    if (opens_bodies) bodies_depth_ = depth_;
+    return true;
+  }
+  bool end_array() override {
+    if (depth_ == bodies_depth_) bodies_depth_ = 0;
+    return close();
+  }
+  bool key(string_t& key) override {
+    if (depth_ == 1) last_key_is_bodies_ = key == "bodies";
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;  // the real parse says what is wrong
+  }
+
+ private:
+  bool value() {
+    ++values;
+    if (bodies_depth_ != 0 && depth_ == bodies_depth_) ++bodies;
+    return true;
+  }
+  bool open() {
+    value();
+    ++depth_;
+    return true;
+  }
+  bool close() {
+    --depth_;
+    return true;
+  }
+  int depth_ = 0, bodies_depth_ = 0;
+  bool last_key_is_bodies_ = false;
+};
+
 }  // namespace
 
-Result<SceneDef> parse_scene(std::string_view json_text) {
+Result<SceneDef> parse_scene(std::string_view json_text, std::size_t max_bodies) {
+  if (max_bodies != kNoBodyLimit) {
+    SceneCounter counter;
+    Json::sax_parse(json_text, &counter);
+    // A body with every field set, or a hull of a few hundred points, is a few hundred values.
+    const std::size_t max_values = 64 * max_bodies + (1u << 20);
+    if (counter.bodies > max_bodies)
+      return Status::error("bodies: " + std::to_string(counter.bodies) + " bodies, more than the " +
+                               std::to_string(max_bodies) + " allowed",
+                           StatusCode::kResourceExhausted);
+    if (counter.values > max_values)
+      return Status::error("scene: " + std::to_string(counter.values) +
+                               " JSON values, more than the " + std::to_string(max_values) +
+                               " a scene of at most " + std::to_string(max_bodies) +
+                               " bodies may hold",
+                           StatusCode::kResourceExhausted);
+  }
   Json json;
   try {
     json = Json::parse(json_text);

@@ -22,7 +22,10 @@ struct SceneDef {
 
 // Parses and validates a whole scene; nothing partial comes back. Errors name the field's path,
 // e.g. "bodies[3].size[1]: must be > 0".
-Result<SceneDef> parse_scene(std::string_view json_text);
+// With `max_bodies`, a scene of more bodies (or of more JSON values than such a scene needs) is
+// refused as RESOURCE_EXHAUSTED after a counting pass that builds nothing, before it is parsed.
+inline constexpr std::size_t kNoBodyLimit = static_cast<std::size_t>(-1);
+Result<SceneDef> parse_scene(std::string_view json_text, std::size_t max_bodies = kNoBodyLimit);
 // Reads a file and parses it; errors start with the file's path.
 Result<SceneDef> load_scene_file(const std::string& path);
 // The scene as JSON that parse_scene reads back to the same scene (numbers round-trip exactly).
