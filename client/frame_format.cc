@@ -57,7 +57,49 @@ Json stats_json(const v1::StepStats& stats) {
   return out;
 }
 
+// "positions: 3 values for 2 bodies (3 each)" when `values` is not `per` times `bodies`.
+Status check_length(const char* field, int values, int per, int bodies, const char* of) {
+  if (static_cast<long long>(values) == static_cast<long long>(per) * bodies) return Status::ok();
+  return Status::error(std::string(field) + ": " + std::to_string(values) + " values for " +
+                       std::to_string(bodies) + " " + of + " (" + std::to_string(per) + " each)");
+}
+
 }  // namespace
+
+Status check_frame(const v1::Frame& frame) {
+  const int bodies = frame.ids_size();
+  if (Status s = check_length("positions", frame.positions_size(), 3, bodies, "bodies"); !s)
+    return s;
+  if (Status s = check_length("orientations", frame.orientations_size(), 4, bodies, "bodies"); !s)
+    return s;
+  if (frame.linear_velocities_size() != 0 || frame.angular_velocities_size() != 0) {
+    if (Status s =
+            check_length("linear_velocities", frame.linear_velocities_size(), 3, bodies, "bodies");
+        !s)
+      return s;
+    if (Status s = check_length("angular_velocities", frame.angular_velocities_size(), 3, bodies,
+                                "bodies");
+        !s)
+      return s;
+  }
+  if (frame.has_contacts()) {
+    const v1::Contacts& c = frame.contacts();
+    const int contacts = c.body_a_size();
+    const std::pair<const char*, std::pair<int, int>> arrays[] = {
+        {"contacts.body_b", {c.body_b_size(), 1}},
+        {"contacts.points", {c.points_size(), 3}},
+        {"contacts.normals", {c.normals_size(), 3}},
+        {"contacts.depths", {c.depths_size(), 1}},
+        {"contacts.impulses", {c.impulses_size(), 1}}};
+    for (const auto& [field, size] : arrays)
+      if (Status s = check_length(field, size.first, size.second, contacts, "contacts"); !s)
+        return s;
+  }
+  for (int i = 0; i < frame.added_size(); ++i)
+    if (frame.added(i).shape().kind_case() == v1::Shape::KIND_NOT_SET)
+      return Status::error("added[" + std::to_string(i) + "].shape: required");
+  return Status::ok();
+}
 
 std::string frame_to_json_line(const v1::Frame& frame) {
   Json line = {{"step", frame.step()}, {"time", frame.time()}, {"dropped", frame.dropped()}};
@@ -117,7 +159,8 @@ std::string frame_to_csv_rows(const v1::Frame& frame, bool velocities) {
   for (int i = 0; i < frame.ids_size(); ++i) {
     rows += std::to_string(frame.step());
     add(frame.time());
-    rows += "," + std::to_string(frame.ids(i));
+    rows += ',';
+    rows += std::to_string(frame.ids(i));
     for (int k = 0; k < 3; ++k)
       add(frame.positions(3 * i + k));
     for (int k = 0; k < 4; ++k)

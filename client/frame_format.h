@@ -3,14 +3,22 @@
 
 #include <string>
 
+#include "physics/status.h"
 #include "tumble/v1/world.pb.h"
 
 namespace tumble::client {
+
+// Whether a frame's arrays agree with its ids (3 position and 4 orientation values per body,
+// velocities for all bodies or none, contact arrays of one length) and its descriptions have
+// shapes; the message names the field. A frame from a file or the network is checked before it
+// is formatted: the formatters below index its arrays by its ids.
+Status check_frame(const v1::Frame& frame);
 
 // {"step", "time", "dropped", "bodies": [{"id", "p": [x,y,z], "q": [w,x,y,z], "v", "w"}],
 //  "contacts": [{"a", "b", "p", "n", "depth", "impulse"}], "added": [...], "removed": [...],
 //  "stats": {every field of tumble.v1.StepStats by name}}
 // Velocities, contacts and statistics appear when the frame has them. Numbers round-trip exactly.
+// The frame must pass check_frame.
 std::string frame_to_json_line(const v1::Frame& frame);
 
 // "step,time,id,x,y,z,qw,qx,qy,qz" (and ",vx,vy,vz,wx,wy,wz" with velocities): a row per body,

@@ -25,16 +25,21 @@ class RecordingWriter {
 class RecordingReader {
  public:
   static Result<RecordingReader> open(const std::string& path);
-  // The next frame: true, or false at the end. A frame cut off at the end of the file (the
-  // recorder was killed mid-write) is reported by truncated().
+  // The next frame: true; false at the end of the file, or when what follows is not a whole,
+  // sound frame (status() then says what and where: a length past the end of the file, bytes
+  // that are not a frame, arrays that do not match the frame's ids).
   bool next(v1::Frame* frame);
-  bool truncated() const { return truncated_; }
+  // OK at the end of a whole recording; the reason reading stopped otherwise.
+  const Status& status() const { return status_; }
+  // How many frames next() has returned.
+  std::size_t frames() const { return frames_; }
 
  private:
   explicit RecordingReader(std::string bytes) : bytes_(std::move(bytes)) {}
+  bool stop(const std::string& why);
   std::string bytes_;
-  std::size_t offset_ = 0;
-  bool truncated_ = false;
+  std::size_t offset_ = 0, frames_ = 0;
+  Status status_ = Status::ok();
 };
 
 }  // namespace tumble::client

@@ -230,9 +230,8 @@ int main(int argc, char** argv) {
       }
       print_frame(frame, replay_options);
     }
-    if (reader.value().truncated())
-      std::fprintf(stderr, "tumble: replay: %s ends inside a frame (recording cut short)\n",
-                   recording_file.c_str());
+    if (!reader.value().status())
+      return fail("replay", reader.value().status().within(recording_file + ": "));
     return 0;
   }
 
@@ -339,10 +338,14 @@ int main(int argc, char** argv) {
   } else if (*stream) {
     if (stream_options.format == "csv") print_line(client::csv_header(stream_options.velocities));
     std::uint64_t received = 0;
+    Status sound = Status::ok();
     const Status ended = client.stream(stream_options.request(), [&](const v1::Frame& frame) {
+      sound = client::check_frame(frame);
+      if (!sound) return false;
       print_frame(frame, stream_options);
       return stream_options.frames == 0 || ++received < stream_options.frames;
     });
+    if (!sound) return fail("stream", sound.within("a frame from the server: "));
     if (!ended) return fail("stream", ended);
   } else if (*record) {
     Result<client::RecordingWriter> writer = client::RecordingWriter::create(recording_file);
