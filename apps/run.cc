@@ -95,7 +95,8 @@ int main(int argc, char** argv) {
   StageTimes stage_sums;
   // Bounded loops that hit their bound, summed over the run: none of their answers was used as if
   // it were right, but a run that hits them is one to look at.
-  std::uint64_t exact_fallbacks = 0, exact_oversized = 0, gyroscopic = 0, continuous = 0;
+  std::uint64_t exact_fallbacks = 0, exact_oversized = 0, gyroscopic = 0, continuous = 0,
+                pair_bound = 0;
   // Islands tall enough to buckle, given more substeps or sweeps (island-steps), and those at the
   // bound.
   std::uint64_t stiffened = 0, stiffness_capped = 0;
@@ -116,6 +117,7 @@ int main(int argc, char** argv) {
     exact_oversized += world.last_step().exact_oversized;
     gyroscopic += world.last_step().gyroscopic_limit_hits;
     continuous += world.last_step().continuous_limit_hits;
+    pair_bound += world.last_step().pair_limit_hits;
     stiffened += world.last_step().stiffened_islands;
     stiffness_capped += world.last_step().stiffness_capped;
     non_finite += world.last_step().non_finite_bodies;
@@ -167,10 +169,11 @@ int main(int argc, char** argv) {
       share(packed), static_cast<unsigned long long>(manifolds), share(reused));
   std::printf(
       "bounds hit over the run: exact islands solved by pgs instead %llu, exact islands too large "
-      "(soft) %llu, gyroscopic steps kept as spin %llu, swept pairs stopped at the bound %llu\n",
+      "(soft) %llu, gyroscopic steps kept as spin %llu, swept pairs stopped at the bound %llu, "
+      "steps with more pairs than the bound (heaped bodies) %llu\n",
       static_cast<unsigned long long>(exact_fallbacks),
       static_cast<unsigned long long>(exact_oversized), static_cast<unsigned long long>(gyroscopic),
-      static_cast<unsigned long long>(continuous));
+      static_cast<unsigned long long>(continuous), static_cast<unsigned long long>(pair_bound));
   std::printf(
       "tall stacks over the run (island-steps): given more substeps (soft) or sweeps (pgs) %llu, "
       "needing more than the bound (32 substeps, 256 sweeps) %llu\n",

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "tumble_qos.h"
@@ -82,11 +83,9 @@ Json stats_json(const tumble_msg_dds__StepStats_& m) {
 
 Json body_json(const tumble_msg_dds__Body_& m) {
   const char* shapes[] = {"sphere", "capsule", "box", "hull", "plane"};
-  Json out = {{"topic", "bodies"},
-              {"id", m.id},
-              {"shape", m.shape < 5 ? shapes[m.shape] : "unknown"},
-              {"static", m.is_static},
-              {"mass", m.mass},
+  Json out = {{"topic", "bodies"},      {"id", m.id},
+              {"instance", m.instance}, {"shape", m.shape < 5 ? shapes[m.shape] : "unknown"},
+              {"static", m.is_static},  {"mass", m.mass},
               {"color", m.color}};
   if (m.shape == 0 || m.shape == 1) out["radius"] = m.radius;
   if (m.shape == 1) out["half_height"] = m.half_height;
@@ -172,6 +171,7 @@ int main(int argc, char** argv) {
 
   const auto start = std::chrono::steady_clock::now();
   long printed = 0;
+  std::unordered_map<std::uint32_t, std::uint64_t> body_at;  // the body each instance holds
   while (count == 0 || printed < count) {
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -185,18 +185,30 @@ int main(int argc, char** argv) {
       dds_sample_info_t infos[16];
       const dds_return_t taken = dds_take(s.reader, samples, infos, 16, 16);
       for (dds_return_t i = 0; i < taken && (count == 0 || printed < count); ++i) {
-        Json line;
+        std::vector<Json> lines;
         if (infos[i].valid_data) {
-          line = s.to_json(samples[i]);
+          if (s.name == "bodies") {
+            // An instance that held another body: that body is gone (its dispose may have been
+            // overwritten before it was read).
+            const auto& body = *static_cast<const tumble_msg_dds__Body_*>(samples[i]);
+            const auto held = body_at.find(body.instance);
+            if (held != body_at.end() && held->second != body.id)
+              lines.push_back({{"topic", "bodies"}, {"id", held->second}, {"removed", true}});
+            body_at[body.instance] = body.id;
+          }
+          lines.push_back(s.to_json(samples[i]));
         } else if (infos[i].instance_state != DDS_IST_ALIVE && s.name == "bodies") {
           tumble_msg_dds__Body_ key{};
           dds_instance_get_key(s.reader, infos[i].instance_handle, &key);
-          line = {{"topic", "bodies"}, {"id", key.id}, {"removed", true}};
-        } else {
-          continue;
+          const auto held = body_at.find(key.instance);
+          if (held == body_at.end()) continue;  // a body this reader never saw
+          lines.push_back({{"topic", "bodies"}, {"id", held->second}, {"removed", true}});
+          body_at.erase(held);
         }
-        std::printf("%s\n", line.dump().c_str());
-        ++printed;
+        for (const Json& line : lines) {
+          std::printf("%s\n", line.dump().c_str());
+          ++printed;
+        }
       }
       std::fflush(stdout);
       if (taken > 0) dds_return_loan(s.reader, samples, taken);

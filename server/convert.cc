@@ -183,6 +183,7 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
   out->set_continuous_impacts(s.continuous_impacts);
   out->set_continuous_limit_hits(s.continuous_limit_hits);
   out->set_gyroscopic_limit_hits(s.gyroscopic_limit_hits);
+  out->set_pair_limit_hits(s.pair_limit_hits);
   out->set_broad_phase_seconds(s.time.broad_phase);
   out->set_narrow_phase_seconds(s.time.narrow_phase);
   out->set_prepare_seconds(s.time.prepare);

@@ -2,8 +2,10 @@
 
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -202,19 +204,29 @@ void DdsPublisher::publish_catalogue(const FrameData& frame) {
   std::vector<Point> vertices;
   BodySample sample{};
   for (auto it = described_.begin(); it != described_.end();) {
-    if (now.contains(*it)) {
+    if (now.contains(it->first)) {
       ++it;
       continue;
     }
-    sample.id = *it;  // only the key matters to a dispose
+    sample.instance = it->second;  // only the key matters to a dispose
+    sample.id = it->first;
     dds_dispose(w.bodies, &sample);
     dds_unregister_instance(w.bodies, &sample);
+    free_instances_.push_back(it->second);
+    std::push_heap(free_instances_.begin(), free_instances_.end(), std::greater<>());
     it = described_.erase(it);
   }
   for (const auto& [id, look] : now) {
     if (described_.contains(id)) continue;  // ids are never reused: a known id is the same body
     const Shape& shape = look.shape;
     sample = BodySample{};
+    if (free_instances_.empty()) {
+      sample.instance = next_instance_++;
+    } else {
+      std::pop_heap(free_instances_.begin(), free_instances_.end(), std::greater<>());
+      sample.instance = free_instances_.back();
+      free_instances_.pop_back();
+    }
     sample.id = id;
     sample.shape = static_cast<std::uint8_t>(shape.type());
     sample.is_static = look.type == BodyType::kStatic;
@@ -230,7 +242,7 @@ void DdsPublisher::publish_catalogue(const FrameData& frame) {
     sample.mass = look.mass;
     sample.color = look.colour;
     dds_write(w.bodies, &sample);
-    described_.insert(id);
+    described_.emplace(id, sample.instance);
   }
   catalogue_ = frame.catalogue;
 }

@@ -10,7 +10,8 @@
 #include <cstdint>
 #include <memory>
 #include <thread>
-#include <unordered_set>
+#include <unordered_map>
+#include <vector>
 
 #include "world_host.h"
 
@@ -45,8 +46,13 @@ class DdsPublisher {
   DdsOptions options_;
   std::unique_ptr<Writers> writers_;
   std::shared_ptr<FrameMailbox> mailbox_;
-  std::shared_ptr<const Catalogue> catalogue_;   // the last one published
-  std::unordered_set<std::uint64_t> described_;  // ids with a live instance on rt/tumble/bodies
+  std::shared_ptr<const Catalogue> catalogue_;  // the last one published
+  // Ids with a live instance on rt/tumble/bodies, and the instance each occupies; instances of
+  // removed bodies are used again (lowest first), so the instances are at most the most bodies
+  // ever alive at once.
+  std::unordered_map<std::uint64_t, std::uint32_t> described_;
+  std::vector<std::uint32_t> free_instances_;  // a min-heap
+  std::uint32_t next_instance_ = 0;
   std::atomic<std::uint64_t> published_{0}, skipped_{0};
   std::atomic<bool> stopping_{false};
   std::thread thread_;

@@ -178,6 +178,80 @@ CrushRun run_crush(World& world) {
 // The limit, as measured: the exact solver holds a 10 m box on 30 cm cubes (a mass ratio of
 // 3.7x10^4) to a tenth of a millimetre; on 10 cm cubes (10^6) a few islands fall back to pgs and
 // the cubes are pressed 15 mm into the ground.
+// Issue 31 (4): the pile of 1 m boxes shrunk to 20 µm boxes of 1e-15 kg (inside the limits),
+// with time scaled as gravity scales it (dt x sqrt(scale)) so the fall looks the same. A fixed
+// 2 cm contact margin made every box a neighbour of every other: 500 such boxes had 190,000 to
+// 320,000 contact points and took seconds a step. With the margin at most a body's thickness the
+// tiny pile has about the contacts the large one has.
+TEST(TinyBodies, CostWhatLargeOnesDo) {
+  constexpr int kBoxes = 300;
+  constexpr double kScale = 2e-5;
+  const SceneDef large = pile_scene(kBoxes);
+  SceneDef tiny = large;
+  tiny.dt = large.dt * std::sqrt(kScale);
+  for (BodyDef& body : tiny.bodies) {
+    if (auto* box = std::get_if<BoxDef>(&body.shape)) {
+      box->half_extents *= kScale;
+      body.mass = 1e-15;
+    }
+    body.position *= kScale;
+  }
+  tiny.world.threads = 1;
+  World large_world = make_world(large).value();
+  World tiny_world = make_world(tiny).value();
+  std::uint32_t most_large = 0, most_tiny = 0;
+  for (int step = 0; step < 120; ++step) {
+    ASSERT_TRUE(large_world.step(large.dt));
+    ASSERT_TRUE(tiny_world.step(tiny.dt));
+    most_large = std::max(most_large, large_world.last_step().contact_points);
+    most_tiny = std::max(most_tiny, tiny_world.last_step().contact_points);
+  }
+  EXPECT_GT(most_large, 0u);
+  EXPECT_GT(most_tiny, 0u);
+  // Contacts grow with the bodies, not their square: a few per box, as in the large pile.
+  EXPECT_LT(most_tiny, 3 * most_large + 100) << most_large << " contact points at 1 m";
+  EXPECT_LT(most_tiny, 16u * kBoxes);
+  std::printf("contact points, most in a step: %u at 1 m, %u at 20 um\n", most_large, most_tiny);
+}
+
+// Issue 31 (4): boxes spawned at one point (within every limit) had pairs in the square of
+// their number; the step keeps World::max_pairs of them, says so, and stays finite and the same
+// for any thread count while the heap comes apart.
+TEST(HeapedBodies, AStepConsidersAtMostTheBoundOfPairs) {
+  auto heap = [](int threads) {
+    SceneDef scene = empty_scene(true);
+    scene.world.threads = threads;
+    BodyDef ground;
+    ground.shape = HalfSpaceDef{};
+    ground.type = BodyType::kStatic;
+    scene.bodies.push_back(ground);
+    for (int i = 0; i < 400; ++i)
+      scene.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 3), 1));
+    return make_world(scene).value();
+  };
+  World one = heap(1), two = heap(2);
+  const std::size_t bound = one.max_pairs();
+  EXPECT_EQ(bound, World::kPairsPerBody * 401 + World::kMinPairBound);
+  ASSERT_GT(400u * 399 / 2, bound);  // the heap has more pairs than the bound
+  std::uint32_t hits = 0;
+  for (int step = 0; step < 3; ++step) {
+    ASSERT_TRUE(one.step(1.0 / 60));
+    ASSERT_TRUE(two.step(1.0 / 60));
+    EXPECT_LE(one.last_step().pairs, bound);
+    hits += one.last_step().pair_limit_hits;
+    EXPECT_EQ(one.last_step().pair_limit_hits, two.last_step().pair_limit_hits);
+  }
+  EXPECT_GT(hits, 0u);
+  EXPECT_TRUE(all_finite(one));
+  EXPECT_EQ(one.save_state().slots.size(), two.save_state().slots.size());
+  for (std::uint32_t slot = 0; slot < one.slot_count(); ++slot) {
+    const BodyId a = one.id_at(slot), b = two.id_at(slot);
+    ASSERT_EQ(a.is_valid(), b.is_valid());
+    if (!a.is_valid()) continue;
+    EXPECT_EQ(one.body(a).position(), two.body(b).position()) << slot;
+  }
+}
+
 TEST(MassRatio, ExactHoldsTenMetreBoxOnThirtyCentimetreCubes) {
   World world = build(big_box_on_four_cubes(0.3, SolverKind::kExact));
   const CrushRun crush = run_crush(world);

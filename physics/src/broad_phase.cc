@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 
@@ -238,8 +239,23 @@ void HashGrid::update_resting(const BroadPhaseInput& input) {
   resting_version_ = input.resting_version;
 }
 
-void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
+bool keep_first_pairs(std::vector<BodyPair>* pairs, std::size_t max_pairs) {
+  std::sort(pairs->begin(), pairs->end());
+  pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
+  if (pairs->size() <= max_pairs) return false;
+  pairs->resize(max_pairs);
+  return true;
+}
+
+bool HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
+  // A thread's list is cut back to its first max_pairs whenever it holds twice that: every pair
+  // among the first max_pairs of all threads together is among the first max_pairs of the thread
+  // that found it, so the result does not depend on how the work was split.
+  const std::size_t max_pairs = input.max_pairs;
+  const std::size_t compact_at =
+      max_pairs > static_cast<std::size_t>(-1) / 2 ? max_pairs : 2 * max_pairs;
+  std::atomic<bool> cut{false};
   const auto& bounds = input.bounds;
   const std::size_t n = bounds.size();
   const int threads = std::max(1, input.threads);
@@ -270,7 +286,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
 
   // Resting bodies never pair with one another: with nothing moving there is nothing to find (and
   // no thread team to start).
-  if (moving.empty()) return;
+  if (moving.empty()) return false;
 
   // (1) The moving bodies' cells, each on its own level.
   moving_unbounded_.clear();
@@ -291,8 +307,13 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   const auto may_touch = [&](std::uint32_t a, std::uint32_t b) {
     return a != b && (input.movable[a] || input.movable[b]) && bounds[a].overlaps(bounds[b]);
   };
+  const auto add = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
+    out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+    if (out.size() >= compact_at && keep_first_pairs(&out, max_pairs))
+      cut.store(true, std::memory_order_relaxed);
+  };
   const auto meet = [&](std::uint32_t a, std::uint32_t b, std::vector<BodyPair>& out) {
-    if (may_touch(a, b)) out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+    if (may_touch(a, b)) add(a, b, out);
   };
   // Two boxes that overlap share every cell their overlap covers, but a pair is emitted only from
   // the cell holding its overlap's lowest corner (on the level where it was found): once, not once
@@ -307,7 +328,7 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
                  static_cast<std::int64_t>(corner.y()),
                  static_cast<std::int64_t>(corner.z())) != key)
       return;
-    out.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+    add(a, b, out);
   };
   // Body i against the bodies of `entries` listed on `level`, in the cells i covers there.
   const auto look_up = [&](std::uint32_t i, int level, const std::vector<Entry>& entries,
@@ -380,12 +401,16 @@ void HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
           meet(static_cast<std::uint32_t>(i), u, out);
       }
     }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (keep_first_pairs(&out, max_pairs)) cut.store(true, std::memory_order_relaxed);
   });
   // (3) Reduction: merge the threads' sorted lists, then drop pairs found by several threads.
   merge_sorted(thread_pairs_, threads, pairs, &pair_buffer_);
   pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
+  if (pairs->size() > max_pairs) {
+    pairs->resize(max_pairs);
+    cut = true;
+  }
+  return cut;
 }
 
 void HashGrid::resting_near(const Aabb& box, std::vector<std::uint32_t>* out) const {
@@ -407,8 +432,12 @@ void HashGrid::resting_near(const Aabb& box, std::vector<std::uint32_t>* out) co
   }
 }
 
-void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
+bool sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
+  const std::size_t max_pairs = input.max_pairs;
+  const std::size_t compact_at =
+      max_pairs > static_cast<std::size_t>(-1) / 2 ? max_pairs : 2 * max_pairs;
+  std::atomic<bool> cut{false};
   const auto& bounds = input.bounds;
   // Kept per thread and reused, so that stepping small worlds allocates nothing.
   thread_local std::vector<std::uint32_t> order, unbounded;
@@ -425,6 +454,7 @@ void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs)
   auto emit = [&](std::uint32_t a, std::uint32_t b) {
     if (!(input.movable[a] || input.movable[b]) || !bounds[a].overlaps(bounds[b])) return;
     pairs->push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+    if (pairs->size() >= compact_at && keep_first_pairs(pairs, max_pairs)) cut = true;
   };
   for (std::size_t i = 0; i < order.size(); ++i)
     for (std::size_t j = i + 1;
@@ -436,7 +466,7 @@ void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs)
     for (std::size_t m = k + 1; m < unbounded.size(); ++m)
       emit(unbounded[k], unbounded[m]);
   }
-  std::sort(pairs->begin(), pairs->end());
+  return keep_first_pairs(pairs, max_pairs) || cut;
 }
 
 }  // namespace tumble

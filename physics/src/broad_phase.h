@@ -50,11 +50,20 @@ struct BroadPhaseInput {
   // once. changes_since 0: no list.
   std::span<const std::uint32_t> resting_changes = {};
   std::uint64_t changes_since = 0;
+  // The most pairs to return: past it, the first ones in (a, b) order are kept, the same for any
+  // thread count, and the call says the bound was hit. Bodies heaped on one another (a thousand
+  // boxes spawned at one point) have pairs in the square of their number; this keeps the memory
+  // of the broad phase and of every later stage in proportion to the bound.
+  std::size_t max_pairs = static_cast<std::size_t>(-1);
 };
+
+// Sorts `pairs`, drops repeats and keeps the first `max_pairs`; true when some were dropped.
+bool keep_first_pairs(std::vector<BodyPair>* pairs, std::size_t max_pairs);
 
 class HashGrid {
  public:
-  void find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);
+  // The pairs, sorted; true when input.max_pairs cut them short.
+  bool find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);
   // The resting bodies of the last find_pairs whose cells meet `box` (and those off the grid),
   // appended to `out`, possibly more than once: candidates, which the caller checks, since the
   // bodies may have changed since.
@@ -102,6 +111,6 @@ class HashGrid {
   double base_ = 1.0;                  // level 0's cell, m; kept with the resting cells
 };
 
-void sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);
+bool sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);
 
 }  // namespace tumble

@@ -122,6 +122,9 @@ struct StepStats {
   // Bodies whose implicit gyroscopic step hit its Newton iteration bound or spun too fast for
   // kGyroscopicMaxPieces; they kept their body-frame spin for the step.
   std::uint32_t gyroscopic_limit_hits = 0;
+  // 1 when the broad phase found more pairs than World::max_pairs and kept the first ones (bodies
+  // heaped inside one another).
+  std::uint32_t pair_limit_hits = 0;
   // The world's limits (WorldLimits) held by the step: bodies whose step produced a non-finite
   // value (they keep their pose from before the step, at rest), bodies slowed to the speed
   // limits, and bodies held at the edge of the world (max_coordinate).

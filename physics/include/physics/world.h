@@ -119,6 +119,13 @@ class World {
   // counted there.
   Status step(double dt);
   const StepStats& last_step() const { return stats_; }
+  // The most pairs a step considers: kPairsPerBody per body and kMinPairBound more. A dense pile
+  // has fewer than 8 per body; only bodies heaped inside one another reach it, and then the pairs
+  // first in (slot, slot) order are kept, the same for any thread count, and the step counts it
+  // in StepStats::pair_limit_hits. It bounds the memory and time of every stage after the broad
+  // phase.
+  static constexpr std::size_t kPairsPerBody = 32, kMinPairBound = 1 << 16;
+  std::size_t max_pairs() const;
   double time() const { return time_; }  // s, simulated
   std::uint64_t step_count() const { return stats_.step; }
   // Normal impulse (N s) of each contact point over the whole last step (all substeps of the soft
