@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -213,6 +214,16 @@ class FuzzService {
       }
       case 3: {
         v1::ApplyImpulseRequest request;
+        if (h.chance(0.2)) {
+          // Issue 31: several impulses on one body, each within the speed limit alone and their
+          // sum perhaps not; all or nothing.
+          const std::uint64_t target = id(h);
+          for (int n = h.integer(2, 10); n > 0; --n) {
+            v1::Impulse* i = request.add_impulses();
+            i->set_id(target);
+            set(h.vector(-1, 1) * std::pow(10.0, h.integer(2, 6)), i->mutable_impulse());
+          }
+        }
         for (int n = h.integer(0, 3); n > 0; --n) {
           v1::Impulse* i = request.add_impulses();
           i->set_id(id(h));
@@ -227,16 +238,21 @@ class FuzzService {
         v1::GetBodiesRequest request;
         for (int n = h.integer(0, 3); n > 0; --n)
           request.add_ids(id(h));
+        if (h.chance(0.1))  // issue 31: one id many times, once a reply of millions
+          for (int n = h.integer(2, 2000), same = request.ids_size() > 0; n > 0; --n)
+            request.add_ids(same ? request.ids(0) : id(h));
         v1::GetBodiesResponse response;
         return stub_->GetBodies(&context, request, &response);
       }
       case 5: {
         v1::LoadSceneRequest request;
         if (h.chance(0.5)) {
-          const char* builtins[] = {"pile:6", "pyramid:3", "tower:4",          "pyramid:100000",
-                                    "pile:0", "pile:-3",   "pile:99999999999", "tower:x",
-                                    "",       "bogus",     "spin:3",           "default"};
-          request.set_builtin(builtins[h.integer(0, 11)]);
+          const char* builtins[] = {"pile:6",  "pyramid:3", "tower:4",          "pyramid:100000",
+                                    "pile:0",  "pile:-3",   "pile:99999999999", "tower:x",
+                                    "",        "bogus",     "spin:3",           "default",
+                                    "pile:300", "pile"};
+          request.set_builtin(builtins[h.integer(0, 13)]);
+          if (h.chance(0.05)) request.set_builtin(std::string(100000, 'p'));  // echoed? clipped
         } else if (h.chance(0.9)) {
           request.set_scene_json(h.mutate(std::string(default_scene_json())));
         }
@@ -281,7 +297,7 @@ class FuzzService {
       default: {
         *read_only = true;
         v1::StreamFramesRequest request;
-        request.set_max_rate(h.number(0, 100));
+        request.set_max_rate(h.chance(0.1) ? std::pow(10.0, -h.integer(3, 300)) : h.number(0, 100));
         request.set_velocities(h.chance(0.5));
         request.set_contacts(h.chance(0.5));
         request.set_stats(h.chance(0.5));
