@@ -427,9 +427,9 @@ grpc::Status WorldService::get_info(const v1::GetInfoRequest&, v1::GetInfoRespon
   response->set_time(status.time);
   response->set_body_count(static_cast<std::uint32_t>(status.bodies));
   response->set_running(status.running);
-  WorldSettings world;
-  host_.inspect([&](const HostedWorld& hosted) { world = hosted.world.settings(); });
-  run_settings_to_proto(status.dt, status.real_time_factor, world, response->mutable_settings());
+  // From the host's status, not the world: GetInfo answers while a long step runs.
+  run_settings_to_proto(status.dt, status.real_time_factor, status.settings,
+                        response->mutable_settings());
   stats_to_proto(status.last_step, response->mutable_last_step());
   response->set_subscribers(static_cast<std::uint32_t>(status.subscribers));
   return grpc::Status::OK;

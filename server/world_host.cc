@@ -18,6 +18,7 @@ WorldHost::WorldHost(World world, double dt, double real_time_factor)
   status_.bodies = hosted_.world.body_count();
   status_.dt = dt;
   status_.real_time_factor = real_time_factor_;
+  status_.settings = hosted_.world.settings();
   last_frame_ = make_frame();  // the state before the first step
   thread_ = std::thread([this] { run(); });
 }
@@ -162,6 +163,7 @@ void WorldHost::apply_pending() {
     status_.bodies = hosted_.world.body_count();
     status_.step = hosted_.world.step_count();  // a command may have replaced the world
     status_.time = hosted_.world.time();
+    status_.settings = hosted_.world.settings();
     command.done.set_value(result);
   }
   if (changed) publish(make_frame());

@@ -34,6 +34,9 @@ struct HostStatus {
   double dt = 0, real_time_factor = 0;
   StepStats last_step;
   std::size_t subscribers = 0;
+  // The world's settings as the last command left them (only commands change them), so that
+  // reading them never waits for a step in progress.
+  WorldSettings settings;
 };
 
 // Simulated seconds per wall-clock second when paced; 0 runs flat out.

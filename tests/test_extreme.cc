@@ -146,10 +146,7 @@ SceneDef big_box_on_four_cubes(double edge, SolverKind kind) {
   SceneDef scene = empty_scene(true);
   scene.world.solver.kind = kind;
   scene.world.solver.sleeping = false;
-  BodyDef floor;
-  floor.shape = HalfSpaceDef{};
-  floor.type = BodyType::kStatic;
-  scene.bodies.push_back(floor);
+  scene.bodies.push_back({.shape = HalfSpaceDef{}, .type = BodyType::kStatic});
   for (int i = 0; i < 4; ++i)
     scene.bodies.push_back(
         box(Vec3::Constant(edge / 2), Vec3(i & 1 ? 4.5 : -4.5, i & 2 ? 4.5 : -4.5, edge / 2)));
@@ -221,10 +218,7 @@ TEST(HeapedBodies, AStepConsidersAtMostTheBoundOfPairs) {
   auto heap = [](int threads) {
     SceneDef scene = empty_scene(true);
     scene.world.threads = threads;
-    BodyDef ground;
-    ground.shape = HalfSpaceDef{};
-    ground.type = BodyType::kStatic;
-    scene.bodies.push_back(ground);
+    scene.bodies.push_back({.shape = HalfSpaceDef{}, .type = BodyType::kStatic});
     for (int i = 0; i < 400; ++i)
       scene.bodies.push_back(box(Vec3::Constant(0.5), Vec3(0, 0, 3), 1));
     return make_world(scene).value();
