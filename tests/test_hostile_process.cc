@@ -130,17 +130,19 @@ TEST_F(HostileProcess, WithTheTokenLargeRequestsAreRefusedBeforeTheyAreParsedAnd
           << hostile.method << ": " << status.error_message();
       // Refused, its memory is given back: the server is within 32 MB of where it started.
       const Memory now = memory_of(server_.pid);
-      if (kMemoryGoesBack)
+      if (kMemoryGoesBack) {
         EXPECT_LT(now.resident, before.resident + 32 * kMiB)
             << hostile.method << ": " << before.resident / kMiB << " -> " << now.resident / kMiB
             << " MiB";
+      }
     }
   // A request read is held twice at most (gRPC's buffer and one copy) while it is scanned, and
   // never parsed: the peak stays within three 64 MB messages (it was 5 GB).
   const Memory after = memory_of(server_.pid);
-  if (kMemoryGoesBack)
+  if (kMemoryGoesBack) {
     EXPECT_LT(after.peak, before.resident + 3 * 64 * kMiB)
         << "peak " << after.peak / kMiB << " MiB";
+  }
 
   // A 30-million-entry batch whose bytes fit the bound of a larger server is refused on its
   // count, before parsing: 49 MiB against a SpawnBodies bound of 52 MB.
