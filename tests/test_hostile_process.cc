@@ -2,15 +2,13 @@
 // hostile request makes the server take, read from /proc (VmRSS now, VmHWM its peak). Without
 // the token nothing of a request is read; with it, a request is refused at its method's bound or
 // by its scan before it is parsed, and the memory it took is given back.
-#include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
-#include <condition_variable>
 #include <fstream>
-#include <mutex>
 #include <string>
 
+#include "generic_call.h"
 #include "process_support.h"
 #include "tumble/v1/world.grpc.pb.h"
 
@@ -58,27 +56,11 @@ class HostileProcess : public ::testing::Test {
 
   grpc::Status call(const std::string& method, const std::string& bytes, bool token,
                     grpc_compression_algorithm compression = GRPC_COMPRESS_NONE) {
-    grpc::GenericStub generic(channel_);
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
     if (token) context.AddMetadata("authorization", "Bearer secret");
     context.set_compression_algorithm(compression);
-    grpc::Slice slice(bytes);
-    grpc::ByteBuffer request(&slice, 1), response;
-    grpc::Status status;
-    bool done = false;
-    std::mutex mutex;
-    std::condition_variable finished;
-    generic.UnaryCall(&context, "/tumble.v1.World/" + method, grpc::StubOptions(), &request,
-                      &response, [&](grpc::Status s) {
-                        std::lock_guard lock(mutex);
-                        status = std::move(s);
-                        done = true;
-                        finished.notify_one();
-                      });
-    std::unique_lock lock(mutex);
-    finished.wait(lock, [&] { return done; });
-    return status;
+    return generic_unary_call(channel_, &context, "/tumble.v1.World/" + method, bytes);
   }
 
   Server server_;

@@ -2,16 +2,14 @@
 // accepted, or cost far more than its size, before the gate (server/call_gate.h) and the checks
 // behind it. Every refusal names what is wrong and leaves the world as it was (its snapshot
 // before and after is the same, byte for byte).
-#include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
-#include <condition_variable>
 #include <functional>
-#include <mutex>
 #include <set>
 #include <string>
 
+#include "generic_call.h"
 #include "request_bounds.h"
 #include "scene_runner.h"
 #include "service.h"
@@ -55,24 +53,8 @@ class HostileTest : public ::testing::Test {
   }
   // `bytes` as the request of `method`, whatever they hold.
   grpc::Status raw_call(const std::string& method, const std::string& bytes) {
-    grpc::GenericStub generic(channel_);
     grpc::ClientContext context;
-    grpc::Slice slice(bytes);
-    grpc::ByteBuffer request(&slice, 1), response;
-    grpc::Status status;
-    bool done = false;
-    std::mutex mutex;
-    std::condition_variable finished;
-    generic.UnaryCall(&context, "/tumble.v1.World/" + method, grpc::StubOptions(), &request,
-                      &response, [&](grpc::Status s) {
-                        std::lock_guard lock(mutex);
-                        status = std::move(s);
-                        done = true;
-                        finished.notify_one();
-                      });
-    std::unique_lock lock(mutex);
-    finished.wait(lock, [&] { return done; });
-    return status;
+    return testing::generic_unary_call(channel_, &context, "/tumble.v1.World/" + method, bytes);
   }
   std::vector<std::uint64_t> ids() {
     grpc::ClientContext context;
