@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <set>
+#include <unordered_set>
 
 #include "convert.h"
 #include "scenes/scene.h"
@@ -56,10 +56,8 @@ Status find_bodies(const HostedWorld& hosted,
 
 // The first id listed a second time, named.
 grpc::Status refuse_repeats(const google::protobuf::RepeatedField<std::uint64_t>& ids) {
-  std::vector<std::uint64_t> sorted(ids.begin(), ids.end());
-  std::sort(sorted.begin(), sorted.end());
-  if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) return grpc::Status::OK;
-  std::set<std::uint64_t> seen;
+  std::unordered_set<std::uint64_t> seen;
+  seen.reserve(static_cast<std::size_t>(ids.size()));
   for (int i = 0; i < ids.size(); ++i)
     if (!seen.insert(ids[i]).second) return invalid("ids[" + std::to_string(i) + "]: listed twice");
   return grpc::Status::OK;
