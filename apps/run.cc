@@ -1,7 +1,7 @@
 // tumble-run: steps a scene (the embedded default, a JSON file or a standard scene) and prints,
-// once per simulated second, what the world is doing: contacts, islands, the fastest body, the
-// deepest penetration, the solver's residual and the cost of a step.
-#include <CLI/CLI.hpp>
+// once per simulated second, what the world is doing: contacts (with those of sleeping bodies,
+// which still rest on each other), islands solved, the fastest body, the deepest penetration, the
+// solver's residual and the cost of a step.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,6 +12,7 @@
 #include "physics/world.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
+#include "tumble/command_line.h"
 
 using namespace tumble;
 
@@ -40,6 +41,7 @@ Totals measure(const World& world) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Steps a Tumble scene and prints what happens, once per simulated second."};
+  cli::keep_conventions(app, "tumble-run");
   std::string scene_file, standard;
   std::string solver;
   double duration = -1;
@@ -57,7 +59,7 @@ int main(int argc, char** argv) {
   app.add_option("--manifold-reuse", manifold_reuse,
                  "pairs of polytopes that moved less than this share of their size keep their "
                  "feature (0 to 0.01; 0 searches every step; default: the scene's)");
-  CLI11_PARSE(app, argc, argv);
+  if (const int exit_status = cli::parse(app, argc, argv); exit_status >= 0) return exit_status;
 
   Result<SceneDef> scene = chosen_scene(scene_file, standard);
   if (!scene) {
@@ -139,9 +141,9 @@ int main(int argc, char** argv) {
       const StepStats& st = world.last_step();
       const Totals t = measure(world);
       std::printf("%7.2f %9u %8u %8u %7u %10.4f %12.2e %12.4f %10.2e %9.3f\n", world.time(),
-                  st.contact_points, st.islands, st.exact_islands, st.sleeping_bodies, t.max_speed,
-                  st.max_penetration, t.kinetic + t.potential, st.residual,
-                  1e3 * window_seconds / window_steps);
+                  st.contact_points + st.resting_contact_points, st.islands, st.exact_islands,
+                  st.sleeping_bodies, t.max_speed, st.max_penetration, t.kinetic + t.potential,
+                  st.residual, 1e3 * window_seconds / window_steps);
       window_seconds = 0;
       window_steps = 0;
     }

@@ -98,6 +98,18 @@ Result<v1::GetBodiesResponse> Client::bodies(const std::vector<std::uint64_t>& i
   return call<v1::GetBodiesResponse>(&v1::World::Stub::GetBodies, request);
 }
 
+Status Client::set_states(const std::vector<v1::BodyStateUpdate>& updates) {
+  v1::SetBodyStateRequest request;
+  request.mutable_updates()->Add(updates.begin(), updates.end());
+  return call<v1::SetBodyStateResponse>(&v1::World::Stub::SetBodyState, request).status();
+}
+
+Status Client::apply_impulses(const std::vector<v1::Impulse>& impulses) {
+  v1::ApplyImpulseRequest request;
+  request.mutable_impulses()->Add(impulses.begin(), impulses.end());
+  return call<v1::ApplyImpulseResponse>(&v1::World::Stub::ApplyImpulse, request).status();
+}
+
 Result<v1::ControlResponse> Client::control(const v1::ControlRequest& request) {
   return call<v1::ControlResponse>(&v1::World::Stub::Control, request);
 }

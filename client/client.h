@@ -53,6 +53,9 @@ class Client {
   Result<std::vector<std::uint64_t>> spawn(const std::vector<v1::BodySpec>& bodies);
   Status remove(const std::vector<std::uint64_t>& ids);
   Result<v1::GetBodiesResponse> bodies(const std::vector<std::uint64_t>& ids = {});
+  // All or nothing: one refused update or impulse leaves every body as it was.
+  Status set_states(const std::vector<v1::BodyStateUpdate>& updates);
+  Status apply_impulses(const std::vector<v1::Impulse>& impulses);
   Result<v1::ControlResponse> control(const v1::ControlRequest& request);
   Result<v1::LoadSceneResponse> load_scene(const v1::LoadSceneRequest& request);
   Result<v1::SnapshotResponse> snapshot();

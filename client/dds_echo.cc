@@ -5,7 +5,7 @@
 // nothing of Tumble's.
 #include <dds/dds.h>
 
-#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -14,6 +14,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "tumble/command_line.h"
 #include "tumble_qos.h"
 #include "tumble_states.h"
 
@@ -109,6 +110,7 @@ Json convert(const void* sample) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Prints what tumble-server --dds publishes, as JSON lines."};
+  tumble::cli::keep_conventions(app, "tumble-dds-echo");
   std::uint32_t domain = 0;
   std::vector<std::string> topics = {"poses", "pose_ids", "contacts", "stats", "bodies"};
   long count = 0;
@@ -118,11 +120,12 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::IsMember({"poses", "pose_ids", "contacts", "stats", "bodies"}));
   app.add_option("--count", count, "stop after this many samples (0: never)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tumble::cli::non_negative);
   app.add_option("--timeout", timeout,
                  "stop after this many seconds (0: never); exit 1 if --count was not reached")
-      ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+      ->check(tumble::cli::non_negative);
+  if (const int exit_status = tumble::cli::parse(app, argc, argv); exit_status >= 0)
+    return exit_status;
 
   const dds_entity_t participant = dds_create_participant(domain, nullptr, nullptr);
   if (participant < 0) {
@@ -171,12 +174,27 @@ int main(int argc, char** argv) {
 
   const auto start = std::chrono::steady_clock::now();
   long printed = 0;
+  constexpr double kSilenceWarning = 5, kForever = 1e9;
+  bool told_of_silence = false;
   std::unordered_map<std::uint32_t, std::uint64_t> body_at;  // the body each instance holds
   while (count == 0 || printed < count) {
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (timeout > 0 && elapsed >= timeout) break;
-    const dds_duration_t wait = timeout > 0 ? DDS_SECS(1) * (timeout - elapsed) : DDS_INFINITY;
+    // Silence is the usual first trouble (no server with --dds, another domain, a firewall):
+    // say so once, then keep waiting.
+    if (!told_of_silence && printed == 0 && elapsed >= kSilenceWarning) {
+      std::fprintf(stderr,
+                   "tumble-dds-echo: nothing received on domain %u in %.0f s; is a tumble-server "
+                   "running with --dds on this domain and network? (still waiting)\n",
+                   domain, kSilenceWarning);
+      told_of_silence = true;
+    }
+    double wait_seconds = timeout > 0 ? timeout - elapsed : kForever;
+    if (!told_of_silence) wait_seconds = std::min(wait_seconds, kSilenceWarning - elapsed);
+    const dds_duration_t wait = wait_seconds >= kForever
+                                    ? DDS_INFINITY
+                                    : static_cast<dds_duration_t>(DDS_SECS(1) * wait_seconds);
     dds_attach_t triggered[8];
     const dds_return_t n = dds_waitset_wait(waitset, triggered, 8, wait);
     for (dds_return_t t = 0; t < n; ++t) {

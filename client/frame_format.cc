@@ -149,7 +149,8 @@ std::string csv_header(bool velocities) {
 }
 
 std::string frame_to_csv_rows(const v1::Frame& frame, bool velocities) {
-  velocities = velocities && frame.linear_velocities_size() == 3 * frame.ids_size();
+  // Rows keep the header's columns: asked-for velocities that a frame lacks are empty cells.
+  const bool has_velocities = frame.linear_velocities_size() == 3 * frame.ids_size();
   std::string rows;
   char cell[32];
   auto add = [&](double value) {
@@ -165,11 +166,13 @@ std::string frame_to_csv_rows(const v1::Frame& frame, bool velocities) {
       add(frame.positions(3 * i + k));
     for (int k = 0; k < 4; ++k)
       add(frame.orientations(4 * i + k));
-    if (velocities) {
+    if (velocities && has_velocities) {
       for (int k = 0; k < 3; ++k)
         add(frame.linear_velocities(3 * i + k));
       for (int k = 0; k < 3; ++k)
         add(frame.angular_velocities(3 * i + k));
+    } else if (velocities) {
+      rows += ",,,,,,";
     }
     rows += '\n';
   }

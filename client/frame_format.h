@@ -22,7 +22,8 @@ Status check_frame(const v1::Frame& frame);
 std::string frame_to_json_line(const v1::Frame& frame);
 
 // "step,time,id,x,y,z,qw,qx,qy,qz" (and ",vx,vy,vz,wx,wy,wz" with velocities): a row per body,
-// so contacts and statistics have no place in it (the CLI refuses to ask for them with CSV).
+// so contacts and statistics have no place in it (the CLI refuses to ask for them with CSV). Rows
+// have the header's columns: with `velocities`, a frame without them gives empty cells.
 std::string csv_header(bool velocities);
 std::string frame_to_csv_rows(const v1::Frame& frame, bool velocities);
 

@@ -3,7 +3,6 @@
 //   tumble --server 127.0.0.1:50051 spawn box --size 1,1,1 --mass 2 --pos 0,0,5
 //   tumble stream --format jsonl --frames 100
 // `tumble COMMAND --help` describes each command.
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -14,6 +13,7 @@
 #include "client.h"
 #include "frame_format.h"
 #include "recording.h"
+#include "tumble/command_line.h"
 
 using namespace tumble;
 
@@ -83,7 +83,7 @@ struct StreamOptions {
           ->check(CLI::IsMember({"jsonl", "csv"}));
     command->add_option("--frames", frames, "stop after this many frames (0: until interrupted)");
     command->add_option("--rate", rate, "at most this many frames per second (0: every step)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::non_negative);
     command->add_flag("--velocities", velocities, "include velocities");
     command->add_flag("--contacts", contacts, "include contact points");
     command->add_flag("--stats", stats, "include the step statistics");
@@ -108,6 +108,21 @@ void print_frame(const v1::Frame& frame, const StreamOptions& options) {
   std::fflush(stdout);
 }
 
+const char* solver_name(v1::SolverKind kind) {
+  switch (kind) {
+    case v1::SOLVER_KIND_EXACT:
+      return "exact";
+    case v1::SOLVER_KIND_PGS:
+      return "pgs";
+    case v1::SOLVER_KIND_SOFT:
+      return "soft";
+    case v1::SOLVER_KIND_AUTO:
+      return "auto";
+    default:
+      return "unknown";
+  }
+}
+
 std::optional<v1::SolverKind> solver_kind(const std::string& name) {
   if (name == "exact") return v1::SOLVER_KIND_EXACT;
   if (name == "pgs") return v1::SOLVER_KIND_PGS;
@@ -120,6 +135,7 @@ std::optional<v1::SolverKind> solver_kind(const std::string& name) {
 
 int main(int argc, char** argv) {
   CLI::App app{"tumble: talks to a tumble-server (spawn, remove, control, stream, record)."};
+  cli::keep_conventions(app, "tumble");
   app.require_subcommand(1);
   client::Connection connection;
   app.add_option("--server", connection.address, "the server's address")->envname("TUMBLE_SERVER");
@@ -144,9 +160,11 @@ int main(int argc, char** argv) {
   spawn->add_option("--radius", body.radius, "sphere, capsule: radius (m)");
   spawn->add_option("--half-height", body.half_height, "capsule: half the core length (m)");
   spawn->add_option("--mass", body.mass, "kg (default: from a density of 1000 kg/m^3)");
-  spawn->add_option("--pos", body.position, "x,y,z (m)")->delimiter(',')->expected(3);
-  spawn->add_option("--vel", body.velocity, "x,y,z (m/s)")->delimiter(',')->expected(3);
-  spawn->add_option("--spin", body.spin, "angular velocity x,y,z (rad/s)")
+  spawn->add_option("--position,--pos", body.position, "x,y,z (m)")->delimiter(',')->expected(3);
+  spawn->add_option("--linear-velocity,--vel", body.velocity, "x,y,z (m/s)")
+      ->delimiter(',')
+      ->expected(3);
+  spawn->add_option("--angular-velocity,--spin", body.spin, "x,y,z (rad/s)")
       ->delimiter(',')
       ->expected(3);
   spawn->add_option("--color", body.colour, "drawing colour 0xRRGGBBAA (0: the viewer's choice)");
@@ -156,21 +174,50 @@ int main(int argc, char** argv) {
   std::string scene_file;
   spawn_scene->add_option("file", scene_file, "a scene (JSON, docs/SCENES.md)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(cli::existing_file);
 
   CLI::App* remove = app.add_subcommand("remove", "remove bodies by id");
   std::vector<std::uint64_t> ids;
-  remove->add_option("ids", ids, "body ids")->required();
+  remove->add_option("ids", ids, "body ids, by spaces or commas")->required()->delimiter(',');
 
   CLI::App* bodies = app.add_subcommand("bodies", "bodies' states as JSON lines");
-  bodies->add_option("ids", ids, "body ids (default: all)");
+  bodies->add_option("ids", ids, "body ids, by spaces or commas (default: all)")->delimiter(',');
+
+  CLI::App* set_state =
+      app.add_subcommand("set-state", "replace a body's position, orientation or velocities");
+  std::uint64_t body_id = 0;
+  std::vector<double> position, orientation, linear_velocity, angular_velocity;
+  set_state->add_option("id", body_id, "the body's id")->required();
+  set_state->add_option("--position,--pos", position, "x,y,z (m)")->delimiter(',')->expected(3);
+  set_state->add_option("--orientation", orientation, "a unit quaternion w,x,y,z")
+      ->delimiter(',')
+      ->expected(4);
+  set_state->add_option("--linear-velocity,--vel", linear_velocity, "x,y,z (m/s)")
+      ->delimiter(',')
+      ->expected(3);
+  set_state->add_option("--angular-velocity,--spin", angular_velocity, "x,y,z (rad/s)")
+      ->delimiter(',')
+      ->expected(3);
+
+  CLI::App* impulse = app.add_subcommand("impulse", "apply an impulse to a body (it wakes)");
+  std::vector<double> impulse_value, impulse_point;
+  impulse->add_option("id", body_id, "the body's id")->required();
+  impulse->add_option("--impulse", impulse_value, "x,y,z (N s, world frame)")
+      ->required()
+      ->delimiter(',')
+      ->expected(3);
+  impulse
+      ->add_option("--point", impulse_point,
+                   "x,y,z (m, world) where it acts (default: the centre of mass, no torque)")
+      ->delimiter(',')
+      ->expected(3);
 
   CLI::App* play = app.add_subcommand("play", "run continuously");
   CLI::App* pause = app.add_subcommand("pause", "stop after the current step");
   CLI::App* reset = app.add_subcommand("reset", "back to the scene as loaded");
   CLI::App* step = app.add_subcommand("step", "run N steps, pause, and return when they are done");
   std::uint32_t steps = 1;
-  step->add_option("n", steps, "steps")->check(CLI::PositiveNumber);
+  step->add_option("n", steps, "steps")->check(cli::positive);
 
   CLI::App* set = app.add_subcommand("set", "change run settings (only those given)");
   std::optional<double> dt, real_time_factor;
@@ -183,6 +230,10 @@ int main(int argc, char** argv) {
   set->add_option("--solver", solver, "exact, pgs, soft or auto")
       ->check(CLI::IsMember({"exact", "pgs", "soft", "auto"}));
   set->add_option("--gravity", gravity, "x,y,z (m/s^2)")->delimiter(',')->expected(3);
+  std::optional<bool> sleeping;
+  set->add_option("--sleeping", sleeping,
+                  "on or off: bodies at rest fall asleep and cost nothing until touched (off "
+                  "wakes every sleeper)");
 
   CLI::App* snapshot = app.add_subcommand("snapshot", "save the whole world to a file");
   CLI::App* restore = app.add_subcommand("restore", "replace the world with a saved one");
@@ -190,7 +241,7 @@ int main(int argc, char** argv) {
   snapshot->add_option("file", state_file, "where to write")->required();
   restore->add_option("file", state_file, "a file written by snapshot")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(cli::existing_file);
 
   CLI::App* stream = app.add_subcommand("stream", "frames to stdout, one per line (csv: per body)");
   StreamOptions stream_options;
@@ -205,23 +256,28 @@ int main(int argc, char** argv) {
   CLI::App* replay = app.add_subcommand("replay", "a recording to stdout, as stream prints it");
   replay->add_option("file", recording_file, "a file written by record")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(cli::existing_file);
   StreamOptions replay_options;
   bool paced = false;
   replay->add_option("--format", replay_options.format, "jsonl or csv")
       ->check(CLI::IsMember({"jsonl", "csv"}));
   replay->add_flag("--paced", paced, "at the recorded simulated-time pace, not at once");
-  CLI11_PARSE(app, argc, argv);
+  if (const int exit_status = cli::parse(app, argc, argv); exit_status >= 0) return exit_status;
 
   if (*replay) {  // needs no server
     Result<client::RecordingReader> reader = client::RecordingReader::open(recording_file);
     if (!reader) return fail("replay", reader.status());
-    if (replay_options.format == "csv") print_line(client::csv_header(true));
-    replay_options.velocities = true;
     v1::Frame frame;
     double first_time = -1;
     const auto start = std::chrono::steady_clock::now();
     while (reader.value().next(&frame)) {
+      // A recording holds velocities in every frame or in none: the first frame says which, and
+      // the CSV header follows it.
+      if (reader.value().frames() == 1) {
+        replay_options.velocities = frame.linear_velocities_size() > 0;
+        if (replay_options.format == "csv")
+          print_line(client::csv_header(replay_options.velocities));
+      }
       if (paced) {
         if (first_time < 0) first_time = frame.time();
         std::this_thread::sleep_until(
@@ -252,7 +308,9 @@ int main(int argc, char** argv) {
                               {"time", i.time()},
                               {"bodies", i.body_count()},
                               {"running", i.running()},
-                              {"subscribers", i.subscribers()}}
+                              {"subscribers", i.subscribers()},
+                              {"achieved_real_time_factor", i.achieved_real_time_factor()},
+                              {"behind", i.behind()}}
                    .dump());
   } else if (*health) {
     Result<bool> serving = client.healthy();
@@ -287,6 +345,26 @@ int main(int argc, char** argv) {
                                 {"asleep", s.asleep()}}
                      .dump());
     }
+  } else if (*set_state) {
+    v1::BodyStateUpdate update;
+    update.set_id(body_id);
+    if (!position.empty()) set_vec(position, update.mutable_position());
+    if (!orientation.empty()) {
+      v1::Quat* q = update.mutable_orientation();
+      q->set_w(orientation[0]);
+      q->set_x(orientation[1]);
+      q->set_y(orientation[2]);
+      q->set_z(orientation[3]);
+    }
+    if (!linear_velocity.empty()) set_vec(linear_velocity, update.mutable_linear_velocity());
+    if (!angular_velocity.empty()) set_vec(angular_velocity, update.mutable_angular_velocity());
+    if (Status s = client.set_states({update}); !s) return fail("set-state", s);
+  } else if (*impulse) {
+    v1::Impulse applied;
+    applied.set_id(body_id);
+    set_vec(impulse_value, applied.mutable_impulse());
+    if (!impulse_point.empty()) set_vec(impulse_point, applied.mutable_point());
+    if (Status s = client.apply_impulses({applied}); !s) return fail("impulse", s);
   } else if (*play || *pause || *reset || *step || *set) {
     v1::ControlRequest request;
     if (*play) request.set_play(true);
@@ -299,6 +377,7 @@ int main(int argc, char** argv) {
     if (substeps) settings->set_substeps(*substeps);
     if (!solver.empty()) settings->set_solver(*solver_kind(solver));
     if (!gravity.empty()) set_vec(gravity, settings->mutable_gravity());
+    if (sleeping) settings->set_sleeping(*sleeping);
     Result<v1::ControlResponse> done = client.control(request);
     if (!done) return fail("control", done.status());
     if (*step) {  // returns once the steps are done, so that the next command sees them
@@ -318,6 +397,8 @@ int main(int argc, char** argv) {
                        {"dt", now.dt()},
                        {"real_time_factor", now.real_time_factor()},
                        {"substeps", now.substeps()},
+                       {"solver", solver_name(now.solver())},
+                       {"sleeping", now.sleeping()},
                        {"gravity", {now.gravity().x(), now.gravity().y(), now.gravity().z()}}}
             .dump());
   } else if (*snapshot) {

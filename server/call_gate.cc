@@ -1,5 +1,7 @@
 #include "call_gate.h"
 
+#include "log.h"
+
 #include <malloc.h>
 
 #include <algorithm>
@@ -214,7 +216,11 @@ grpc::ServerGenericBidiReactor* CallGate::CreateReactor(
   if (name.empty() || (unary == unary_.end() && stream == streams_.end()))
     return new RefusedCall(
         grpc::Status(grpc::StatusCode::UNIMPLEMENTED, "no method " + method.substr(0, 200)));
-  if (grpc::Status denied = authorize_(*context); !denied.ok()) return new RefusedCall(denied);
+  if (grpc::Status denied = authorize_(*context); !denied.ok()) {
+    log(LogLevel::kDebug,
+        name + " from " + context->peer() + " refused: " + denied.error_message());
+    return new RefusedCall(denied);
+  }
   const MethodBounds bounds = bounds_.of(name);
   if (stream != streams_.end()) return stream->second(charged(*this, bounds.bytes), bounds.bytes);
   if (unary_in_flight_.fetch_add(1) >= kMaxUnaryInFlight) {

@@ -184,6 +184,7 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
   out->set_continuous_limit_hits(s.continuous_limit_hits);
   out->set_gyroscopic_limit_hits(s.gyroscopic_limit_hits);
   out->set_pair_limit_hits(s.pair_limit_hits);
+  out->set_resting_contact_points(s.resting_contact_points);
   out->set_broad_phase_seconds(s.time.broad_phase);
   out->set_narrow_phase_seconds(s.time.narrow_phase);
   out->set_prepare_seconds(s.time.prepare);
@@ -197,6 +198,7 @@ WorldSettings RunChange::applied_to(WorldSettings settings) const {
   if (gravity) settings.gravity = *gravity;
   if (substeps) settings.solver.substeps = *substeps;
   if (solver) settings.solver.kind = *solver;
+  if (sleeping) settings.solver.sleeping = *sleeping;
   return settings;
 }
 
@@ -217,6 +219,7 @@ Result<RunChange> run_change_from_proto(const v1::RunSettings& settings, double 
     change.gravity = vec(settings.gravity());
   }
   if (settings.has_substeps()) change.substeps = settings.substeps();
+  if (settings.has_sleeping()) change.sleeping = settings.sleeping();
   switch (settings.solver()) {
     case v1::SOLVER_KIND_UNSPECIFIED:
       break;
@@ -243,6 +246,7 @@ void run_settings_to_proto(double dt, double real_time_factor, const WorldSettin
   out->set_dt(dt);
   out->set_real_time_factor(real_time_factor);
   out->set_substeps(world.solver.substeps);
+  out->set_sleeping(world.solver.sleeping);
   out->set_solver(static_cast<v1::SolverKind>(static_cast<int>(world.solver.kind) + 1));
   set(world.gravity, out->mutable_gravity());
 }

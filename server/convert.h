@@ -32,6 +32,7 @@ struct RunChange {
   std::optional<Vec3> gravity;
   std::optional<int> substeps;
   std::optional<SolverKind> solver;
+  std::optional<bool> sleeping;
   // `settings` with this change's world settings applied.
   WorldSettings applied_to(WorldSettings settings) const;
 };

@@ -67,21 +67,27 @@ std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted,
     append(body.linear_velocity(), frame->linear_velocities);
     append(body.angular_velocity(), frame->angular_velocities);
   }
-  const auto impulses = world.contact_impulses();
-  std::size_t row = 0;
-  for (const Contact& contact : world.contacts()) {
-    for (int i = 0; i < contact.manifold.count; ++i, ++row) {
-      const ContactPoint& point = contact.manifold.points[i];
-      frame->contact_a.push_back(hosted.ids.wire(contact.a));
-      frame->contact_b.push_back(hosted.ids.wire(contact.b));
-      frame->contact_points.insert(frame->contact_points.end(), point.point_b.data(),
-                                   point.point_b.data() + 3);
-      frame->contact_normals.insert(frame->contact_normals.end(), contact.manifold.normal.data(),
-                                    contact.manifold.normal.data() + 3);
-      frame->contact_depths.push_back(point.depth);
-      frame->contact_impulses.push_back(row < impulses.size() ? impulses[row] : 0.0);
+  // The step's contacts, then those of sleeping islands: they still carry their weight, as the
+  // impulse of a step of dt.
+  auto add_contacts = [&](std::span<const Contact> contacts, std::span<const double> impulses,
+                          double scale) {
+    std::size_t row = 0;
+    for (const Contact& contact : contacts) {
+      for (int i = 0; i < contact.manifold.count; ++i, ++row) {
+        const ContactPoint& point = contact.manifold.points[i];
+        frame->contact_a.push_back(hosted.ids.wire(contact.a));
+        frame->contact_b.push_back(hosted.ids.wire(contact.b));
+        frame->contact_points.insert(frame->contact_points.end(), point.point_b.data(),
+                                     point.point_b.data() + 3);
+        frame->contact_normals.insert(frame->contact_normals.end(), contact.manifold.normal.data(),
+                                      contact.manifold.normal.data() + 3);
+        frame->contact_depths.push_back(point.depth);
+        frame->contact_impulses.push_back(row < impulses.size() ? scale * impulses[row] : 0.0);
+      }
     }
-  }
+  };
+  add_contacts(world.contacts(), world.contact_impulses(), 1.0);
+  add_contacts(world.resting_contacts(), world.resting_contact_forces(), hosted.dt);
   return frame;
 }
 

@@ -6,7 +6,6 @@
 
 #include <pthread.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
@@ -16,12 +15,15 @@
 #include <string>
 #include <vector>
 
+#include "bind_failure.h"
+#include "log.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
 #include "service.h"
 #ifdef TUMBLE_WITH_DDS
 #include "dds_publisher.h"
 #endif
+#include "tumble/command_line.h"
 
 namespace {
 
@@ -72,6 +74,7 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
   CLI::App app{"Tumble's simulation server: steps a world and serves it over gRPC."};
+  cli::keep_conventions(app, "tumble-server");
   std::string listen = "127.0.0.1:50051", scene_name, scene_file;
   int threads = 0;
   double real_time_factor = 1;
@@ -83,6 +86,7 @@ int main(int argc, char** argv) {
   bool dds = false;
   std::uint32_t dds_domain = 0;
   double dds_rate = 0;
+  std::string log_level = "info";
   app.add_option("--listen", listen, "address to listen on (loopback by default)")
       ->envname("TUMBLE_LISTEN");
   app.add_option("--scene", scene_file, "a scene file (JSON, docs/SCENES.md)")
@@ -91,11 +95,11 @@ int main(int argc, char** argv) {
       ->envname("TUMBLE_STANDARD");
   app.add_option("--threads", threads, "OpenMP threads for the step (0: all)")
       ->envname("TUMBLE_THREADS")
-      ->check(CLI::NonNegativeNumber);
+      ->check(cli::non_negative);
   app.add_option("--real-time-factor", real_time_factor,
                  "1: simulated time at wall-clock pace; 0: as fast as possible")
       ->envname("TUMBLE_REAL_TIME_FACTOR")
-      ->check(CLI::NonNegativeNumber);
+      ->check(cli::non_negative);
   app.add_option("--max-bodies", max_bodies, "refuse spawns beyond this many bodies")
       ->envname("TUMBLE_MAX_BODIES");
   app.add_flag("--paused", paused, "start paused (Control play starts it)");
@@ -123,8 +127,14 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 232));
   app.add_option("--dds-rate", dds_rate, "DDS samples per second at most (0: every step)")
       ->envname("TUMBLE_DDS_RATE")
-      ->check(CLI::NonNegativeNumber);
-  CLI11_PARSE(app, argc, argv);
+      ->check(cli::non_negative);
+  app.add_option("--log-level", log_level,
+                 "error, warn, info or debug: what the log on stderr holds (debug: every refused "
+                 "request)")
+      ->envname("TUMBLE_LOG_LEVEL")
+      ->check(CLI::IsMember({"error", "warn", "info", "debug"}));
+  if (const int exit_status = cli::parse(app, argc, argv); exit_status >= 0) return exit_status;
+  server::set_log_level(*server::log_level_from_name(log_level));
   if (tls_cert.empty() != tls_key.empty()) {
     std::fprintf(stderr, "tumble-server: --tls-cert and --tls-key go together\n");
     return 2;
@@ -196,14 +206,20 @@ int main(int argc, char** argv) {
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
+  // Without this gRPC sets SO_REUSEPORT, and a second server on a taken port starts, says it
+  // listens, and shares the port's connections with the first.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   int port = 0;
   builder.AddListeningPort(listen, credentials, &port);
   service.register_on(builder);
   std::unique_ptr<grpc::Server> grpc_server = builder.BuildAndStart();
   if (grpc_server == nullptr || port == 0) {
-    std::fprintf(stderr, "tumble-server: --listen: cannot listen on %s\n", listen.c_str());
+    std::fprintf(stderr, "tumble-server: --listen: cannot listen on %s: %s\n", listen.c_str(),
+                 server::explain_bind_failure(listen).c_str());
     return 1;
   }
+  // Health by the service's name, as well as the server's (""), for probes that ask for it.
+  grpc_server->GetHealthCheckService()->SetServingStatus(v1::World::service_full_name(), true);
   // With port 0 the system picks one: print the one in use, for scripts and tests to read.
   const std::string bound = listen.substr(0, listen.rfind(':')) + ":" + std::to_string(port);
   std::printf("tumble-server: scene %s, %zu bodies, listening on %s%s\n",
@@ -211,6 +227,11 @@ int main(int argc, char** argv) {
               tls_cert.empty() ? "" : " (TLS)");
   if (dds) std::printf("tumble-server: publishing on DDS domain %u\n", dds_domain);
   std::fflush(stdout);
+  server::log(server::LogLevel::kInfo,
+              "serving scene " + scene.value().name + " (" + std::to_string(host.status().bodies) +
+                  " bodies) on " + bound +
+                  (token.empty() ? ", no token required" : ", token required") +
+                  (paused ? ", paused" : ""));
   if (!paused) host.play();
 
   int signal = 0;
@@ -221,5 +242,8 @@ int main(int argc, char** argv) {
   host.pause();
   std::printf("tumble-server: stopped at step %llu\n",
               static_cast<unsigned long long>(host.status().step));
+  server::log(server::LogLevel::kInfo, std::string("stopped by ") +
+                                           (signal == SIGINT ? "SIGINT" : "SIGTERM") + " at step " +
+                                           std::to_string(host.status().step));
   return 0;
 }

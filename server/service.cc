@@ -1,5 +1,7 @@
 #include "service.h"
 
+#include "log.h"
+
 #include <algorithm>
 #include <chrono>
 #include <unordered_set>
@@ -84,6 +86,10 @@ CallGate::Unary WorldService::unary(grpc::Status (WorldService::*serve)(const Re
             Response response;
             grpc::Status status = (this->*serve)(request, &response);
             if (status.ok()) response.SerializeToString(out);
+            if (!status.ok() && logs(LogLevel::kDebug))
+              log(LogLevel::kDebug, Request::descriptor()->name() + " refused (code " +
+                                        std::to_string(status.error_code()) +
+                                        "): " + status.error_message());
             return status;
           }};
 }
@@ -430,6 +436,9 @@ grpc::Status WorldService::get_info(const v1::GetInfoRequest&, v1::GetInfoRespon
                         response->mutable_settings());
   stats_to_proto(status.last_step, response->mutable_last_step());
   response->set_subscribers(static_cast<std::uint32_t>(status.subscribers));
+  response->set_achieved_real_time_factor(status.achieved_real_time_factor);
+  response->set_behind(status.behind);
+  response->set_times_behind(status.times_behind);
   return grpc::Status::OK;
 }
 

@@ -1,7 +1,10 @@
 #include "world_host.h"
 
+#include "log.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 namespace tumble::server {
@@ -73,6 +76,7 @@ void WorldHost::pause() {
   std::lock_guard lock(mutex_);
   running_ = false;
   steps_left_ = 0;
+  status_.behind = false;  // nothing is due while paused
 }
 
 void WorldHost::step(std::uint64_t steps) {
@@ -185,12 +189,16 @@ void WorldHost::run() {
   Clock::time_point epoch = Clock::now();
   double paced_time = 0;
   bool was_stepping = false;
+  // The window over which the achieved real-time factor is measured.
+  Clock::time_point window_start = epoch;
+  double window_time = 0;
   while (true) {
     apply_pending();
     if (stopping_) return;
     const bool stepping = running_ || steps_left_ > 0;
     if (!stepping) {
       was_stepping = false;
+      status_.behind = false;
       idle_.notify_all();
       wake_.wait(lock, [&] { return stopping_ || !commands_.empty() || running_ || steps_left_; });
       continue;
@@ -199,14 +207,37 @@ void WorldHost::run() {
       epoch = Clock::now();
       paced_time = 0;
       was_stepping = true;
+      window_start = epoch;
+      window_time = status_.time;
     }
     if (running_ && real_time_factor_ > 0) {
       const auto due = epoch + std::chrono::duration_cast<Clock::duration>(
                                    std::chrono::duration<double>(paced_time / real_time_factor_));
-      if (Clock::now() < due) {
+      const Clock::time_point now = Clock::now();
+      if (now < due) {
+        if (status_.behind) {
+          status_.behind = false;
+          log(LogLevel::kInfo, "the world keeps its real-time factor again");
+        }
         // Commands and control still get through while waiting.
         wake_.wait_until(lock, due, [&] { return stopping_ || !commands_.empty() || !running_; });
         continue;
+      }
+      if (std::chrono::duration<double>(now - due).count() > kBehindSeconds) {
+        if (!status_.behind) {
+          status_.behind = true;
+          ++status_.times_behind;
+          char message[256];
+          std::snprintf(message, sizeof message,
+                        "the world fell behind its real-time factor %g: the last step took "
+                        "%.3g ms, one is due every %.3g ms (fewer bodies, a larger dt or a lower "
+                        "factor would help)",
+                        real_time_factor_, 1e3 * status_.last_step.time.total,
+                        1e3 * hosted_.dt / real_time_factor_);
+          log(LogLevel::kWarn, message);
+        }
+        epoch = now;  // the debt is forgiven: running flat out to pay it would only lag more
+        paced_time = 0;
       }
     }
     const double dt = hosted_.dt;
@@ -221,6 +252,14 @@ void WorldHost::run() {
     status_.step = hosted_.world.step_count();
     status_.time = hosted_.world.time();
     status_.last_step = hosted_.world.last_step();
+    const Clock::time_point now = Clock::now();
+    if (const double wall = std::chrono::duration<double>(now - window_start).count(); wall >= 1) {
+      // (A world replaced meanwhile may have gone back in time: that window says nothing.)
+      if (status_.time >= window_time)
+        status_.achieved_real_time_factor = (status_.time - window_time) / wall;
+      window_start = now;
+      window_time = status_.time;
+    }
     if (frame != nullptr) publish(std::move(frame));
   }
 }

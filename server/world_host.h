@@ -37,7 +37,17 @@ struct HostStatus {
   // The world's settings as the last command left them (only commands change them), so that
   // reading them never waits for a step in progress.
   WorldSettings settings;
+  // Simulated seconds per wall-clock second over the last second of running (0 before it).
+  double achieved_real_time_factor = 0;
+  // Paced and unable to keep up: the steps are late by more than kBehindSeconds. Set until the
+  // world is on time again; counted once per such episode.
+  bool behind = false;
+  std::uint64_t times_behind = 0;
 };
+
+// How late the paced steps may run before the world counts as behind; past it, the debt is
+// forgiven (the pace restarts from now) rather than paid by running flat out.
+inline constexpr double kBehindSeconds = 0.25;
 
 // Simulated seconds per wall-clock second when paced; 0 runs flat out.
 inline constexpr double kMinRealTimeFactor = 1e-3, kMaxRealTimeFactor = 1e3;

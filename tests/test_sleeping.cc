@@ -29,6 +29,59 @@ TEST(Sleeping, SettledStackSleepsAndCostsNothing) {
   EXPECT_EQ(stats.islands, 0u);
 }
 
+// Asleep, a stack still rests on the floor: its contacts are reported (not solved), and each
+// box's contacts carry the weight above it. They go when the stack wakes, and return when it
+// sleeps again.
+TEST(Sleeping, SleepersReportTheContactsThatCarryTheirWeight) {
+  World world = build(tower_scene(5));
+  run(world, 1.0 / 60, 300);
+  ASSERT_TRUE(all_asleep(world));
+  EXPECT_EQ(world.contacts().size(), 0u);  // nothing solved
+  const auto resting = world.resting_contacts();
+  const auto forces = world.resting_contact_forces();
+  ASSERT_EQ(resting.size(), 5u);  // floor-box and four box-box faces
+  std::size_t points = 0;
+  for (const Contact& c : resting)
+    points += static_cast<std::size_t>(c.manifold.count);
+  EXPECT_EQ(forces.size(), points);
+  EXPECT_EQ(world.last_step().resting_contact_points, points);
+  // The floor carries all five boxes: the forces of the contacts with the static ground sum to
+  // the stack's weight.
+  double on_floor = 0, weight = 0;
+  std::size_t point = 0;
+  for (const Contact& c : resting)
+    for (int i = 0; i < c.manifold.count; ++i, ++point)
+      if (world.body(c.a)->is_static() || world.body(c.b)->is_static()) on_floor += forces[point];
+  for (const BodyView b : dynamic_bodies(world))
+    weight += b->mass() * world.settings().gravity.norm();
+  EXPECT_NEAR(on_floor, weight, 1e-3 * weight);
+
+  // Woken: the stored contacts go; the step solves its own again.
+  ASSERT_TRUE(world.wake(world.id_at(3)).is_ok());
+  EXPECT_EQ(world.resting_contacts().size(), 0u);
+  ASSERT_TRUE(world.step(1.0 / 60).is_ok());
+  EXPECT_EQ(world.last_step().resting_contact_points, 0u);
+  EXPECT_GT(world.last_step().contact_points, 0u);
+  run(world, 1.0 / 60, 120);
+  ASSERT_TRUE(all_asleep(world));
+  EXPECT_EQ(world.resting_contacts().size(), 5u);
+}
+
+// Switching sleeping off wakes every sleeper at once (else only a touch would).
+TEST(Sleeping, SwitchedOffWhileAsleepWakesEverySleeper) {
+  World world = build(pile_scene(27));
+  run(world, 1.0 / 60, 600);
+  ASSERT_GT(world.last_step().sleeping_bodies, 0u);
+  WorldSettings settings = world.settings();
+  settings.solver.sleeping = false;
+  ASSERT_TRUE(world.set_settings(settings).is_ok());
+  for (const BodyView b : dynamic_bodies(world))
+    EXPECT_FALSE(b->asleep());
+  EXPECT_EQ(world.resting_contacts().size(), 0u);
+  ASSERT_TRUE(world.step(1.0 / 60).is_ok());
+  EXPECT_EQ(world.last_step().sleeping_bodies, 0u);
+}
+
 // A pile of 250 falls, tumbles and settles; once every box is slower than the sleep speeds
 // (0.05 m/s and rad/s) the whole pile is asleep within a second (the delay is 0.5 s).
 TEST(Sleeping, SettledPileFallsAsleepSoonAfterSettling) {

@@ -103,6 +103,32 @@ TEST(MassRatio, HeavyOnLightHoldsWithTheExactSolver) {
   }
 }
 
+// `auto` pays for Lemke only where the soft answer would differ (auto_solver.h): the heavy box on
+// light ones goes to the exact solver and holds as it does there; a pile of like boxes never does.
+TEST(AutoSolver, ExactWhereSoftWouldDifferOnly) {
+  SceneDef stack = awake(mass_ratio_scene(false));
+  stack.world.solver.kind = SolverKind::kAuto;
+  World world = build(stack);
+  const std::vector<Vec3> start = positions(world);
+  std::uint64_t pivots = 0;
+  run(world, 1.0 / 60, 600, [&](long) { pivots += world.last_step().lemke_pivots; });
+  EXPECT_GT(pivots, 600u);  // the stack is Lemke's, every step
+  const std::vector<Vec3> end = positions(world);
+  for (std::size_t i = 0; i < end.size(); ++i)
+    EXPECT_LT((end[i] - start[i]).norm(), 2e-3);
+
+  SceneDef pile = pile_scene(64);
+  pile.world.solver.kind = SolverKind::kAuto;
+  World piled = build(pile);
+  std::uint64_t pile_pivots = 0, contact_points = 0;
+  run(piled, 1.0 / 60, 180, [&](long) {
+    pile_pivots += piled.last_step().lemke_pivots;
+    contact_points += piled.last_step().contact_points;
+  });
+  EXPECT_GT(contact_points, 0u);
+  EXPECT_EQ(pile_pivots, 0u);  // (bodies touching nothing count as exact islands: no pivots)
+}
+
 // S1: 1000 tilted boxes dropped in a lattice settle within 10 s; nothing escapes or turns NaN.
 TEST(Pile, ThousandBoxesSettle) {
   World world = build(awake(pile_scene(1000)));

@@ -164,6 +164,32 @@ TEST(WorldHost, RealTimePacing) {
   EXPECT_FALSE(host.set_dt(0));
 }
 
+// A world that cannot keep its real-time factor says so: a step of 1/60 s is due every 17 us at
+// a factor of 1000, and 200 boxes take longer than that. Once late by a quarter second it counts
+// as behind, and is measured running slower than asked. A world that keeps up is never behind.
+TEST(WorldHost, SaysWhenItFallsBehindItsRealTimeFactor) {
+  WorldHost late(pile_world(200), 1.0 / 60, kMaxRealTimeFactor);
+  late.play();
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (late.status().times_behind == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(10ms);
+  std::this_thread::sleep_for(1100ms);  // a whole window of the achieved factor
+  const HostStatus status = late.status();
+  late.pause();
+  EXPECT_TRUE(status.behind);
+  EXPECT_EQ(status.times_behind, 1u);  // one episode, however long
+  EXPECT_GT(status.achieved_real_time_factor, 0.0);
+  EXPECT_LT(status.achieved_real_time_factor, kMaxRealTimeFactor);
+  EXPECT_FALSE(late.status().behind);  // paused: nothing is due
+
+  WorldHost on_time(pile_world(8), 1.0 / 60, 1.0);
+  on_time.play();
+  std::this_thread::sleep_for(1200ms);
+  EXPECT_FALSE(on_time.status().behind);
+  EXPECT_EQ(on_time.status().times_behind, 0u);
+  EXPECT_NEAR(on_time.status().achieved_real_time_factor, 1.0, 0.2);
+}
+
 // The host's own concurrency without gRPC in the way (so that ThreadSanitizer sees every
 // synchronisation): 16 threads apply spawn and remove batches, 4 read frames, 2 inspect and
 // change settings, all while the world runs; every batch appears whole or not at all.

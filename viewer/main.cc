@@ -3,7 +3,6 @@
 // so, and reconnects.
 //   tumble-viewer --server 127.0.0.1:50051
 //   tumble-viewer --server 127.0.0.1:50051 --offscreen --out frames --frames 120 --every 2
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,6 +12,7 @@
 
 #include "client.h"
 #include "offscreen.h"
+#include "tumble/command_line.h"
 #include "window.h"
 #include "world_view.h"
 
@@ -20,6 +20,7 @@ using namespace tumble;
 
 int main(int argc, char** argv) {
   CLI::App app{"tumble-viewer: draws a running tumble-server's world."};
+  cli::keep_conventions(app, "tumble-viewer");
   client::Connection connection;
   std::string out_dir = "frames", size = "1280x720";
   std::uint32_t frames = 60, every = 1;
@@ -38,20 +39,20 @@ int main(int argc, char** argv) {
       "--screenshot", screenshot,
       "window: save the picture after --frames pictures of the world into this PNG and close");
   app.add_option("--out", out_dir, "folder for the PNG frames");
-  app.add_option("--frames", frames, "how many pictures to write")->check(CLI::PositiveNumber);
-  app.add_option("--every", every, "draw every Nth frame received")->check(CLI::PositiveNumber);
+  app.add_option("--frames", frames, "how many pictures to write")->check(cli::positive);
+  app.add_option("--every", every, "draw every Nth frame received")->check(cli::positive);
   double fps = 0;
   std::string video;
   app.add_option("--fps", fps,
                  "pictures per simulated second (instead of --every), and the video's frame rate")
-      ->check(CLI::NonNegativeNumber);
+      ->check(cli::non_negative);
   app.add_option("--video", video, "also encode the pictures into this video (needs ffmpeg)");
   app.add_option("--size", size, "WIDTHxHEIGHT");
   app.add_option("--eye", eye, "camera position x,y,z (m)")->delimiter(',')->expected(3);
   app.add_option("--target", target, "point looked at x,y,z (m)")->delimiter(',')->expected(3);
   app.add_option("--give-up-after", give_up_after,
                  "seconds without a server before stopping (it reconnects meanwhile)");
-  CLI11_PARSE(app, argc, argv);
+  if (const int exit_status = cli::parse(app, argc, argv); exit_status >= 0) return exit_status;
 
   int width = 0, height = 0;
   if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0) {

@@ -9,6 +9,7 @@
 #include <limits>
 #include <optional>
 
+#include "auto_solver.h"
 #include "exact_solver.h"
 #include "integrate.h"
 #include "parallel.h"
@@ -663,6 +664,12 @@ void World::prepare_contacts(double dt) {
     s.island_row_begin.push_back(static_cast<std::uint32_t>(s.island_rows.size()));
     const std::uint32_t points = s.island_row_begin[i + 1] - s.island_row_begin[i];
     IslandSolver kind = IslandSolver::kSoft;
+    const auto island_bodies = std::span(s.islands.bodies)
+                                   .subspan(s.islands.body_begin[i],
+                                            s.islands.body_begin[i + 1] - s.islands.body_begin[i]);
+    const auto island_links = std::span(s.islands.links)
+                                  .subspan(s.islands.link_begin[i],
+                                           s.islands.link_begin[i + 1] - s.islands.link_begin[i]);
     switch (solver.kind) {
       case SolverKind::kExact:
         // A dense LCP of 10 unknowns a point: past the bound, memory and pivots would grow
@@ -683,22 +690,22 @@ void World::prepare_contacts(double dt) {
       case SolverKind::kAuto: {
         // One body against statics gains nothing from solving its contacts together with
         // others' (there are none), and the soft step resolves it at a fraction of a Lemke
-        // solve's cost (8-direction pyramids make 10 unknowns per point). A body touching
-        // nothing takes the plain step of dt.
-        const bool alone = s.islands.body_begin[i + 1] - s.islands.body_begin[i] == 1;
+        // solve's cost (8-direction pyramids make 10 unknowns per point). Of the small islands
+        // of several bodies, only those where the soft answer would differ pay for Lemke
+        // (auto_solver.h): in a pile of like bodies, none. A body touching nothing takes the
+        // plain step of dt.
+        const bool alone = island_bodies.size() == 1;
         const bool small = points <= static_cast<std::uint32_t>(std::min(
                                          solver.exact_max_points, solver.exact_max_island_points));
-        kind = points == 0 || (!alone && small) ? IslandSolver::kExact : IslandSolver::kSoft;
+        const bool exact =
+            points == 0 || (!alone && small &&
+                            soft_would_differ(island_bodies, island_links, s.links, s.body_of,
+                                              s.dynamic, settings_.gravity.norm(), solver));
+        kind = exact ? IslandSolver::kExact : IslandSolver::kSoft;
         break;
       }
     }
     s.reports[i].solver = kind;
-    const auto island_bodies = std::span(s.islands.bodies)
-                                   .subspan(s.islands.body_begin[i],
-                                            s.islands.body_begin[i + 1] - s.islands.body_begin[i]);
-    const auto island_links = std::span(s.islands.links)
-                                  .subspan(s.islands.link_begin[i],
-                                           s.islands.link_begin[i + 1] - s.islands.link_begin[i]);
     if (kind == IslandSolver::kSoft) {
       const IslandStiffness stiffness =
           island_stiffness(island_bodies, island_links, s.links, s.touching, s.dynamic, s.body_of,
@@ -948,6 +955,15 @@ std::uint32_t World::wake_touched() {
 void World::update_sleep(double dt) {
   StepScratch& s = *scratch_;
   const SolverSettings& solver = settings_.solver;
+  drop_woken_contacts();  // before islands fall asleep, perhaps under the ids of woken ones
+  // Room for every contact of this step to come to rest, reserved ahead (doubling): a resting
+  // scene moves its manifolds from contacts_ to here, and the step allocates nothing for it.
+  const auto reserve = [](auto& store, std::size_t room) {
+    if (store.capacity() < room) store.reserve(std::max(room, 2 * store.capacity()));
+  };
+  reserve(resting_contacts_, resting_contacts_.size() + contacts_.size());
+  reserve(resting_island_, resting_island_.size() + contacts_.size());
+  reserve(resting_forces_, resting_forces_.size() + impulses_.size());
   bool fell_asleep = false;
   for (std::size_t i = 0; i < s.islands.count(); ++i) {
     double shortest = std::numeric_limits<double>::infinity();
@@ -961,6 +977,7 @@ void World::update_sleep(double dt) {
     if (!solver.sleeping || shortest < solver.sleep_delay) continue;
     // Named by its lowest slot (solver indices keep the slots' order).
     const std::uint32_t island = s.solver_slot[s.islands.bodies[s.islands.body_begin[i]]];
+    keep_resting_contacts(island, static_cast<std::uint32_t>(i), dt);
     for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
       const std::uint32_t slot = s.solver_slot[s.islands.bodies[k]];
       Body& body = bodies_[slot].body;
@@ -978,6 +995,7 @@ void World::update_sleep(double dt) {
     awake_stale_ = true;  // the sleepers leave the moving set
   }
   stats_.sleeping_bodies = static_cast<std::uint32_t>(sleeping_count_);
+  stats_.resting_contact_points = static_cast<std::uint32_t>(resting_forces_.size());
 }
 
 void World::finish_step(double dt) {

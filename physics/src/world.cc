@@ -119,7 +119,14 @@ Status World::set_settings(const WorldSettings& settings) {
     if (bodies_[i].alive)
       if (Status s = check_limits(bodies_[i].body, settings.limits); !s)
         return s.within("limits: the body in slot " + std::to_string(i) + " is beyond them: ");
+  const bool sleeping_ends = settings_.solver.sleeping && !settings.solver.sleeping;
   settings_ = settings;
+  // Without sleeping, nothing would wake the sleepers but a touch: they wake now.
+  if (sleeping_ends) {
+    for (std::uint32_t island = 0; island < sleeper_head_.size(); ++island)
+      if (sleeper_head_[island] != kNoSlot) wake_island(island);
+    drop_woken_contacts();
+  }
   return Status::ok();
 }
 
@@ -195,6 +202,7 @@ Status World::remove_body(BodyId id) {
   slot.body = Body();
   free_slots_.push_back(id.index);
   --live_count_;
+  drop_woken_contacts();
   return Status::ok();
 }
 
@@ -268,6 +276,7 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
   else if (body.asleep)
     wake_island(body.sleep_island);
   body.sleep_timer = 0;
+  drop_woken_contacts();
   return Status::ok();
 }
 
@@ -290,6 +299,7 @@ Status World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point) {
   body.sleep_timer = 0;
   std::tie(body.linear_velocity, body.angular_velocity) =
       velocities_after_impulse(body, impulse, point);
+  drop_woken_contacts();
   return Status::ok();
 }
 
@@ -324,6 +334,7 @@ Status World::apply_impulses(std::span<const ImpulseAt> impulses) {
     body.sleep_timer = 0;
     std::tie(body.linear_velocity, body.angular_velocity) = velocities;
   }
+  drop_woken_contacts();
   return Status::ok();
 }
 
@@ -344,7 +355,39 @@ std::uint32_t World::wake_island(std::uint32_t island) {
     next = sleeper_next_[slot];
     sleeper_next_[slot] = kNoSlot;
   }
+  resting_woken_ = resting_woken_ || woken > 0;
   return woken;
+}
+
+void World::keep_resting_contacts(std::uint32_t island, std::uint32_t island_index, double dt) {
+  const StepScratch& s = *scratch_;
+  for (std::uint32_t k = s.islands.link_begin[island_index];
+       k < s.islands.link_begin[island_index + 1]; ++k) {
+    const std::uint32_t m = s.islands.links[k];
+    resting_contacts_.push_back(contacts_[m]);
+    resting_island_.push_back(island);
+    for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r)
+      resting_forces_.push_back(impulses_[r] / dt);
+  }
+}
+
+void World::drop_woken_contacts() {
+  if (!resting_woken_) return;
+  resting_woken_ = false;
+  std::size_t kept = 0, kept_points = 0, point = 0;
+  for (std::size_t m = 0; m < resting_contacts_.size(); ++m) {
+    const int count = resting_contacts_[m].manifold.count;
+    if (sleeper_head_[resting_island_[m]] != kNoSlot) {  // still asleep
+      resting_contacts_[kept] = resting_contacts_[m];
+      resting_island_[kept++] = resting_island_[m];
+      for (int i = 0; i < count; ++i)
+        resting_forces_[kept_points++] = resting_forces_[point + i];
+    }
+    point += static_cast<std::size_t>(count);
+  }
+  resting_contacts_.resize(kept);
+  resting_island_.resize(kept);
+  resting_forces_.resize(kept_points);
 }
 
 void World::resting_changed(std::uint32_t slot) {
@@ -402,6 +445,7 @@ Status World::wake(BodyId id) {
   if (!contains(id)) return Status::not_found("body: no body with this id");
   const Body& body = bodies_[id.index].body;
   if (body.asleep) wake_island(body.sleep_island);
+  drop_woken_contacts();
   return Status::ok();
 }
 

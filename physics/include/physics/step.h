@@ -11,8 +11,9 @@ enum class SolverKind : std::uint8_t {
   kExact,  // one linear complementarity problem per island, solved by Lemke's algorithm
   kPgs,    // projected Gauss-Seidel (sequential impulses), warm-started, one velocity solve
   kSoft,   // substeps with soft contacts: solve with bias, integrate, relax without bias
-  kAuto,   // exact for islands of several bodies with up to `exact_max_points` contact points;
-           // soft for larger ones and for a single body touching only statics
+  kAuto,   // exact for islands of several bodies with up to `exact_max_points` contact points
+           // where soft would answer otherwise (a mass ratio above 4, a body smaller than 100
+           // soft sags); soft for the rest
 };
 std::string_view solver_name(SolverKind kind);
 std::optional<SolverKind> solver_from_name(std::string_view name);
@@ -30,7 +31,7 @@ struct SolverSettings {
   // Position iterations after the velocity solve (pgs, and exact islands that fell back to it):
   // nonlinear Gauss-Seidel that moves bodies out of penetration without adding velocity.
   int position_iterations = 3;
-  // auto: an island with at most this many contact points goes to the exact solver.
+  // auto: an island with at most this many contact points may go to the exact solver.
   int exact_max_points = 12;
   // Directions of the friction pyramid in the exact solver (its facets); 4 to 32. The first one
   // follows the sliding direction, so a sliding body feels the full Coulomb force.
@@ -111,6 +112,9 @@ struct StepStats {
   // |min(impulse / effective mass, normal velocity - target)|; 0 when exactly solved.
   double residual = 0;
   std::uint32_t sleeping_bodies = 0, woken_bodies = 0;
+  // Contact points of sleeping islands (World::resting_contacts): they still carry the weight,
+  // but the step did not solve them.
+  std::uint32_t resting_contact_points = 0;
   // Bodies the step solved: the moving ones and the others their contacts touch (statics).
   // Sleepers and untouched statics cost the solver nothing, however many the world holds.
   std::uint32_t solver_bodies = 0;

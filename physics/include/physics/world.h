@@ -133,6 +133,13 @@ class World {
   std::span<const double> contact_impulses() const { return impulses_; }
   // The manifolds of the last step (or of the last find_contacts()).
   std::span<const Contact> contacts() const { return contacts_; }
+  // The manifolds of the islands now asleep, as the step before they fell asleep left them: a
+  // box asleep on the floor still rests on it. With the normal force (N) each point carried
+  // then, in the order of the manifolds and their points; times a step's dt, the impulse it
+  // would carry in that step. Dropped when the island wakes. Not part of save_state(): a world
+  // made by from_state() lists its sleepers' contacts again once they wake and settle.
+  std::span<const Contact> resting_contacts() const { return resting_contacts_; }
+  std::span<const double> resting_contact_forces() const { return resting_forces_; }
 
   // Broad phase: pairs of bodies whose world bounds (grown by the contact margin) overlap, at
   // least one of them dynamic, sorted, unique.
@@ -194,6 +201,15 @@ class World {
   // only grow, so any consumer that saw resting_logged_from_ or later finds every change since in
   // the log. Past its bound (or before the first broad phase) the log is dropped and every
   // resting body is redone.
+  // resting_contacts(): per manifold, the island (its sleep_island) it belongs to. Waking an
+  // island only marks the store (resting_woken_); the manifolds go in drop_woken_contacts(),
+  // once per step or call, however many islands woke.
+  std::vector<Contact> resting_contacts_;
+  std::vector<double> resting_forces_;
+  std::vector<std::uint32_t> resting_island_;
+  bool resting_woken_ = false;
+  void keep_resting_contacts(std::uint32_t island, std::uint32_t island_index, double dt);
+  void drop_woken_contacts();
   std::vector<std::uint32_t> resting_log_;
   std::uint64_t resting_logged_from_ = 0;
   bool resting_log_dropped_ = true;

@@ -1,0 +1,179 @@
+// Our programs keep their ecosystem's conventions on the command line, and the CLI has the
+// commands a user reaches for: --version, exit status 2 for a usage error, defaults in --help,
+// errors that name the environment variable or the file at fault; a second server on a taken
+// port fails; health answers by service name; impulses, state changes and sleeping from the CLI;
+// a recording without velocities replays as CSV with a header that matches its rows.
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "process_support.h"
+
+namespace {
+
+using namespace tumble::testing;
+
+std::vector<std::string> programs() {
+  std::vector<std::string> all = {TUMBLE_SERVER_BINARY, TUMBLE_CLI_BINARY, TUMBLE_RUN_BINARY};
+#ifdef TUMBLE_VIEWER_BINARY
+  all.push_back(TUMBLE_VIEWER_BINARY);
+#endif
+#ifdef TUMBLE_DDS_ECHO_BINARY
+  all.push_back(TUMBLE_DDS_ECHO_BINARY);
+#endif
+  return all;
+}
+
+std::string cli(const Server& server) {
+  return std::string(TUMBLE_CLI_BINARY) + " --server " + server.address + " ";
+}
+
+TEST(CommandLine, EveryProgramPrintsItsVersionAndExitsTwoOnAUsageError) {
+  for (const std::string& program : programs()) {
+    SCOPED_TRACE(program);
+    const Output version = run(program + " --version");
+    EXPECT_EQ(version.code, 0) << version.text;
+    EXPECT_NE(version.text.find(TUMBLE_VERSION), std::string::npos) << version.text;
+    const Output unknown = run(program + " --no-such-flag");
+    EXPECT_EQ(unknown.code, 2) << unknown.text;
+    EXPECT_NE(unknown.text.find("--no-such-flag"), std::string::npos) << unknown.text;
+    const Output help = run(program + " --help");
+    EXPECT_EQ(help.code, 0) << help.text;
+  }
+  // The defaults are in --help: the address a client calls and a server listens on.
+  EXPECT_NE(run(std::string(TUMBLE_CLI_BINARY) + " --help").text.find("127.0.0.1:50051"),
+            std::string::npos);
+  EXPECT_NE(run(std::string(TUMBLE_SERVER_BINARY) + " --help").text.find("127.0.0.1:50051"),
+            std::string::npos);
+}
+
+TEST(CommandLine, MistakesAreNamedAsWhatTheyAre) {
+  const std::string tumble = TUMBLE_CLI_BINARY;
+  const Output unknown = run(tumble + " frobnicate");
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.text.find("unknown command 'frobnicate'"), std::string::npos) << unknown.text;
+  EXPECT_NE(unknown.text.find("spawn"), std::string::npos) << unknown.text;  // what there is
+  const Output none = run(tumble);
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.text.find("a command is required"), std::string::npos) << none.text;
+  const Output missing = run(tumble + " restore /nonexistent/world.snap");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.text.find("/nonexistent/world.snap: no such file"), std::string::npos)
+      << missing.text;
+  // A value from the environment is refused by the variable's name, in a line, not with the
+  // largest double written out.
+  const Output variable =
+      run("TUMBLE_THREADS=abc " + std::string(TUMBLE_SERVER_BINARY) + " --listen 127.0.0.1:0");
+  EXPECT_EQ(variable.code, 2);
+  EXPECT_NE(variable.text.find("TUMBLE_THREADS=abc"), std::string::npos) << variable.text;
+  EXPECT_NE(variable.text.find("not a number"), std::string::npos) << variable.text;
+  EXPECT_LT(variable.text.size(), 300u) << variable.text;
+  const Output negative = run(std::string(TUMBLE_SERVER_BINARY) + " --threads -2");
+  EXPECT_EQ(negative.code, 2);
+  EXPECT_NE(negative.text.find("must be 0 or more"), std::string::npos) << negative.text;
+}
+
+TEST(CommandLine, ASecondServerOnATakenPortFailsNamingIt) {
+  Server first;
+  ASSERT_NO_FATAL_FAILURE(first.start({"--paused"}));
+  const Output second = run("timeout 30 " + std::string(TUMBLE_SERVER_BINARY) + " --listen " +
+                            first.address + " --paused");
+  EXPECT_EQ(second.code, 1) << second.text;
+  EXPECT_NE(second.text.find("cannot listen on " + first.address), std::string::npos)
+      << second.text;
+  EXPECT_NE(second.text.find("address already in use"), std::string::npos) << second.text;
+  EXPECT_EQ(second.text.find("listening on"), std::string::npos) << second.text;
+  // The first one still answers, alone.
+  EXPECT_EQ(run(cli(first) + "health").code, 0);
+}
+
+TEST(CommandLine, HealthAnswersByTheServicesName) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  auto channel = grpc::CreateChannel(server.address, grpc::InsecureChannelCredentials());
+  auto health = grpc::health::v1::Health::NewStub(channel);
+  for (const char* name : {"", "tumble.v1.World"}) {
+    grpc::ClientContext context;
+    grpc::health::v1::HealthCheckRequest request;
+    request.set_service(name);
+    grpc::health::v1::HealthCheckResponse response;
+    const grpc::Status status = health->Check(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << "'" << name << "': " << status.error_message();
+    EXPECT_EQ(response.status(), grpc::health::v1::HealthCheckResponse::SERVING) << name;
+  }
+}
+
+TEST(CommandLine, ImpulsesStatesAndSleepingFromTheCli) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  std::vector<std::string> ids;
+  for (const char* z : {"0.5", "3"}) {  // far from the default scene's bodies
+    const Output made = run(tumble + "spawn box --size 1,1,1 --mass 2 --position 50,50," + z);
+    ASSERT_EQ(made.code, 0) << made.text;
+    ids.push_back(made.text.substr(0, made.text.find('\n')));
+  }
+  // Ids by commas, as `stream --ids` takes them.
+  const Output two = run(tumble + "bodies " + ids[0] + "," + ids[1]);
+  ASSERT_EQ(two.code, 0) << two.text;
+  EXPECT_EQ(std::count(two.text.begin(), two.text.end(), '\n'), 2);
+
+  ASSERT_EQ(run(tumble + "impulse " + ids[1] + " --impulse 4,0,0").code, 0);
+  const Output pushed = run(tumble + "bodies " + ids[1]);
+  EXPECT_NE(pushed.text.find("\"v\":[2.0,0.0,0.0]"), std::string::npos)
+      << pushed.text;  // 4 N s / 2 kg
+  ASSERT_EQ(
+      run(tumble + "set-state " + ids[1] + " --position 55,50,3 --linear-velocity 0,0,0").code, 0);
+  const Output moved = run(tumble + "bodies " + ids[1]);
+  EXPECT_NE(moved.text.find("\"p\":[55.0,50.0,3.0]"), std::string::npos) << moved.text;
+  const Output refused = run(tumble + "impulse 999999 --impulse 1,0,0");
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_NE(refused.text.find("no body"), std::string::npos) << refused.text;
+
+  // The box on the floor falls asleep and still reports its contacts, carrying m g dt.
+  ASSERT_EQ(run(tumble + "step 120").code, 0);
+  const Output asleep = run(tumble + "bodies " + ids[0]);
+  EXPECT_NE(asleep.text.find("\"asleep\":true"), std::string::npos) << asleep.text;
+  const Output frame = run(tumble + "stream --frames 1 --contacts --ids " + ids[0]);
+  ASSERT_EQ(frame.code, 0) << frame.text;
+  EXPECT_NE(frame.text.find("\"contacts\""), std::string::npos) << frame.text;
+  EXPECT_NE(frame.text.find("\"impulse\""), std::string::npos) << frame.text;
+  // Sleeping off wakes it.
+  const Output off = run(tumble + "set --sleeping off");
+  ASSERT_EQ(off.code, 0) << off.text;
+  EXPECT_NE(off.text.find("\"sleeping\":false"), std::string::npos) << off.text;
+  const Output awake = run(tumble + "bodies " + ids[0]);
+  EXPECT_NE(awake.text.find("\"asleep\":false"), std::string::npos) << awake.text;
+}
+
+TEST(CommandLine, ACsvReplayWithoutVelocitiesHasTheColumnsOfItsRows) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start());
+  TempDir dir;
+  const Output recorded = run(cli(server) + "record " + dir / "run.rec" + " --frames 3");
+  ASSERT_EQ(recorded.code, 0) << recorded.text;
+  for (const char* format : {"csv"}) {
+    const Output replay =
+        run(std::string(TUMBLE_CLI_BINARY) + " replay --format " + format + " " + dir / "run.rec");
+    ASSERT_EQ(replay.code, 0) << replay.text;
+    std::istringstream lines(replay.text);
+    std::string header, row;
+    ASSERT_TRUE(std::getline(lines, header));
+    EXPECT_EQ(header, "step,time,id,x,y,z,qw,qx,qy,qz");
+    int rows = 0;
+    while (std::getline(lines, row)) {
+      ++rows;
+      EXPECT_EQ(std::count(row.begin(), row.end(), ','),
+                std::count(header.begin(), header.end(), ','))
+          << row;
+    }
+    EXPECT_EQ(rows, 3 * 51);
+  }
+}
+
+}  // namespace
