@@ -2,17 +2,21 @@
 // once per simulated second, what the world is doing: contacts (with those of sleeping bodies,
 // which still rest on each other), islands solved, the fastest body, the deepest penetration, the
 // solver's residual and the cost of a step.
+#include <omp.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
+
 #include <string>
 
 #include "physics/world.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
 #include "tumble/command_line.h"
+#include "tumble/passive_wait.h"
 
 using namespace tumble;
 
@@ -40,6 +44,7 @@ Totals measure(const World& world) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  tumble::cli::wait_passively_by_default(argv);  // first: it may run the program again
   CLI::App app{"Steps a Tumble scene and prints what happens, once per simulated second."};
   cli::keep_conventions(app, "tumble-run");
   std::string scene_file, standard;
@@ -89,9 +94,12 @@ int main(int argc, char** argv) {
 
   const long steps = std::lround(def.duration / def.dt);
   const long per_second = std::max(1L, std::lround(1 / def.dt));
-  std::printf("scene %s: %zu bodies, dt %.6g s, %ld steps, solver %s\n", def.name.c_str(),
-              world.body_count(), def.dt, steps,
-              std::string(solver_name(def.world.solver.kind)).c_str());
+  const char* wait_policy = std::getenv("OMP_WAIT_POLICY");
+  std::printf("scene %s: %zu bodies, dt %.6g s, %ld steps, solver %s, %d threads waiting %s\n",
+              def.name.c_str(), world.body_count(), def.dt, steps,
+              std::string(solver_name(def.world.solver.kind)).c_str(),
+              def.world.threads > 0 ? def.world.threads : omp_get_max_threads(),
+              wait_policy != nullptr ? wait_policy : "as libgomp chooses");
   std::printf("%7s %9s %8s %8s %7s %10s %12s %12s %10s %9s\n", "t [s]", "contacts", "islands",
               "exact", "asleep", "max |v|", "penetration", "energy [J]", "residual", "ms/step");
   StageTimes stage_sums;

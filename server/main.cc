@@ -24,6 +24,7 @@
 #include "dds_publisher.h"
 #endif
 #include "tumble/command_line.h"
+#include "tumble/passive_wait.h"
 
 namespace {
 
@@ -62,6 +63,7 @@ tumble::Status override_limits(const std::vector<std::string>& options,
 }  // namespace
 
 int main(int argc, char** argv) {
+  tumble::cli::wait_passively_by_default(argv);  // first: it may run the program again
   using namespace tumble;
   // SIGINT and SIGTERM are blocked in every thread (threads inherit the mask) and taken by the
   // main thread with sigwait, so shutting down runs as ordinary code, not in a signal handler.

@@ -78,6 +78,19 @@ TEST(CommandLine, MistakesAreNamedAsWhatTheyAre) {
   EXPECT_NE(negative.text.find("must be 0 or more"), std::string::npos) << negative.text;
 }
 
+// Spinning OpenMP threads collapse a step on a busy machine (passive_wait.h): the programs that
+// step a world wait passively unless the user chose otherwise.
+TEST(CommandLine, OpenMpThreadsWaitPassivelyUnlessTheUserChose) {
+  const std::string run_scene =
+      std::string(TUMBLE_RUN_BINARY) + " --standard pile:8 --duration 0.05 --threads 2";
+  const Output chosen_for_them = run("env -u OMP_WAIT_POLICY " + run_scene);
+  ASSERT_EQ(chosen_for_them.code, 0) << chosen_for_them.text;
+  EXPECT_NE(chosen_for_them.text.find("2 threads waiting passive"), std::string::npos)
+      << chosen_for_them.text;
+  const Output chosen = run("OMP_WAIT_POLICY=active " + run_scene);
+  EXPECT_NE(chosen.text.find("2 threads waiting active"), std::string::npos) << chosen.text;
+}
+
 TEST(CommandLine, ASecondServerOnATakenPortFailsNamingIt) {
   Server first;
   ASSERT_NO_FATAL_FAILURE(first.start({"--paused"}));
