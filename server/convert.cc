@@ -36,7 +36,7 @@ Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
       const v1::Vec3& size = shape.box().size();
       for (auto [value, axis] : {std::pair{size.x(), "x"}, {size.y(), "y"}, {size.z(), "z"}})
         if (Status s = positive(value, std::string("shape.box.size.") + axis); !s) return s;
-      return ShapeDef{BoxDef{0.5 * vec(size)}};
+      return ShapeDef{BoxDef::of_size(vec(size))};
     }
     case v1::Shape::kSphere:
       if (Status s = positive(shape.sphere().radius(), "shape.sphere.radius"); !s) return s;

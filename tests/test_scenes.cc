@@ -81,6 +81,10 @@ TEST(SceneJson, NamesTheBadField) {
       error_of(R"({"bodies": [{"shape": "hull", "points": [[0,0,0],[1,0,0],[2,0,0],[3,0,0]]}]})")
           .rfind("bodies[0].shape.", 0),
       0u);
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "capsule", "half_height": 1, "length": 2}]})"),
+            "bodies[0].length: half_height and length give the same size: give one");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "capsule", "half_height": 0}]})"),
+            "bodies[0].half_height: must be > 0");
   EXPECT_EQ(error_of(R"({"bodies": [)").rfind("scene: not valid JSON", 0), 0u);
   EXPECT_EQ(error_of(R"([1, 2])"), "scene: must be an object");
 }

@@ -109,12 +109,16 @@ ShapeDef read_shape(ObjectReader& r) {
     const Vec3 v = ObjectReader::read_vector(*size, r.child("size"));
     for (int k = 0; k < 3; ++k)
       if (!(v[k] > 0)) fail(r.child("size") + "[" + std::to_string(k) + "]", "must be > 0");
-    return BoxDef{0.5 * v};
+    return BoxDef::of_size(v);
   }
   if (type == "sphere") return SphereDef{positive(r, "radius", 0.5)};
   if (type == "capsule") {
     const double radius = positive(r, "radius", 0.25);
-    return CapsuleDef{radius, 0.5 * positive(r, "length", 1.0)};
+    // half_height, as in the API, the CLI and Python; `length` (twice it) is the older name.
+    if (r.find("half_height") != nullptr && r.find("length") != nullptr)
+      fail(r.child("length"), "half_height and length give the same size: give one");
+    if (r.find("length") != nullptr) return CapsuleDef{radius, 0.5 * positive(r, "length", 1.0)};
+    return CapsuleDef{radius, positive(r, "half_height", 0.5)};
   }
   if (type == "hull") {
     const Json* points = r.find("points");
@@ -248,7 +252,7 @@ Json body_json(const BodyDef& def) {
         } else if constexpr (std::is_same_v<T, CapsuleDef>) {
           out["shape"] = "capsule";
           out["radius"] = shape.radius;
-          out["length"] = 2 * shape.half_height;
+          out["half_height"] = shape.half_height;
         } else if constexpr (std::is_same_v<T, HullDef>) {
           out["shape"] = "hull";
           out["points"] = Json::array();

@@ -4,6 +4,7 @@ import math
 import time
 
 import numpy as np
+import pytest
 
 import tumble
 
@@ -120,6 +121,33 @@ def test_remove_move_and_push(empty_world):
     pushed = world.body(a)
     np.testing.assert_allclose(pushed.linear_velocity, [1, 0, 0], atol=1e-12)
     np.testing.assert_allclose(pushed.angular_velocity, [0, 0, -2 * 0.5 / (2 * 2 / 12)], atol=1e-9)
+
+
+def test_one_name_per_concept_with_the_old_names_accepted(empty_world):
+    world = empty_world
+    world.settings(gravity=(0, 0, 0))
+    a = world.spawn_box(size=(1, 1, 1), position=(1, 2, 3), linear_velocity=(0, 0, 1))
+    b = world.spawn_box(size=(1, 1, 1), pos=(4, 5, 6), vel=(0, 0, 1))
+    np.testing.assert_array_equal(world.body(a).position, [1, 2, 3])
+    np.testing.assert_array_equal(world.body(b).position, [4, 5, 6])
+    world.set_state(a, position=(7, 7, 7), linear_velocity=(1, 0, 0))
+    np.testing.assert_array_equal(world.body(a).linear_velocity, [1, 0, 0])
+    with pytest.raises(tumble.ArgumentError, match="position and pos"):
+        world.spawn_box(size=(1, 1, 1), position=(0, 0, 0), pos=(1, 1, 1))
+    assert [body.id for body in world.bodies()] == [a, b]  # nothing spawned by the refusal
+
+
+def test_sleeping_is_switched_at_run_time(empty_world):
+    world = empty_world
+    world.spawn_ground()
+    box = world.spawn_box(size=(1, 1, 1), mass=2.0, position=(0, 0, 0.5))
+    world.step(90)
+    assert world.body(box).asleep
+    assert world.settings().sleeping
+    assert not world.settings(sleeping=False).sleeping
+    assert not world.body(box).asleep
+    with pytest.raises(tumble.ArgumentError, match="sleeping"):
+        world.settings(sleeping="no")
 
 
 def test_snapshot_restore_continues_bit_for_bit(world):

@@ -2,7 +2,7 @@
 
     import tumble
     world = tumble.connect("127.0.0.1:50051")
-    box = world.spawn_box(size=(1, 1, 1), mass=2.0, pos=(0, 0, 5))
+    box = world.spawn_box(size=(1, 1, 1), mass=2.0, position=(0, 0, 5))
     world.step(120)
     for frame in world.frames(rate=60, count=10): print(frame.step, frame.position(box))
 

@@ -10,17 +10,28 @@ from tumble.errors import ArgumentError
 from tumble.v1 import world_pb2 as pb
 
 
-@dataclass
+def aliased(name, value, alias_name, alias_value, default):
+    """One concept has one name everywhere (position, linear_velocity); the short names of
+    earlier versions (pos, vel) are still accepted, but not both at once."""
+    if value is not None and alias_value is not None:
+        raise ArgumentError(f"{name} and {alias_name} are the same value: give one")
+    if value is not None:
+        return value
+    return alias_value if alias_value is not None else default
+
+
+@dataclass(init=False)
 class BodySpec:
     """One body to spawn. Absent values take the server's defaults: density 1000 kg/m^3 (the mass
     follows from the volume), friction 0.5, restitution 0, identity orientation, at rest.
 
-    pos: m, of the shape's origin; vel: m/s; angular_velocity: rad/s, world frame; orientation:
-    (w, x, y, z); color: 0xRRGGBBAA or (r, g, b[, a]) in [0, 1]."""
+    position: m, of the shape's origin; linear_velocity: m/s; angular_velocity: rad/s, world
+    frame; orientation: (w, x, y, z); color: 0xRRGGBBAA or (r, g, b[, a]) in [0, 1]. `pos` and
+    `vel` are accepted for position and linear_velocity."""
 
     shape: object
-    pos: tuple = (0.0, 0.0, 0.0)
-    vel: tuple = (0.0, 0.0, 0.0)
+    position: tuple = (0.0, 0.0, 0.0)
+    linear_velocity: tuple = (0.0, 0.0, 0.0)
     orientation: Optional[tuple] = None
     angular_velocity: Optional[tuple] = None
     mass: Optional[float] = None
@@ -30,6 +41,22 @@ class BodySpec:
     color: object = None
     static: bool = False
 
+    def __init__(self, shape, position=None, linear_velocity=None, orientation=None,
+                 angular_velocity=None, mass=None, density=None, friction=None, restitution=None,
+                 color=None, static=False, *, pos=None, vel=None):
+        self.shape = shape
+        self.position = aliased("position", position, "pos", pos, (0.0, 0.0, 0.0))
+        self.linear_velocity = aliased("linear_velocity", linear_velocity, "vel", vel,
+                                       (0.0, 0.0, 0.0))
+        self.orientation = orientation
+        self.angular_velocity = angular_velocity
+        self.mass = mass
+        self.density = density
+        self.friction = friction
+        self.restitution = restitution
+        self.color = color
+        self.static = static
+
     def to_proto(self, name="bodies[0]"):
         if not isinstance(self.shape, shapes.SHAPES):
             kinds = ", ".join(kind.__name__ for kind in shapes.SHAPES)
@@ -37,8 +64,8 @@ class BodySpec:
         spec = pb.BodySpec()
         spec.shape.CopyFrom(self.shape.to_proto())
         spec.type = pb.BODY_TYPE_STATIC if self.static else pb.BODY_TYPE_DYNAMIC
-        convert.set_vec3(spec.position, self.pos, f"{name}.pos")
-        convert.set_vec3(spec.linear_velocity, self.vel, f"{name}.vel")
+        convert.set_vec3(spec.position, self.position, f"{name}.position")
+        convert.set_vec3(spec.linear_velocity, self.linear_velocity, f"{name}.linear_velocity")
         if self.orientation is not None:
             convert.set_quat(spec.orientation, self.orientation, f"{name}.orientation")
         else:

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import grpc
 
 from tumble import convert
-from tumble.bodies import Body, BodySpec
+from tumble.bodies import Body, BodySpec, aliased
 from tumble.errors import ArgumentError, Error, from_rpc
 from tumble.frames import FrameStream, plain
 from tumble.shapes import Box, Capsule, Hull, Plane, Sphere
@@ -30,19 +30,22 @@ _SOLVERS = {
 @dataclass
 class Settings:
     """The run's settings in force: dt (s), substeps (soft solver), solver, gravity (m/s^2),
-    real_time_factor (1: wall-clock pace, 0: as fast as the machine can)."""
+    real_time_factor (1: wall-clock pace, 0: as fast as the machine can), sleeping (bodies at
+    rest fall asleep and cost nothing until touched)."""
 
     dt: float
     substeps: int
     solver: str
     gravity: tuple
     real_time_factor: float
+    sleeping: bool = True
 
     @staticmethod
     def from_proto(settings):
         solver = next((k for k, v in _SOLVERS.items() if v == settings.solver), "unspecified")
         gravity = (settings.gravity.x, settings.gravity.y, settings.gravity.z)
-        return Settings(settings.dt, settings.substeps, solver, gravity, settings.real_time_factor)
+        return Settings(settings.dt, settings.substeps, solver, gravity, settings.real_time_factor,
+                        settings.sleeping)
 
 
 @dataclass
@@ -55,12 +58,16 @@ class Info:
     settings: Settings
     last_step: SimpleNamespace  # the last step's statistics (tumble.v1.StepStats)
     subscribers: int
+    # Simulated seconds per wall-clock second over the last second of running, and whether the
+    # world is late on its real-time factor (by more than a quarter second).
+    achieved_real_time_factor: float = 0.0
+    behind: bool = False
 
 
 @dataclass
 class Snapshot:
     """The whole world's state at `step`; World.restore continues the run from it bit for bit.
-    `state` is what `tumble snapshot --out FILE` writes, so files move between the two."""
+    `state` is what `tumble snapshot FILE` writes, so files move between the two."""
 
     step: int
     state: bytes
@@ -72,13 +79,16 @@ class LoadedScene:
     ids: list  # the scene's bodies, in its order
 
 
-def connect(address="127.0.0.1:50051", token=None, *, tls_ca=None, timeout=5.0):
+def connect(address=None, token=None, *, tls_ca=None, timeout=5.0):
     """Connects to a Tumble server and checks that it answers: an unreachable server, or one
     that refuses the token, raises tumble.Error here (naming the address), not on first use.
 
+    address: HOST:PORT (default: $TUMBLE_SERVER when set, else 127.0.0.1:50051, as the CLI).
     token: sent as "authorization: Bearer TOKEN" (default: $TUMBLE_TOKEN when set).
     tls_ca: path of the PEM certificate authority that signed the server's certificate; when
     given, the connection uses TLS. timeout: s to wait for the server's first answer."""
+    if address is None:
+        address = os.environ.get("TUMBLE_SERVER") or "127.0.0.1:50051"
     if token is None:
         token = os.environ.get("TUMBLE_TOKEN") or None
     options = [("grpc.max_receive_message_length", _MAX_MESSAGE_BYTES),
@@ -118,11 +128,12 @@ class World:
 
     # --- bodies -------------------------------------------------------------------------------
 
-    def spawn(self, shape, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
+    def spawn(self, shape, position=None, linear_velocity=None, **options):
         """Spawns one body of `shape` (Box, Sphere, Capsule, Hull or Plane); returns its id.
         Options are BodySpec's: orientation, angular_velocity, mass, density, friction,
-        restitution, color, static."""
-        return self.spawn_many([BodySpec(shape, pos, vel, **options)])[0]
+        restitution, color, static (and pos, vel: the older names of position and
+        linear_velocity)."""
+        return self.spawn_many([BodySpec(shape, position, linear_velocity, **options)])[0]
 
     def spawn_many(self, specs):
         """Spawns a batch of BodySpec all or nothing; returns their ids in the order given."""
@@ -133,20 +144,25 @@ class World:
             request.bodies.append(spec.to_proto(f"bodies[{i}]"))
         return list(self._rpc("SpawnBodies", request).ids)
 
-    def spawn_box(self, size, mass=None, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
+    def spawn_box(self, size, mass=None, position=None, linear_velocity=None, **options):
         """A box of full extents `size` (m); mass in kg (default: from density)."""
-        return self.spawn(Box(tuple(convert.array(size, 3, "size"))), pos, vel, mass=mass, **options)
+        return self.spawn(Box(tuple(convert.array(size, 3, "size"))), position, linear_velocity,
+                          mass=mass, **options)
 
-    def spawn_sphere(self, radius, mass=None, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
-        return self.spawn(Sphere(radius), pos, vel, mass=mass, **options)
+    def spawn_sphere(self, radius, mass=None, position=None, linear_velocity=None, **options):
+        return self.spawn(Sphere(radius), position, linear_velocity, mass=mass, **options)
 
-    def spawn_capsule(self, radius, half_height, mass=None, pos=(0.0, 0.0, 0.0),
-                      vel=(0.0, 0.0, 0.0), **options):
-        return self.spawn(Capsule(radius, half_height), pos, vel, mass=mass, **options)
+    def spawn_capsule(self, radius, half_height, mass=None, position=None, linear_velocity=None,
+                      **options):
+        """A capsule along the body's z axis: a segment of length 2 half_height swept by a
+        sphere of `radius`."""
+        return self.spawn(Capsule(radius, half_height), position, linear_velocity, mass=mass,
+                          **options)
 
-    def spawn_hull(self, points, mass=None, pos=(0.0, 0.0, 0.0), vel=(0.0, 0.0, 0.0), **options):
+    def spawn_hull(self, points, mass=None, position=None, linear_velocity=None, **options):
         """The convex hull of `points` ((N, 3), body frame, m)."""
-        return self.spawn(Hull(convert.points(points, "points")), pos, vel, mass=mass, **options)
+        return self.spawn(Hull(convert.points(points, "points")), position, linear_velocity,
+                          mass=mass, **options)
 
     def spawn_ground(self, height=0.0, **options):
         """A static ground: the half-space below z = height."""
@@ -156,15 +172,19 @@ class World:
         """Removes a body or a list of them, all or nothing (one unknown id: NOT_FOUND)."""
         self._rpc("RemoveBodies", pb.RemoveBodiesRequest(ids=convert.ids(ids)))
 
-    def set_state(self, body_id, pos=None, orientation=None, vel=None, angular_velocity=None):
-        """Moves a body or sets its velocities; values not given are left as they are."""
+    def set_state(self, body_id, position=None, orientation=None, linear_velocity=None,
+                  angular_velocity=None, *, pos=None, vel=None):
+        """Moves a body or sets its velocities; values not given are left as they are (pos and
+        vel: the older names of position and linear_velocity)."""
         update = pb.BodyStateUpdate(id=convert.ids(body_id, "id")[0])
-        if pos is not None:
-            convert.set_vec3(update.position, pos, "pos")
+        position = aliased("position", position, "pos", pos, None)
+        linear_velocity = aliased("linear_velocity", linear_velocity, "vel", vel, None)
+        if position is not None:
+            convert.set_vec3(update.position, position, "position")
         if orientation is not None:
             convert.set_quat(update.orientation, orientation, "orientation")
-        if vel is not None:
-            convert.set_vec3(update.linear_velocity, vel, "vel")
+        if linear_velocity is not None:
+            convert.set_vec3(update.linear_velocity, linear_velocity, "linear_velocity")
         if angular_velocity is not None:
             convert.set_vec3(update.angular_velocity, angular_velocity, "angular_velocity")
         self._rpc("SetBodyState", pb.SetBodyStateRequest(updates=[update]))
@@ -209,7 +229,8 @@ class World:
         """Back to the scene as last loaded, at step 0."""
         self._control(pb.ControlRequest(reset=True))
 
-    def settings(self, dt=None, substeps=None, solver=None, gravity=None, real_time_factor=None):
+    def settings(self, dt=None, substeps=None, solver=None, gravity=None, real_time_factor=None,
+                 sleeping=None):
         """Changes the settings given (none: reads them); returns the settings in force."""
         request = pb.ControlRequest()
         settings = request.settings
@@ -228,6 +249,11 @@ class World:
             convert.set_vec3(settings.gravity, gravity, "gravity")
         if real_time_factor is not None:
             settings.real_time_factor = convert.number(real_time_factor, "real_time_factor")
+        if sleeping is not None:
+            if not isinstance(sleeping, bool):
+                raise ArgumentError(f"sleeping: expected True or False, got {sleeping!r}",
+                                    "settings")
+            settings.sleeping = sleeping
         return Settings.from_proto(self._rpc("Control", request).settings)
 
     def load_scene(self, scene):
@@ -254,7 +280,8 @@ class World:
         response = self._rpc("GetInfo", pb.GetInfoRequest())
         return Info(response.version, response.step, response.time, response.body_count,
                     response.running, Settings.from_proto(response.settings),
-                    plain(response.last_step), response.subscribers)
+                    plain(response.last_step), response.subscribers,
+                    response.achieved_real_time_factor, response.behind)
 
     # --- frames, snapshots --------------------------------------------------------------------
 

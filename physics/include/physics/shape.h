@@ -22,9 +22,12 @@ struct CapsuleDef {
   double radius = 0.25;
   double half_height = 0.5;
 };
-// The box [-h, h]^3. half_extents: m, each > 0.
+// The box [-h, h]^3. half_extents: m, each > 0. The engine's own arithmetic is in half extents;
+// every other interface (scene JSON, the API, the CLI, Python) gives a box by its full `size`,
+// which of_size() takes.
 struct BoxDef {
   Vec3 half_extents = Vec3::Constant(0.5);
+  static BoxDef of_size(const Vec3& size) { return {0.5 * size}; }
 };
 // The convex hull of `points` (m, in the body frame). At least 4 points spanning a volume, at
 // most kMaxHullPoints (every contact query walks the hull's vertices, so their number bounds the
