@@ -3,30 +3,13 @@
 #include "frame_format.h"
 
 #include <google/protobuf/io/coded_stream.h>
-#include <google/protobuf/util/delimited_message_util.h>
 
 #include <sstream>
 
 namespace tumble::client {
 namespace {
-constexpr char kMagic[] = "tumble-recording 1\n";
-constexpr std::size_t kMagicLength = sizeof kMagic - 1;
+constexpr std::size_t kMagicLength = sizeof kRecordingMagic - 1;
 }  // namespace
-
-Result<RecordingWriter> RecordingWriter::create(const std::string& path) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) return Status::error(path + ": cannot create");
-  file.write(kMagic, kMagicLength);
-  file.flush();
-  if (!file) return Status::error(path + ": cannot write");
-  return RecordingWriter(std::move(file));
-}
-
-Status RecordingWriter::write(const v1::Frame& frame) {
-  if (!google::protobuf::util::SerializeDelimitedToOstream(frame, &file_) || !file_.flush())
-    return Status::error("recording: cannot write (disk full?)");
-  return Status::ok();
-}
 
 Result<RecordingReader> RecordingReader::open(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
@@ -34,7 +17,7 @@ Result<RecordingReader> RecordingReader::open(const std::string& path) {
   std::stringstream bytes;
   bytes << file.rdbuf();
   std::string data = std::move(bytes).str();
-  if (data.compare(0, kMagicLength, kMagic) != 0)
+  if (data.compare(0, kMagicLength, kRecordingMagic) != 0)
     return Status::error(path + ": not a tumble recording (no 'tumble-recording 1' header)");
   RecordingReader reader(std::move(data));
   reader.offset_ = kMagicLength;

@@ -1,26 +1,19 @@
 // Recorded streams: a file of frames exactly as the server sent them, so that a run can be
 // replayed, drawn or analysed later without the server. The first frame describes every body.
-// Format: the line "tumble-recording 1\n", then each Frame as a varint length and its bytes.
+// Format: the line "tumble-recording 1\n", then each Frame as a varint length and its bytes
+// (proto/tumble/recording_writer.h).
 #pragma once
 
 #include <fstream>
 #include <string>
 
 #include "physics/status.h"
+#include "tumble/recording_writer.h"
 #include "tumble/v1/world.pb.h"
 
 namespace tumble::client {
 
-class RecordingWriter {
- public:
-  static Result<RecordingWriter> create(const std::string& path);
-  // Written through to the file, so a recording cut short loses at most the frame in flight.
-  Status write(const v1::Frame& frame);
-
- private:
-  explicit RecordingWriter(std::ofstream file) : file_(std::move(file)) {}
-  std::ofstream file_;
-};
+using tumble::RecordingWriter;  // proto/tumble/recording_writer.h: the server writes them too
 
 class RecordingReader {
  public:

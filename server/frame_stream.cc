@@ -159,41 +159,8 @@ void FrameStream::offer() {
 void FrameStream::encode(const FrameData& data, std::uint64_t dropped) {
   v1::Frame own;
   own.set_dropped(dropped);
-  // Bodies new to this subscriber get their descriptions; vanished ones are listed. The host
-  // makes a new catalogue (and a new world a new epoch) whenever the set of bodies changes, so a
-  // frame sharing the last one's catalogue has nothing to diff.
-  if (data.catalogue != known_catalogue_) {
-    std::vector<std::uint64_t> current;
-    if (options_.ids.empty()) {
-      current = data.ids;
-    } else {
-      for (std::uint64_t id : data.ids)
-        if (std::binary_search(options_.ids.begin(), options_.ids.end(), id)) current.push_back(id);
-    }
-    std::sort(current.begin(), current.end());
-    // A new world (a scene loaded, a snapshot restored): every body it holds is described again,
-    // whether or not its id was known (a restored snapshot gives bodies back their ids), and
-    // only the ids it no longer has are removed. So no id is ever both removed and added in one
-    // frame, and a subscriber may apply the two lists in either order.
-    const bool new_world = data.epoch != epoch_;
-    epoch_ = data.epoch;
-    std::vector<std::uint64_t> added, removed;
-    if (new_world)
-      added = current;
-    else
-      std::set_difference(current.begin(), current.end(), known_.begin(), known_.end(),
-                          std::back_inserter(added));
-    std::set_difference(known_.begin(), known_.end(), current.begin(), current.end(),
-                        std::back_inserter(removed));
-    for (std::uint64_t wire : added) {
-      const auto look = data.catalogue->find(wire);
-      if (look != data.catalogue->end()) describe(wire, look->second, own.add_added());
-    }
-    for (std::uint64_t wire : removed)
-      own.add_removed(wire);
-    known_ = std::move(current);
-    known_catalogue_ = data.catalogue;
-  }
+  // Bodies new to this subscriber get their descriptions; vanished ones are listed.
+  catalogue_.add_changes(data, options_.ids, &own);
   grpc::Slice parts[2] = {slice_of(shared_encoding(data, options_)),
                           grpc::Slice(own.SerializeAsString())};
   buffer_ = grpc::ByteBuffer(parts, 2);

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "call_gate.h"
+#include "catalogue_diff.h"
 #include "convert.h"
 #include "world_host.h"
 
@@ -102,9 +103,8 @@ class FrameStream final : public RequestReader {
   bool writing_ = false, finishing_ = false, finished_ = false;
   grpc::Status final_status_;
   grpc::ByteBuffer buffer_;  // the write in flight
-  std::uint64_t dropped_ = 0, epoch_ = 0;
-  std::vector<std::uint64_t> known_;  // ids this subscriber has descriptions of, sorted
-  std::shared_ptr<const Catalogue> known_catalogue_;
+  std::uint64_t dropped_ = 0;
+  CatalogueDiff catalogue_;  // what this subscriber was told about the bodies
   std::chrono::steady_clock::time_point last_sent_{};
   bool sent_any_ = false;  // the first frame (describing every body) goes whatever the rate
 };

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "bind_failure.h"
+#include "frame_recorder.h"
 #include "log.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
@@ -89,6 +90,7 @@ int main(int argc, char** argv) {
   std::uint32_t dds_domain = 0;
   double dds_rate = 0;
   std::string log_level = "info";
+  std::string record_file;
   app.add_option("--listen", listen, "address to listen on (loopback by default)")
       ->envname("TUMBLE_LISTEN");
   app.add_option("--scene", scene_file, "a scene file (JSON, docs/SCENES.md)")
@@ -130,6 +132,11 @@ int main(int argc, char** argv) {
   app.add_option("--dds-rate", dds_rate, "DDS samples per second at most (0: every step)")
       ->envname("TUMBLE_DDS_RATE")
       ->check(cli::non_negative);
+  app.add_option("--record", record_file,
+                 "write every frame (velocities, contacts, statistics) to this recording, none "
+                 "dropped: the world waits for the disk if it must (tumble replay, tumble-viewer "
+                 "--replay)")
+      ->envname("TUMBLE_RECORD");
   app.add_option("--log-level", log_level,
                  "error, warn, info or debug: what the log on stderr holds (debug: every refused "
                  "request)")
@@ -180,6 +187,16 @@ int main(int argc, char** argv) {
   }
 
   server::WorldHost host(std::move(world).value(), scene.value().dt, real_time_factor);
+  std::shared_ptr<server::FrameRecorder> recorder;
+  if (!record_file.empty()) {
+    auto started = server::FrameRecorder::start(record_file);
+    if (!started) {
+      std::fprintf(stderr, "tumble-server: --record: %s\n", started.error().c_str());
+      return 2;
+    }
+    recorder = std::move(started).value();
+    host.record_to(recorder);
+  }
 #ifdef TUMBLE_WITH_DDS
   std::unique_ptr<server::DdsPublisher> dds_publisher;
   if (dds) {
@@ -242,6 +259,14 @@ int main(int argc, char** argv) {
   service.shut_down();
   grpc_server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
   host.pause();
+  if (recorder != nullptr) {
+    host.wait_idle(std::chrono::seconds(10));  // the step in flight is recorded too
+    host.record_to(nullptr);
+    const Status written = recorder->finish();
+    server::log(written ? server::LogLevel::kInfo : server::LogLevel::kError,
+                "--record: " + std::to_string(recorder->frames_written()) + " frames in " +
+                    record_file + (written ? "" : " (" + written.message() + ")"));
+  }
   std::printf("tumble-server: stopped at step %llu\n",
               static_cast<unsigned long long>(host.status().step));
   server::log(server::LogLevel::kInfo, std::string("stopped by ") +

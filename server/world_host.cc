@@ -145,7 +145,14 @@ HostStatus WorldHost::status() const {
 }
 
 // With the lock held.
+void WorldHost::record_to(std::shared_ptr<FrameSink> sink) {
+  std::lock_guard lock(mutex_);
+  sink_ = std::move(sink);
+  if (sink_ != nullptr && last_frame_ != nullptr) sink_->put(last_frame_);
+}
+
 void WorldHost::publish(std::shared_ptr<const FrameData> frame) {
+  if (sink_ != nullptr) sink_->put(frame);
   last_frame_ = frame;
   for (const auto& mailbox : subscribers_)
     mailbox->put(frame);
@@ -243,7 +250,9 @@ void WorldHost::run() {
     const double dt = hosted_.dt;
     if (steps_left_ > 0) --steps_left_;
     in_step_ = true;
+    const std::shared_ptr<FrameSink> sink = sink_;
     lock.unlock();  // the world is this thread's alone; callers may queue meanwhile
+    if (sink != nullptr) sink->wait_for_room();  // a lossless recording sets the pace
     const Status stepped = hosted_.world.step(dt);
     std::shared_ptr<const FrameData> frame = stepped ? make_frame() : nullptr;
     lock.lock();

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "frame.h"
+#include "frame_sink.h"
 #include "hosted_world.h"
 #include "mailbox.h"
 #include "physics/world.h"
@@ -77,6 +78,11 @@ class WorldHost {
   // Waits until the world is paused with no steps left to run, or the timeout passes.
   bool wait_idle(std::chrono::milliseconds timeout);
 
+  // Every frame from now on goes to `sink` too, starting with the newest: nothing is dropped,
+  // and the world waits before a step until the sink has room (frame_sink.h). One sink at most;
+  // nullptr ends it.
+  void record_to(std::shared_ptr<FrameSink> sink);
+
   std::shared_ptr<FrameMailbox> subscribe();
   void unsubscribe(const std::shared_ptr<FrameMailbox>& mailbox);
 
@@ -110,6 +116,7 @@ class WorldHost {
   double real_time_factor_;
   HostStatus status_;
   std::vector<std::shared_ptr<FrameMailbox>> subscribers_;
+  std::shared_ptr<FrameSink> sink_;
   // The newest frame: a new subscriber starts from it, even while the world is paused.
   std::shared_ptr<const FrameData> last_frame_;
   void publish(std::shared_ptr<const FrameData> frame);

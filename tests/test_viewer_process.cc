@@ -90,6 +90,59 @@ TEST(ViewerProcess, SurvivesTheServerStoppingAndStartingAgain) {
 }
 
 // The window under Xvfb and the off-screen renderer draw the same state alike.
+// tumble-server --record keeps every frame (a subscriber over the network drops the ones it is
+// too slow for); tumble replay reads them all, and the viewer plays the file without a server,
+// off screen and in a window.
+TEST(ViewerProcess, TheServersRecordingHasEveryStepAndTheViewerPlaysIt) {
+  TempDir dir;
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--record", dir / "run.rec", "--paused"}));
+  const Output stepped =
+      run(std::string(TUMBLE_CLI_BINARY) + " --server " + server.address + " step 200");
+  ASSERT_EQ(stepped.code, 0) << stepped.text;
+  int code = -1;
+  std::string last;
+  server.stop(&code, &last);
+  ASSERT_EQ(code, 0);
+  const Output replay = run(std::string(TUMBLE_CLI_BINARY) + " replay " + dir / "run.rec");
+  ASSERT_EQ(replay.code, 0) << replay.text.substr(0, 400);
+  // Every step from the state before the first (step 0) to 200, in order, none dropped (a
+  // command's change, such as the step request's settings, adds a frame of the same step).
+  std::size_t next_step = 0, with_contacts = 0, frames = 0;
+  std::size_t line_start = 0;
+  while (line_start < replay.text.size()) {
+    const std::size_t end = replay.text.find('\n', line_start);
+    const std::string line = replay.text.substr(line_start, end - line_start);
+    const std::size_t step = std::stoul(line.substr(line.find("\"step\":") + 7));
+    EXPECT_TRUE(step == next_step || step + 1 == next_step) << step << " after " << next_step;
+    next_step = step + 1;
+    EXPECT_NE(line.find("\"dropped\":0"), std::string::npos) << "frame " << frames;
+    with_contacts += line.find("\"contacts\":[{") != std::string::npos;
+    ++frames;
+    line_start = end + 1;
+  }
+  EXPECT_EQ(next_step, 201u);
+  EXPECT_GT(with_contacts, frames / 2);
+
+  const Output pictures =
+      run(std::string(TUMBLE_VIEWER_BINARY) + " --replay " + dir / "run.rec" +
+          " --offscreen --size 320x180 --frames 2 --every 20 --out " + dir / "replayed");
+  ASSERT_EQ(pictures.code, 0) << pictures.text;
+  const Png first = load(dir / "replayed/frame-00000.png");
+  EXPECT_EQ(first.width, 320);
+  const Output window =
+      run("ASAN_OPTIONS=detect_leaks=0 timeout 60 xvfb-run -a -s '-screen 0 1280x720x24' " +
+          std::string(TUMBLE_VIEWER_BINARY) + " --replay " + dir / "run.rec" +
+          " --size 320x180 --frames 3 --screenshot " + dir / "window.png");
+  ASSERT_EQ(window.code, 0) << window.text;
+  EXPECT_EQ(load(dir / "window.png").width, 320);
+  // A file that is not a recording is refused by name.
+  const Output refused = run(std::string(TUMBLE_VIEWER_BINARY) + " --replay " +
+                             std::string(TUMBLE_VIEWER_BINARY) + " --offscreen");
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.text.find("not a tumble recording"), std::string::npos) << refused.text;
+}
+
 TEST(ViewerProcess, TheWindowAndTheOffscreenPictureAgree) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));

@@ -1,16 +1,20 @@
-// tumble-viewer: attaches to a running tumble-server and draws its world, in a window (GLFW) or
-// off screen (OSMesa) into PNG frames; if the server goes away it keeps the last picture, says
-// so, and reconnects.
+// tumble-viewer: attaches to a running tumble-server and draws its world, or plays a recording,
+// in a window (GLFW) or off screen (OSMesa) into PNG frames; if the server goes away it keeps the
+// last picture, says so, and reconnects.
 //   tumble-viewer --server 127.0.0.1:50051
 //   tumble-viewer --server 127.0.0.1:50051 --offscreen --out frames --frames 120 --every 2
+//   tumble-viewer --replay run.rec
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #include "client.h"
+#include "frame_source.h"
 #include "offscreen.h"
 #include "tumble/command_line.h"
 #include "window.h"
@@ -19,7 +23,7 @@
 using namespace tumble;
 
 int main(int argc, char** argv) {
-  CLI::App app{"tumble-viewer: draws a running tumble-server's world."};
+  CLI::App app{"tumble-viewer: draws a running tumble-server's world, or plays a recording."};
   cli::keep_conventions(app, "tumble-viewer");
   client::Connection connection;
   std::string out_dir = "frames", size = "1280x720";
@@ -31,7 +35,11 @@ int main(int argc, char** argv) {
   app.add_option("--token", connection.token, "bearer token")->envname("TUMBLE_TOKEN");
   app.add_option("--tls-ca", connection.tls_ca_file, "TLS: the certificate authority (PEM)")
       ->envname("TUMBLE_TLS_CA");
-  std::string screenshot;
+  std::string screenshot, replay;
+  app.add_option("--replay", replay,
+                 "play this recording (tumble record, tumble-server --record) instead of a "
+                 "server's world: in a window at its recorded pace, off screen as fast as drawn")
+      ->check(cli::existing_file);
   bool contacts = false;
   app.add_flag("--contacts", contacts, "draw contact points and normals");
   app.add_flag("--offscreen", offscreen, "render with OSMesa into PNG files (no display needed)");
@@ -59,10 +67,24 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tumble-viewer: --size: expected WIDTHxHEIGHT, got %s\n", size.c_str());
     return 2;
   }
-  Result<client::Client> connected = client::Client::connect(connection);
-  if (!connected) {
-    std::fprintf(stderr, "tumble-viewer: %s\n", connected.error().c_str());
-    return 2;
+  std::optional<client::Client> connected;
+  std::unique_ptr<viewer::FrameSource> source;
+  if (!replay.empty()) {
+    auto opened = viewer::RecordingSource::open_file(replay, /*paced=*/!offscreen);
+    if (!opened) {
+      std::fprintf(stderr, "tumble-viewer: --replay: %s\n", opened.error().c_str());
+      return 2;
+    }
+    source = std::move(opened).value();
+  } else {
+    Result<client::Client> made = client::Client::connect(connection);
+    if (!made) {
+      std::fprintf(stderr, "tumble-viewer: %s\n", made.error().c_str());
+      return 2;
+    }
+    connected.emplace(std::move(made).value());
+    // Contacts are cheap to carry in a window, which toggles them; pictures ask only if drawn.
+    source = std::make_unique<viewer::ServerSource>(*connected, contacts || !offscreen);
   }
   viewer::Camera camera;
   camera.eye = {eye[0], eye[1], eye[2]};
@@ -75,7 +97,7 @@ int main(int argc, char** argv) {
     options.screenshot = screenshot;
     options.frames = static_cast<int>(frames);
     options.contacts = contacts;
-    return viewer::run_window(connected.value(), options);
+    return viewer::run_window(*source, options);
   }
 
   std::error_code made;
@@ -121,12 +143,10 @@ int main(int argc, char** argv) {
   while (written < frames) {
     // A new stream describes every body again; the view starts over with it.
     viewer::WorldView view;
-    v1::StreamFramesRequest request;
-    request.set_contacts(contacts);
-    client::FrameStream stream = connected.value().subscribe(request);
+    source->open();
     v1::Frame frame;
     bool any = false;
-    while (written < frames && stream.next(&frame)) {
+    while (written < frames && source->next(&frame)) {
       any = true;
       view.apply(frame);
       if (fps > 0) {
@@ -148,7 +168,14 @@ int main(int argc, char** argv) {
       ++written;
     }
     if (written >= frames) break;
-    const Status ended = stream.finish();
+    const Status ended = source->finish();
+    if (!source->reopens()) {  // the recording ended before --frames pictures
+      if (!ended) {
+        std::fprintf(stderr, "tumble-viewer: --replay: %s\n", ended.message().c_str());
+        return 1;
+      }
+      break;
+    }
     if (any) {
       lost_since = std::chrono::steady_clock::now();
       std::fprintf(stderr,

@@ -86,7 +86,7 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
 
 }  // namespace
 
-int run_window(client::Client& client, const WindowOptions& options) {
+int run_window(FrameSource& source, const WindowOptions& options) {
   if (!glfwInit()) {
     std::fprintf(stderr, "tumble-viewer: no display for a window (try --offscreen)\n");
     return 1;
@@ -125,30 +125,28 @@ int run_window(client::Client& client, const WindowOptions& options) {
     // the window draws the newest state at its own pace. A lost server is retried.
     std::mutex mutex;
     WorldView view;
-    std::atomic<bool> closing{false}, connected{false};
-    client::FrameStream* current = nullptr;  // under `mutex`: what closing the window cancels
+    std::atomic<bool> closing{false}, connected{false}, ended{false};
     std::thread reader([&] {
       while (!closing) {
-        v1::StreamFramesRequest request;
-        request.set_contacts(true);  // cheap to carry, drawn when toggled on
-        client::FrameStream stream = client.subscribe(request);
+        source.open();
         {
           std::lock_guard lock(mutex);
           view = WorldView();  // a new stream describes everything again
-          current = &stream;
-          if (closing) stream.cancel();
         }
         v1::Frame frame;
-        while (!closing && stream.next(&frame)) {
+        while (!closing && source.next(&frame)) {
           std::lock_guard lock(mutex);
           view.apply(frame);
           // Under the lock and after the frame: a picture drawn while `connected` shows a world.
           connected = true;
         }
-        {
-          std::lock_guard lock(mutex);
-          current = nullptr;
+        if (!source.reopens()) {  // a recording played to its end: its last frame stays
+          ended = true;
+          const Status status = source.finish();
+          if (!status) std::fprintf(stderr, "tumble-viewer: %s\n", status.message().c_str());
+          return;
         }
+        source.finish();
         connected = false;
         if (!closing) std::this_thread::sleep_for(std::chrono::milliseconds(300));
       }
@@ -176,12 +174,12 @@ int run_window(client::Client& client, const WindowOptions& options) {
         v1::ControlRequest request;
         running = !running;
         (running ? request.set_play(true) : request.set_pause(true));
-        client.control(request);
+        source.control(request);
       }
       for (; input.steps > 0; --input.steps) {
         v1::ControlRequest request;
         request.set_step(1);
-        client.control(request);
+        source.control(request);
         running = false;
       }
       int width = 0, height = 0;
@@ -238,14 +236,16 @@ int run_window(client::Client& client, const WindowOptions& options) {
         std::snprintf(title, sizeof title,
                       "tumble-viewer - step %llu, t = %.2f s, %zu bodies, %.0f fps%s",
                       static_cast<unsigned long long>(step), time, bodies, fps,
-                      connected ? "" : " - server lost, reconnecting");
+                      ended       ? " - end of the recording"
+                      : connected ? ""
+                                  : " - server lost, reconnecting");
         glfwSetWindowTitle(window, title);
       }
     }
     {
       std::lock_guard lock(mutex);
       closing = true;
-      if (current != nullptr) current->cancel();
+      source.cancel();
     }
     reader.join();
   }

@@ -1,13 +1,12 @@
-// The window front end (GLFW): draws the stream as it comes, with orbit (left drag), pan (right
-// drag) and zoom (wheel); Space plays or pauses the server, N steps it once, C shows or hides
-// contacts, F follows the next body (again: the one after; Backspace: stop following), Esc
-// closes. Step, simulated time,
-// bodies and frame rate show in the title.
+// The window front end (GLFW): draws the frames as they come (a server's or a recording's), with
+// orbit (left drag), pan (right drag) and zoom (wheel); Space plays or pauses the server, N steps
+// it once, C shows or hides contacts, F follows the next body (again: the one after; Backspace:
+// stop following), Esc closes. Step, simulated time, bodies and frame rate show in the title.
 #pragma once
 
 #include <string>
 
-#include "client.h"
+#include "frame_source.h"
 #include "renderer.h"
 
 namespace tumble::viewer {
@@ -22,6 +21,6 @@ struct WindowOptions {
 };
 
 // Runs until the window is closed; the exit code.
-int run_window(client::Client& client, const WindowOptions& options);
+int run_window(FrameSource& source, const WindowOptions& options);
 
 }  // namespace tumble::viewer

@@ -1,0 +1,84 @@
+#include "frame_recorder.h"
+
+#include "log.h"
+
+namespace tumble::server {
+
+Result<std::shared_ptr<FrameRecorder>> FrameRecorder::start(const std::string& path) {
+  Result<RecordingWriter> writer = RecordingWriter::create(path);
+  if (!writer) return writer.status();
+  std::shared_ptr<FrameRecorder> recorder(new FrameRecorder(std::move(writer).value()));
+  recorder->thread_ = std::thread([raw = recorder.get()] { raw->write_frames(); });
+  return recorder;
+}
+
+FrameRecorder::FrameRecorder(RecordingWriter writer) : writer_(std::move(writer)) {
+  options_.velocities = options_.contacts = options_.stats = true;
+}
+
+Status FrameRecorder::finish() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  return status();
+}
+
+FrameRecorder::~FrameRecorder() {
+  finish();
+}
+
+void FrameRecorder::put(std::shared_ptr<const FrameData> frame) {
+  {
+    std::lock_guard lock(mutex_);
+    // Past a write error nothing more is kept: the world goes on, the log said why.
+    if (!status_) return;
+    queue_.push_back(std::move(frame));
+  }
+  changed_.notify_all();
+}
+
+void FrameRecorder::wait_for_room() {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [&] { return queue_.size() < kQueuedFrames || !status_ || stopping_; });
+}
+
+void FrameRecorder::write_frames() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    changed_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+    if (queue_.empty()) return;  // stopping, and everything written
+    const std::shared_ptr<const FrameData> data = std::move(queue_.front());
+    queue_.pop_front();
+    lock.unlock();
+    changed_.notify_all();  // room for the stepping thread
+    v1::Frame frame;
+    frame_to_proto(*data, options_, &frame);
+    catalogue_.add_changes(*data, {}, &frame);
+    const Status written = writer_.write(frame);
+    lock.lock();
+    if (!written) {
+      status_ = written;
+      queue_.clear();
+      log(LogLevel::kError, "--record: " + written.message() + "; the recording stops at frame " +
+                                std::to_string(written_));
+      changed_.notify_all();
+      return;
+    }
+    ++written_;
+  }
+}
+
+std::uint64_t FrameRecorder::frames_written() const {
+  std::lock_guard lock(mutex_);
+  return written_;
+}
+
+Status FrameRecorder::status() const {
+  std::lock_guard lock(mutex_);
+  return status_;
+}
+
+}  // namespace tumble::server
