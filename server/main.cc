@@ -18,6 +18,7 @@
 #include "bind_failure.h"
 #include "frame_recorder.h"
 #include "log.h"
+#include "reflection_v1.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
 #include "service.h"
@@ -231,6 +232,10 @@ int main(int argc, char** argv) {
   int port = 0;
   builder.AddListeningPort(listen, credentials, &port);
   service.register_on(builder);
+  server::ReflectionV1 reflection_v1(
+      {v1::World::service_full_name(), "grpc.health.v1.Health",
+       "grpc.reflection.v1alpha.ServerReflection", "grpc.reflection.v1.ServerReflection"});
+  builder.RegisterService(&reflection_v1);
   std::unique_ptr<grpc::Server> grpc_server = builder.BuildAndStart();
   if (grpc_server == nullptr || port == 0) {
     std::fprintf(stderr, "tumble-server: --listen: cannot listen on %s: %s\n", listen.c_str(),

@@ -11,7 +11,12 @@
 #include <string>
 #include <vector>
 
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/descriptor.pb.h>
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "grpc/reflection/v1/reflection.grpc.pb.h"
 #include "process_support.h"
 
 namespace {
@@ -119,6 +124,67 @@ TEST(CommandLine, HealthAnswersByTheServicesName) {
     ASSERT_TRUE(status.ok()) << "'" << name << "': " << status.error_message();
     EXPECT_EQ(response.status(), grpc::health::v1::HealthCheckResponse::SERVING) << name;
   }
+}
+
+// Reflection v1 (which newer tools ask for first) answers beside v1alpha, and its messages are
+// v1alpha's field for field, so a tool reads both alike.
+TEST(CommandLine, ReflectionV1ListsTheServicesAndDescribesTheApi) {
+  // A call into gRPC's reflection library, so that the linker keeps it (and its v1alpha
+  // descriptors in the pool).
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  const auto* pool = google::protobuf::DescriptorPool::generated_pool();
+  for (const char* name :
+       {"ServerReflectionRequest", "ExtensionRequest", "ServerReflectionResponse",
+        "FileDescriptorResponse", "ExtensionNumberResponse", "ListServiceResponse",
+        "ServiceResponse", "ErrorResponse"}) {
+    const auto* v1 = pool->FindMessageTypeByName(std::string("grpc.reflection.v1.") + name);
+    const auto* alpha = pool->FindMessageTypeByName(std::string("grpc.reflection.v1alpha.") + name);
+    ASSERT_NE(v1, nullptr) << name;
+    ASSERT_NE(alpha, nullptr) << name;
+    ASSERT_EQ(v1->field_count(), alpha->field_count()) << name;
+    for (int i = 0; i < v1->field_count(); ++i) {
+      const auto* a = v1->field(i);
+      const auto* b = alpha->FindFieldByNumber(a->number());
+      ASSERT_NE(b, nullptr) << name << "." << a->name();
+      EXPECT_EQ(a->name(), b->name());
+      EXPECT_EQ(a->type(), b->type()) << name << "." << a->name();
+      EXPECT_EQ(a->is_repeated(), b->is_repeated()) << name << "." << a->name();
+    }
+  }
+
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--token", "secret"}));
+  auto stub = grpc::reflection::v1::ServerReflection::NewStub(
+      grpc::CreateChannel(server.address, grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  auto stream = stub->ServerReflectionInfo(&context);
+  grpc::reflection::v1::ServerReflectionRequest request;
+  grpc::reflection::v1::ServerReflectionResponse response;
+  request.set_list_services("");
+  ASSERT_TRUE(stream->Write(request));
+  ASSERT_TRUE(stream->Read(&response));
+  std::vector<std::string> services;
+  for (const auto& service : response.list_services_response().service())
+    services.push_back(service.name());
+  EXPECT_NE(std::find(services.begin(), services.end(), "tumble.v1.World"), services.end());
+  EXPECT_NE(std::find(services.begin(), services.end(), "grpc.reflection.v1.ServerReflection"),
+            services.end());
+
+  request.set_file_containing_symbol("tumble.v1.World.SpawnBodies");
+  ASSERT_TRUE(stream->Write(request));
+  ASSERT_TRUE(stream->Read(&response));
+  const auto& files = response.file_descriptor_response().file_descriptor_proto();
+  ASSERT_GE(files.size(), 1);
+  google::protobuf::FileDescriptorProto last;
+  ASSERT_TRUE(last.ParseFromString(files[files.size() - 1]));  // imports come first
+  EXPECT_EQ(last.name(), "tumble/v1/world.proto");
+
+  request.set_file_containing_symbol("tumble.v1.NoSuchThing");
+  ASSERT_TRUE(stream->Write(request));
+  ASSERT_TRUE(stream->Read(&response));
+  EXPECT_EQ(response.error_response().error_code(), grpc::StatusCode::NOT_FOUND);
+  stream->WritesDone();
+  EXPECT_TRUE(stream->Finish().ok());
 }
 
 TEST(CommandLine, ImpulsesStatesAndSleepingFromTheCli) {

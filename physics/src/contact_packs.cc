@@ -84,9 +84,7 @@ TUMBLE_INLINE void pack_point(const LaneRows& rows, const LaneRows& friction_row
 
 }  // namespace
 
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+TUMBLE_PER_CPU
 void pack_manifolds(const std::uint32_t (&manifolds)[kWideLanes],
                     std::span<const std::uint32_t> row_begin, std::span<const ContactRow> rows,
                     std::span<const NormalBlock> blocks, std::span<const SolverBody> bodies,
@@ -400,9 +398,7 @@ void set_packed_sweeps(bool on) {
   sweep_packs.store(on, std::memory_order_relaxed);
 }
 
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+TUMBLE_PER_CPU
 void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep) {
   WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);
   const WidePair motion =
@@ -422,9 +418,7 @@ void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_
   scatter(pack, kAllLanes, pair, bodies);
 }
 
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+TUMBLE_PER_CPU
 void update_separations(ContactPack& pack, std::span<const SolverBody> bodies) {
   const WidePair motion =
       gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
@@ -432,9 +426,7 @@ void update_separations(ContactPack& pack, std::span<const SolverBody> bodies) {
     set_substep_separation(pack, motion, pack.point[p]);
 }
 
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+TUMBLE_PER_CPU
 void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies, double h,
                     double (&lane_residuals)[kWideLanes]) {
   const WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);
@@ -461,9 +453,7 @@ void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies,
 // program loads: the same operations lane by lane, so the same bits on either.
 // (Vectors cross its boundary by reference: GCC gives the clones one calling convention only
 // that way.)
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+TUMBLE_PER_CPU
 double
 solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
            const SolverSettings& settings, const Softness* soft, double h, double* lane_changes) {

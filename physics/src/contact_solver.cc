@@ -95,9 +95,7 @@ void invert_positive_definite(const Eigen::Matrix4d& k, int count, Eigen::Matrix
 
 }  // namespace
 
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+TUMBLE_PER_CPU
 void prepare_rows(const ContactManifold& manifold, std::uint32_t solver_a, const Body& a,
                   std::uint32_t solver_b,
                   const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,

@@ -18,9 +18,7 @@ using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eig
 // island's solve). Four doubles at a time in the AVX2 clone; element by element the same
 // operation as Eigen's row update (a - c * b, no fused multiply-add), so the same bits on any
 // machine.
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+TUMBLE_PER_CPU
 void eliminate(double* rows, int n, int pivot_row, const double* column) {
   const double* pivot = rows + static_cast<std::ptrdiff_t>(pivot_row) * n;
   for (int i = 0; i < n; ++i) {

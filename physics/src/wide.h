@@ -16,6 +16,16 @@
 // build, which inlines less). It also keeps the solver's small parts in its innermost loops.
 #define TUMBLE_INLINE inline __attribute__((always_inline))
 
+// The hot loops are built twice, for AVX2 and for any x86-64, and the loader picks one per
+// machine (an ifunc). ThreadSanitizer instruments the ifunc's resolver, which the loader runs
+// before the sanitizer's runtime has started, and the program died before main: a
+// ThreadSanitizer build takes the portable loops alone.
+#if defined(__x86_64__) && !defined(__SANITIZE_THREAD__)
+#define TUMBLE_PER_CPU __attribute__((target_clones("avx2", "default")))
+#else
+#define TUMBLE_PER_CPU
+#endif
+
 // GCC warns that passing these vectors by value has another ABI with AVX than without; every
 // function taking or returning one is inlined, so no call passes them.
 #pragma GCC diagnostic ignored "-Wpsabi"
