@@ -34,7 +34,7 @@ std::shared_ptr<const Catalogue> updated_catalogue(HostedWorld& hosted,
   return fresh;
 }
 
-std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted,
+std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted, double dt,
                                             std::shared_ptr<const Catalogue> catalogue) {
   const World& world = hosted.world;
   auto frame = std::make_shared<FrameData>();
@@ -87,7 +87,7 @@ std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted,
     }
   };
   add_contacts(world.contacts(), world.contact_impulses(), 1.0);
-  add_contacts(world.resting_contacts(), world.resting_contact_forces(), hosted.dt);
+  add_contacts(world.resting_contacts(), world.resting_contact_forces(), dt);
   return frame;
 }
 

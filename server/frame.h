@@ -59,8 +59,10 @@ std::shared_ptr<const Catalogue> updated_catalogue(HostedWorld& hosted,
                                                    std::shared_ptr<const Catalogue> current,
                                                    std::uint64_t current_epoch);
 
-// The frame of `hosted` as it is now.
-std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted,
+// The frame of `hosted` as it is now. `dt`: the step's, which turns the resting contacts' forces
+// into the impulses of a step (passed in: the host changes hosted.dt under its lock, and the
+// stepping thread builds frames without it).
+std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted, double dt,
                                             std::shared_ptr<const Catalogue> catalogue);
 
 }  // namespace tumble::server

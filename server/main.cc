@@ -232,9 +232,9 @@ int main(int argc, char** argv) {
   int port = 0;
   builder.AddListeningPort(listen, credentials, &port);
   service.register_on(builder);
-  server::ReflectionV1 reflection_v1(
-      {v1::World::service_full_name(), "grpc.health.v1.Health",
-       "grpc.reflection.v1alpha.ServerReflection", "grpc.reflection.v1.ServerReflection"});
+  server::ReflectionV1 reflection_v1({v1::World::service_full_name(), "grpc.health.v1.Health",
+                                      "grpc.reflection.v1alpha.ServerReflection",
+                                      "grpc.reflection.v1.ServerReflection"});
   builder.RegisterService(&reflection_v1);
   std::unique_ptr<grpc::Server> grpc_server = builder.BuildAndStart();
   if (grpc_server == nullptr || port == 0) {

@@ -22,7 +22,7 @@ WorldHost::WorldHost(World world, double dt, double real_time_factor)
   status_.dt = dt;
   status_.real_time_factor = real_time_factor_;
   status_.settings = hosted_.world.settings();
-  last_frame_ = make_frame();  // the state before the first step
+  last_frame_ = make_frame(dt);  // the state before the first step
   thread_ = std::thread([this] { run(); });
 }
 
@@ -177,7 +177,7 @@ void WorldHost::apply_pending() {
     status_.settings = hosted_.world.settings();
     command.done.set_value(result);
   }
-  if (changed) publish(make_frame());
+  if (changed) publish(make_frame(hosted_.dt));
 }
 
 void WorldHost::refresh_catalogue() {
@@ -185,8 +185,8 @@ void WorldHost::refresh_catalogue() {
   catalogue_epoch_ = hosted_.epoch;
 }
 
-std::shared_ptr<const FrameData> WorldHost::make_frame() const {
-  return server::make_frame(hosted_, catalogue_);
+std::shared_ptr<const FrameData> WorldHost::make_frame(double dt) const {
+  return server::make_frame(hosted_, dt, catalogue_);
 }
 
 void WorldHost::run() {
@@ -254,7 +254,7 @@ void WorldHost::run() {
     lock.unlock();  // the world is this thread's alone; callers may queue meanwhile
     if (sink != nullptr) sink->wait_for_room();  // a lossless recording sets the pace
     const Status stepped = hosted_.world.step(dt);
-    std::shared_ptr<const FrameData> frame = stepped ? make_frame() : nullptr;
+    std::shared_ptr<const FrameData> frame = stepped ? make_frame(dt) : nullptr;
     lock.lock();
     in_step_ = false;
     paced_time += dt;

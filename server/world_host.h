@@ -98,7 +98,8 @@ class WorldHost {
   void refresh_catalogue();
   void run();
   void apply_pending();
-  std::shared_ptr<const FrameData> make_frame() const;
+  // `dt`: the step's (hosted_.dt is read under the lock; a frame is built without it).
+  std::shared_ptr<const FrameData> make_frame(double dt) const;
 
   HostedWorld hosted_;  // the world by the stepping thread only (commands run there); dt under
                         // the lock

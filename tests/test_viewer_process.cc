@@ -26,9 +26,11 @@ Png load(const std::string& path) {
 }
 
 std::string viewer(const Server& server, const std::string& out, int frames) {
+  // A fixed camera (without --eye and --target the viewer frames what it first sees), so that
+  // pictures of different steps compare.
   return std::string(TUMBLE_VIEWER_BINARY) + " --server " + server.address +
-         " --offscreen --size 320x180 --give-up-after 20 --out " + out + " --frames " +
-         std::to_string(frames);
+         " --offscreen --eye 8,-12,6 --target 0,0,1 --size 320x180 --give-up-after 20 --out " +
+         out + " --frames " + std::to_string(frames);
 }
 
 TEST(ViewerProcess, PicturesOfLaterStepsDifferWhereTheBodiesFell) {
@@ -154,7 +156,7 @@ TEST(ViewerProcess, TheWindowAndTheOffscreenPictureAgree) {
       run("ASAN_OPTIONS=detect_leaks=0 timeout 60 xvfb-run -a -s "
           "'-screen 0 1280x720x24' " +
           std::string(TUMBLE_VIEWER_BINARY) + " --server " + server.address +
-          " --size 320x180 --frames 3 --screenshot " + dir / "window.png");
+          " --eye 8,-12,6 --target 0,0,1 --size 320x180 --frames 3 --screenshot " + dir / "window.png");
   ASSERT_EQ(window.code, 0) << window.text;
   const Output offscreen = run(viewer(server, dir / "offscreen", 1));
   ASSERT_EQ(offscreen.code, 0) << offscreen.text;

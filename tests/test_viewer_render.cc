@@ -189,9 +189,60 @@ TEST_F(RenderTest, FramesBecomeInstancesWithAnOptionalContactOverlay) {
   EXPECT_FLOAT_EQ(model(0, 0), 1.0f);  // half of the 2 m size: the unit cube spans [-1, 1]
   EXPECT_FLOAT_EQ(model(0, 3), 1.0f);
   EXPECT_FLOAT_EQ(model(2, 3), 3.0f);
-  const auto overlay = view.instances(*renderer_, true);
-  EXPECT_EQ(overlay[renderer_->box_mesh()].size(), 3u);  // the body and two rods
+  const auto overlay = view.contact_overlay(*renderer_);
+  EXPECT_EQ(overlay[renderer_->box_mesh()].size(), 2u);  // two rods
   EXPECT_EQ(overlay[renderer_->sphere_mesh()].size(), 2u);
+  // Sized to the scene: a contact ball's radius is 1.5% of the radius of the sphere around the
+  // bodies (here the one box, centred at z = 3).
+  const auto around = view.bounds();
+  ASSERT_TRUE(around.has_value());
+  EXPECT_NEAR(around->first.z(), 3.0f, 1e-5f);
+  EXPECT_FLOAT_EQ(overlay[renderer_->sphere_mesh()][0].model(0, 0), 0.015f * around->second);
+}
+
+// Colours follow the order bodies were described in, not their ids: a world reset gives the same
+// bodies new ids, and they keep their colours. The camera frames what it sees.
+TEST_F(RenderTest, ColoursSurviveAResetAndTheCameraFramesTheBodies) {
+  auto describe = [](v1::Frame* frame, std::uint64_t id, double x) {
+    v1::BodyDescription* d = frame->add_added();
+    d->set_id(id);
+    d->mutable_shape()->mutable_sphere()->set_radius(0.5);
+    frame->add_ids(id);
+    for (double v : {x, 0.0, 10.0})
+      frame->add_positions(v);
+    for (double v : {1.0, 0.0, 0.0, 0.0})
+      frame->add_orientations(v);
+  };
+  WorldView view;
+  v1::Frame first;
+  for (std::uint64_t id : {1, 2, 3})
+    describe(&first, id, static_cast<double>(id));
+  view.apply(first);
+  const auto before = view.instances(*renderer_)[renderer_->sphere_mesh()];
+  v1::Frame reset;  // the same scene again, under new ids
+  for (std::uint64_t id : {1, 2, 3})
+    reset.add_removed(id);
+  for (std::uint64_t id : {10, 11, 12})
+    describe(&reset, id, static_cast<double>(id - 9));
+  view.apply(reset);
+  const auto after = view.instances(*renderer_)[renderer_->sphere_mesh()];
+  ASSERT_EQ(before.size(), 3u);
+  ASSERT_EQ(after.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_EQ(before[i].colour, after[i].colour) << i;
+  EXPECT_NE(before[0].colour, before[1].colour);
+
+  const auto around = view.bounds();
+  ASSERT_TRUE(around.has_value());
+  EXPECT_NEAR(around->first.x(), 2.0f, 1e-5f);
+  EXPECT_NEAR(around->first.z(), 10.0f, 1e-5f);
+  const Camera camera = framed(Camera(), around->first, around->second);
+  EXPECT_EQ(camera.target, around->first);
+  // The sphere fits the picture's height, with a margin.
+  const float distance = (camera.eye - camera.target).norm();
+  const float half_fov = 0.5f * camera.fov_y_degrees * static_cast<float>(M_PI) / 180;
+  EXPECT_GT(distance * std::sin(half_fov), around->second);
+  EXPECT_LT(distance * std::sin(half_fov), 1.2f * around->second);
 }
 
 #endif

@@ -56,8 +56,13 @@ int main(int argc, char** argv) {
       ->check(cli::non_negative);
   app.add_option("--video", video, "also encode the pictures into this video (needs ffmpeg)");
   app.add_option("--size", size, "WIDTHxHEIGHT");
-  app.add_option("--eye", eye, "camera position x,y,z (m)")->delimiter(',')->expected(3);
-  app.add_option("--target", target, "point looked at x,y,z (m)")->delimiter(',')->expected(3);
+  app.add_option("--eye", eye,
+                 "camera position x,y,z (m; default: framing the bodies from 8,-12,6)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--target", target, "point looked at x,y,z (m; default: the bodies' centre)")
+      ->delimiter(',')
+      ->expected(3);
   app.add_option("--give-up-after", give_up_after,
                  "seconds without a server before stopping (it reconnects meanwhile)");
   if (const int exit_status = cli::parse(app, argc, argv); exit_status >= 0) return exit_status;
@@ -89,6 +94,9 @@ int main(int argc, char** argv) {
   viewer::Camera camera;
   camera.eye = {eye[0], eye[1], eye[2]};
   camera.target = {target[0], target[1], target[2]};
+  // Without --eye or --target, the camera frames the bodies it first sees, from the default
+  // direction.
+  bool frame_the_scene = app.count("--eye") == 0 && app.count("--target") == 0;
   if (!offscreen) {
     viewer::WindowOptions options;
     options.width = width;
@@ -97,6 +105,7 @@ int main(int argc, char** argv) {
     options.screenshot = screenshot;
     options.frames = static_cast<int>(frames);
     options.contacts = contacts;
+    options.frame_the_scene = frame_the_scene;
     return viewer::run_window(*source, options);
   }
 
@@ -155,7 +164,15 @@ int main(int argc, char** argv) {
       } else if (received++ % every != 0) {
         continue;
       }
-      renderer.draw(view.instances(renderer, contacts), camera, lighting, width, height);
+      if (frame_the_scene) {  // once, on the first picture with bodies
+        if (const auto around = view.bounds()) {
+          camera = viewer::framed(camera, around->first, around->second);
+          frame_the_scene = false;
+        }
+      }
+      renderer.draw(
+          view.instances(renderer), camera, lighting, width, height,
+          contacts ? view.contact_overlay(renderer) : std::vector<std::vector<viewer::Instance>>{});
       const std::vector<std::uint8_t> picture = context.read_rgba();
       char name[64];
       std::snprintf(name, sizeof name, "frame-%05u.png", written);

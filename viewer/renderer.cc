@@ -137,7 +137,8 @@ int Renderer::add_mesh(const Mesh& mesh) {
 }
 
 void Renderer::draw(const std::vector<std::vector<Instance>>& instances, const Camera& camera,
-                    const Lighting& lighting, int width, int height) {
+                    const Lighting& lighting, int width, int height,
+                    const std::vector<std::vector<Instance>>& overlay) {
   gl_.Viewport(0, 0, width, height);
   gl_.ClearColor(lighting.background.x(), lighting.background.y(), lighting.background.z(), 1);
   gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -155,15 +156,23 @@ void Renderer::draw(const std::vector<std::vector<Instance>>& instances, const C
   gl_.Uniform1f(gl_.GetUniformLocation(program_, "ambient"), lighting.ambient);
   gl_.Uniform1f(gl_.GetUniformLocation(program_, "specular_strength"), lighting.specular);
   gl_.Uniform1f(gl_.GetUniformLocation(program_, "shininess"), lighting.shininess);
-  for (std::size_t m = 0; m < instances.size() && m < meshes_.size(); ++m) {
-    if (instances[m].empty()) continue;
-    const GpuMesh& mesh = meshes_[m];
-    gl_.BindVertexArray(mesh.vertex_array);
-    gl_.BindBuffer(GL_ARRAY_BUFFER, mesh.instances);
-    gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(instances[m].size() * sizeof(Instance)),
-                   instances[m].data(), GL_STREAM_DRAW);
-    gl_.DrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr,
-                              static_cast<GLsizei>(instances[m].size()));
+  const auto draw_all = [&](const std::vector<std::vector<Instance>>& by_mesh) {
+    for (std::size_t m = 0; m < by_mesh.size() && m < meshes_.size(); ++m) {
+      if (by_mesh[m].empty()) continue;
+      const GpuMesh& mesh = meshes_[m];
+      gl_.BindVertexArray(mesh.vertex_array);
+      gl_.BindBuffer(GL_ARRAY_BUFFER, mesh.instances);
+      gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(by_mesh[m].size() * sizeof(Instance)),
+                     by_mesh[m].data(), GL_STREAM_DRAW);
+      gl_.DrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr,
+                                static_cast<GLsizei>(by_mesh[m].size()));
+    }
+  };
+  draw_all(instances);
+  if (!overlay.empty()) {
+    // Over everything drawn so far, still depth-tested among themselves.
+    gl_.Clear(GL_DEPTH_BUFFER_BIT);
+    draw_all(overlay);
   }
   gl_.BindVertexArray(0);
 }

@@ -48,8 +48,11 @@ class Renderer {
   int ground_mesh() const { return ground_; }
 
   // instances[m]: the instances of mesh m this frame (missing or empty: not drawn).
+  // `overlay` (by mesh, as `instances`) is drawn over everything else: markers that must show
+  // inside a pile.
   void draw(const std::vector<std::vector<Instance>>& instances, const Camera& camera,
-            const Lighting& lighting, int width, int height);
+            const Lighting& lighting, int width, int height,
+            const std::vector<std::vector<Instance>>& overlay = {});
 
  private:
   struct GpuMesh {

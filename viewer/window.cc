@@ -163,7 +163,7 @@ int run_window(FrameSource& source, const WindowOptions& options) {
 
     const Lighting lighting;
     std::uint64_t following = 0;
-    bool running = true, contacts = options.contacts;
+    bool running = true, contacts = options.contacts, frame_the_scene = options.frame_the_scene;
     int drawn = 0;
     auto second = std::chrono::steady_clock::now();
     int frames_this_second = 0;
@@ -184,7 +184,7 @@ int run_window(FrameSource& source, const WindowOptions& options) {
       }
       int width = 0, height = 0;
       glfwGetFramebufferSize(window, &width, &height);
-      std::vector<std::vector<Instance>> instances;
+      std::vector<std::vector<Instance>> instances, overlay;
       std::uint64_t step = 0;
       double time = 0;
       std::size_t bodies = 0;
@@ -200,13 +200,22 @@ int run_window(FrameSource& source, const WindowOptions& options) {
           if (const auto at = view.position_of(following)) orbit.target = *at;
         if (input.contact_toggles % 2 == 1) contacts = !contacts;
         input.contact_toggles = 0;
-        instances = view.instances(renderer, contacts);
+        if (frame_the_scene)
+          if (const auto around = view.bounds()) {
+            const Camera framed_camera =
+                framed(orbit.camera(options.camera), around->first, around->second);
+            orbit.target = framed_camera.target;
+            orbit.distance = (framed_camera.eye - framed_camera.target).norm();
+            frame_the_scene = false;
+          }
+        instances = view.instances(renderer);
+        if (contacts) overlay = view.contact_overlay(renderer);
         showing_world = connected;
         step = view.step();
         time = view.time();
         bodies = view.body_count();
       }
-      renderer.draw(instances, orbit.camera(options.camera), lighting, width, height);
+      renderer.draw(instances, orbit.camera(options.camera), lighting, width, height, overlay);
       // The screenshot counts pictures of the world only: a loaded machine may draw several
       // before the first frame arrives.
       if (showing_world) ++drawn;

@@ -18,6 +18,8 @@ struct WindowOptions {
   std::string screenshot;
   int frames = 0;
   bool contacts = false;  // the overlay at start
+  // Frame the bodies of the first frame (the camera's direction kept); false keeps the camera.
+  bool frame_the_scene = false;
 };
 
 // Runs until the window is closed; the exit code.

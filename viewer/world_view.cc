@@ -1,8 +1,11 @@
 #include "world_view.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace tumble::viewer {
 
-Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t id, bool is_static) {
+Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t ordinal, bool is_static) {
   if (rgba != 0)
     return {static_cast<float>(rgba >> 24 & 0xFF) / 255,
             static_cast<float>(rgba >> 16 & 0xFF) / 255, static_cast<float>(rgba >> 8 & 0xFF) / 255,
@@ -11,7 +14,42 @@ Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t id, bool is_static
   static const Eigen::Vector4f palette[] = {{0.90f, 0.45f, 0.20f, 1}, {0.25f, 0.55f, 0.85f, 1},
                                             {0.35f, 0.70f, 0.35f, 1}, {0.85f, 0.75f, 0.25f, 1},
                                             {0.65f, 0.40f, 0.75f, 1}, {0.85f, 0.35f, 0.40f, 1}};
-  return palette[(id & 0xFFFFFFFFu) % std::size(palette)];
+  return palette[ordinal % std::size(palette)];
+}
+
+Camera framed(const Camera& camera, const Eigen::Vector3f& centre, float radius) {
+  Camera out = camera;
+  Eigen::Vector3f back = camera.eye - camera.target;
+  if (back.norm() < 1e-6f) back = Eigen::Vector3f(0.5f, -0.75f, 0.4f);
+  const float half_fov = 0.5f * camera.fov_y_degrees * static_cast<float>(M_PI) / 180;
+  // 10% of margin; never inside the sphere.
+  const float distance = std::max(1.1f * radius / std::sin(half_fov), radius + camera.near_plane);
+  out.target = centre;
+  out.eye = centre + distance * back.normalized();
+  return out;
+}
+
+std::optional<std::pair<Eigen::Vector3f, float>> WorldView::bounds() const {
+  Eigen::Vector3f low = Eigen::Vector3f::Constant(INFINITY), high = -low;
+  for (const auto& [id, pose] : poses_) {
+    const auto look = looks_.find(id);
+    if (look == looks_.end() || look->second.shape().has_plane()) continue;
+    const v1::Shape& shape = look->second.shape();
+    float reach = 0.5f;
+    if (shape.has_box())
+      reach = 0.5f * Eigen::Vector3f(static_cast<float>(shape.box().size().x()),
+                                     static_cast<float>(shape.box().size().y()),
+                                     static_cast<float>(shape.box().size().z()))
+                         .norm();
+    else if (shape.has_sphere())
+      reach = static_cast<float>(shape.sphere().radius());
+    else if (shape.has_capsule())
+      reach = static_cast<float>(shape.capsule().radius() + shape.capsule().half_height());
+    low = low.cwiseMin(pose.position - Eigen::Vector3f::Constant(reach));
+    high = high.cwiseMax(pose.position + Eigen::Vector3f::Constant(reach));
+  }
+  if (!(low.x() <= high.x())) return std::nullopt;
+  return std::pair{0.5f * (low + high), std::max(0.5f * (high - low).norm(), 0.1f)};
 }
 
 std::uint64_t WorldView::next_dynamic_body(std::uint64_t id) const {
@@ -38,9 +76,13 @@ void WorldView::apply(const v1::Frame& frame) {
   for (std::uint64_t id : frame.removed()) {
     looks_.erase(id);
     poses_.erase(id);
+    ordinals_.erase(id);
   }
-  for (const v1::BodyDescription& d : frame.added())
+  if (looks_.empty()) next_ordinal_ = 0;
+  for (const v1::BodyDescription& d : frame.added()) {
     looks_[d.id()] = d;
+    if (ordinals_.emplace(d.id(), next_ordinal_).second) ++next_ordinal_;
+  }
   contacts_ = frame.contacts();
   const int n = frame.ids_size();
   if (frame.positions_size() != 3 * n || frame.orientations_size() != 4 * n) return;
@@ -57,7 +99,7 @@ void WorldView::apply(const v1::Frame& frame) {
   }
 }
 
-std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer, bool contacts) {
+std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
   std::vector<std::vector<Instance>> out(3);
   auto add = [&](int mesh, const Instance& instance) {
     if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
@@ -68,7 +110,9 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer, bool
     if (look == looks_.end()) continue;  // not described yet
     const v1::BodyDescription& d = look->second;
     Instance instance;
-    instance.colour = body_colour(d.color(), id, d.type() == v1::BODY_TYPE_STATIC);
+    const auto ordinal = ordinals_.find(id);
+    instance.colour = body_colour(d.color(), ordinal != ordinals_.end() ? ordinal->second : id,
+                                  d.type() == v1::BODY_TYPE_STATIC);
     Eigen::Affine3f model = Eigen::Translation3f(pose.position) * pose.orientation;
     const v1::Shape& shape = d.shape();
     switch (shape.kind_case()) {
@@ -117,30 +161,40 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer, bool
         break;
     }
   }
+  return out;
+}
+
+std::vector<std::vector<Instance>> WorldView::contact_overlay(Renderer& renderer) const {
+  std::vector<std::vector<Instance>> out;
+  auto add = [&](int mesh, const Instance& instance) {
+    if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
+    out[mesh].push_back(instance);
+  };
+  const auto around = bounds();
+  const float ball = std::max(0.015f * (around ? around->second : 1.0f), 0.005f);
   const int points = contacts_.body_a_size();
-  if (contacts && contacts_.points_size() == 3 * points && contacts_.normals_size() == 3 * points) {
-    for (int i = 0; i < points; ++i) {
-      const Eigen::Vector3f p(static_cast<float>(contacts_.points(3 * i)),
-                              static_cast<float>(contacts_.points(3 * i + 1)),
-                              static_cast<float>(contacts_.points(3 * i + 2)));
-      const Eigen::Vector3f n = Eigen::Vector3f(static_cast<float>(contacts_.normals(3 * i)),
-                                                static_cast<float>(contacts_.normals(3 * i + 1)),
-                                                static_cast<float>(contacts_.normals(3 * i + 2)))
-                                    .normalized();
-      Instance point;
-      point.model = (Eigen::Translation3f(p) * Eigen::Scaling(0.04f)).matrix();
-      point.colour = {0.9f, 0.1f, 0.1f, 1};
-      add(renderer.sphere_mesh(), point);
-      // The rod: the unit cube squeezed to 1 cm and stretched to 0.2 m along the normal.
-      Instance rod;
-      const Eigen::Quaternionf turn =
-          Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), n);
-      rod.model = (Eigen::Translation3f(p + 0.1f * n) * turn *
-                   Eigen::Scaling(Eigen::Vector3f(0.005f, 0.005f, 0.1f)))
-                      .matrix();
-      rod.colour = {0.95f, 0.95f, 0.95f, 1};
-      add(renderer.box_mesh(), rod);
-    }
+  if (contacts_.points_size() != 3 * points || contacts_.normals_size() != 3 * points) return out;
+  for (int i = 0; i < points; ++i) {
+    const Eigen::Vector3f p(static_cast<float>(contacts_.points(3 * i)),
+                            static_cast<float>(contacts_.points(3 * i + 1)),
+                            static_cast<float>(contacts_.points(3 * i + 2)));
+    const Eigen::Vector3f n = Eigen::Vector3f(static_cast<float>(contacts_.normals(3 * i)),
+                                              static_cast<float>(contacts_.normals(3 * i + 1)),
+                                              static_cast<float>(contacts_.normals(3 * i + 2)))
+                                  .normalized();
+    Instance point;
+    point.model = (Eigen::Translation3f(p) * Eigen::Scaling(ball)).matrix();
+    point.colour = {0.95f, 0.1f, 0.1f, 1};
+    add(renderer.sphere_mesh(), point);
+    // The rod: the unit cube squeezed to a third of the ball and stretched to five balls along
+    // the normal.
+    Instance rod;
+    const Eigen::Quaternionf turn = Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), n);
+    rod.model = (Eigen::Translation3f(p + 2.5f * ball * n) * turn *
+                 Eigen::Scaling(Eigen::Vector3f(0.3f * ball, 0.3f * ball, 2.5f * ball)))
+                    .matrix();
+    rod.colour = {1, 1, 1, 1};
+    add(renderer.box_mesh(), rod);
   }
   return out;
 }

@@ -19,10 +19,17 @@ class WorldView {
  public:
   // Takes a frame: descriptions of added bodies, removals, and every pose in it.
   void apply(const v1::Frame& frame);
-  // Instances by the renderer's mesh handles (capsules get meshes of their own on first sight).
-  // With `contacts`, the last frame's contact points (small red balls) and normals (thin white
-  // rods, 0.2 m from the point along the normal) are added, when the stream carries them.
-  std::vector<std::vector<Instance>> instances(Renderer& renderer, bool contacts = false);
+  // The bodies as instances by the renderer's mesh handles (capsules get meshes of their own on
+  // first sight).
+  std::vector<std::vector<Instance>> instances(Renderer& renderer);
+  // The last frame's contacts, when the stream carries them, for Renderer::draw's overlay (drawn
+  // over the bodies, so that points inside a pile show): each point a red ball, its normal a
+  // white rod. Sized to the scene: the ball's radius is 1.5% of the radius of the sphere around the
+  // bodies (at least 5 mm), the rod five times that.
+  std::vector<std::vector<Instance>> contact_overlay(Renderer& renderer) const;
+  // A sphere around the bodies that move and the statics of finite size (not the ground), or
+  // nothing before the first frame with such bodies.
+  std::optional<std::pair<Eigen::Vector3f, float>> bounds() const;
 
   std::uint64_t step() const { return step_; }
   double time() const { return time_; }
@@ -41,11 +48,19 @@ class WorldView {
   std::map<std::pair<float, float>, int> capsule_meshes_;
   std::unordered_map<std::uint64_t, int> hull_meshes_;  // by body id: each hull its own mesh
   v1::Contacts contacts_;
+  // Each body's place in the order bodies were described, counted from the last time the view
+  // held none: a colour follows it, so a world reset (new ids, the same bodies) keeps its colours.
+  std::unordered_map<std::uint64_t, std::uint64_t> ordinals_;
+  std::uint64_t next_ordinal_ = 0;
   std::uint64_t step_ = 0;
   double time_ = 0;
 };
 
-// 0xRRGGBBAA as RGBA in [0, 1]; 0 picks a colour from a fixed palette by the body's id.
-Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t id, bool is_static);
+// 0xRRGGBBAA as RGBA in [0, 1]; 0 picks a colour from a fixed palette by the body's ordinal.
+Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t ordinal, bool is_static);
+
+// The camera moved back along its line of sight (or forward) so that the sphere fills the
+// picture's height, looking at its centre.
+Camera framed(const Camera& camera, const Eigen::Vector3f& centre, float radius);
 
 }  // namespace tumble::viewer
