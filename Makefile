@@ -63,6 +63,7 @@ report:
 	@scripts/install-deps core service viewer bench report
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release >/dev/null
 	@cmake --build $(BUILD_DIR) -j $(JOBS) --target tumble-report
+	@$(if $(QUICK),,echo "report: rewrites the committed docs/report/ (git diff docs/report shows what changed); QUICK=1 writes into $(BUILD_DIR)/report-quick instead")
 	@$(BUILD_DIR)/bench/tumble-report $(if $(QUICK),--quick) --out $(REPORT_DIR) \
 	  --commit $$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 	@/usr/bin/python3 scripts/report-plots $(REPORT_DIR)
