@@ -96,6 +96,17 @@ TEST(CommandLine, OpenMpThreadsWaitPassivelyUnlessTheUserChose) {
   EXPECT_NE(chosen.text.find("2 threads waiting active"), std::string::npos) << chosen.text;
 }
 
+#ifdef TUMBLE_DDS_ECHO_BINARY
+// With nothing to hear, tumble-dds-echo says so after 5 s (and keeps listening until --timeout),
+// instead of waiting in silence.
+TEST(CommandLine, DdsEchoSaysWhenNothingArrives) {
+  const Output silent = run(std::string(TUMBLE_DDS_ECHO_BINARY) + " --domain 201 --timeout 6");
+  EXPECT_EQ(silent.code, 0) << silent.text;
+  EXPECT_NE(silent.text.find("nothing received on domain 201 in 5 s"), std::string::npos)
+      << silent.text;
+}
+#endif
+
 TEST(CommandLine, ASecondServerOnATakenPortFailsNamingIt) {
   Server first;
   ASSERT_NO_FATAL_FAILURE(first.start({"--paused"}));
