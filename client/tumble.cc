@@ -3,11 +3,13 @@
 //   tumble --server 127.0.0.1:50051 spawn box --size 1,1,1 --mass 2 --pos 0,0,5
 //   tumble stream --format jsonl --frames 100
 // `tumble COMMAND --help` describes each command.
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "client.h"
@@ -108,19 +110,13 @@ void print_frame(const v1::Frame& frame, const StreamOptions& options) {
   std::fflush(stdout);
 }
 
-const char* solver_name(v1::SolverKind kind) {
-  switch (kind) {
-    case v1::SOLVER_KIND_EXACT:
-      return "exact";
-    case v1::SOLVER_KIND_PGS:
-      return "pgs";
-    case v1::SOLVER_KIND_SOFT:
-      return "soft";
-    case v1::SOLVER_KIND_AUTO:
-      return "auto";
-    default:
-      return "unknown";
-  }
+// "exact" for SOLVER_KIND_EXACT: the enum's own names, lowercase, without the prefix.
+std::string solver_name(v1::SolverKind kind) {
+  std::string name = v1::SolverKind_Name(kind);
+  name.erase(0, std::string_view("SOLVER_KIND_").size());
+  for (char& c : name)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return name;
 }
 
 std::optional<v1::SolverKind> solver_kind(const std::string& name) {
