@@ -23,7 +23,9 @@ class TumbleSimulation final : public Simulation {
         settings_ = "pgs, " + std::to_string(s.iterations) + " iterations";
         break;
       case SolverKind::kAuto:
-        settings_ = "exact <= " + std::to_string(s.exact_max_points) + " points, else soft";
+        settings_ = "soft; exact where soft would differ (<= " +
+                    std::to_string(s.exact_max_points) +
+                    " points, a mass ratio > 4 or a body under 100 soft sags)";
         break;
       case SolverKind::kExact:
         settings_ = "Lemke, " + std::to_string(s.friction_directions) + "-sided friction pyramid";
