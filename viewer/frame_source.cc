@@ -37,16 +37,8 @@ Result<std::unique_ptr<RecordingSource>> RecordingSource::open_file(const std::s
 }
 
 void RecordingSource::open() {
-  if (!reader_) {
-    Result<client::RecordingReader> reader = client::RecordingReader::open(path_);
-    if (!reader) {
-      status_ = reader.status();
-      return;
-    }
-    reader_.emplace(std::move(reader).value());
-  }
   first_time_ = -1;
-}
+}  // the file is opened once, by open_file
 
 bool RecordingSource::next(v1::Frame* frame) {
   if (!reader_ || !reader_->next(frame)) {
