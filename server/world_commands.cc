@@ -1,0 +1,261 @@
+#include "world_commands.h"
+
+#include <unordered_set>
+
+#include "convert.h"
+#include "request_bounds.h"
+#include "scenes/standard.h"
+#include "tumble/v1/snapshot.pb.h"
+
+namespace tumble::server {
+namespace {
+
+std::string entry(const char* list, int i) {
+  return std::string(list) + "[" + std::to_string(i) + "]";
+}
+
+Vec3 vec(const v1::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+void set_vec(const Vec3& v, v1::Vec3* out) {
+  out->set_x(v.x());
+  out->set_y(v.y());
+  out->set_z(v.z());
+}
+
+BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
+  BodyMotion motion;
+  if (update.has_position()) motion.position = vec(update.position());
+  if (update.has_orientation()) {
+    const v1::Quat& q = update.orientation();
+    motion.orientation = Quat(q.w(), q.x(), q.y(), q.z());
+  }
+  if (update.has_linear_velocity()) motion.linear_velocity = vec(update.linear_velocity());
+  if (update.has_angular_velocity()) motion.angular_velocity = vec(update.angular_velocity());
+  return motion;
+}
+
+// The body each entry's id names, refusing the first unknown one ("updates[2].id: no body 9").
+template <class Entries>
+Status find_entries(const HostedWorld& hosted, const char* list, const Entries& entries,
+                    std::vector<BodyId>* ids) {
+  ids->reserve(entries.size());
+  for (int i = 0; i < entries.size(); ++i) {
+    const BodyId id = hosted.ids.find(entries[i].id());
+    if (!hosted.world.contains(id))
+      return Status::not_found(entry(list, i) + ".id: no body " + std::to_string(entries[i].id()));
+    ids->push_back(id);
+  }
+  return Status::ok();
+}
+
+}  // namespace
+
+Status find_bodies(const HostedWorld& hosted, const WireIds& wire_ids, std::vector<BodyId>* ids) {
+  for (int i = 0; i < wire_ids.size(); ++i) {
+    const BodyId id = hosted.ids.find(wire_ids[i]);
+    if (!hosted.world.contains(id))
+      return Status::not_found(entry("ids", i) + ": no body " + std::to_string(wire_ids[i]));
+    ids->push_back(id);
+  }
+  return Status::ok();
+}
+
+Status refuse_repeats(const WireIds& ids) {
+  std::unordered_set<std::uint64_t> seen;
+  seen.reserve(static_cast<std::size_t>(ids.size()));
+  for (int i = 0; i < ids.size(); ++i)
+    if (!seen.insert(ids[i]).second) return Status::error(entry("ids", i) + ": listed twice");
+  return Status::ok();
+}
+
+Result<std::vector<BodyDef>> body_defs(const v1::SpawnBodiesRequest& request) {
+  std::vector<BodyDef> defs;
+  defs.reserve(request.bodies_size());
+  for (int i = 0; i < request.bodies_size(); ++i) {
+    Result<BodyDef> def = body_from_proto(request.bodies(i));
+    if (!def) return Status::error(entry("bodies", i) + "." + def.error());
+    defs.push_back(std::move(def).value());
+  }
+  return defs;
+}
+
+Status spawn_bodies(HostedWorld& hosted, const std::vector<BodyDef>& defs,
+                    const v1::SpawnBodiesRequest& request, std::size_t max_bodies,
+                    std::vector<std::uint64_t>* ids) {
+  World& world = hosted.world;
+  if (world.body_count() + defs.size() > max_bodies)
+    return Status::error("bodies: " + std::to_string(defs.size()) + " more would exceed the " +
+                             std::to_string(max_bodies) + " bodies allowed",
+                         StatusCode::kResourceExhausted);
+  Result<std::vector<BodyId>> made = world.create_bodies(defs);
+  if (!made) return made.status();
+  hosted.ids.sync(world);
+  for (std::size_t i = 0; i < made.value().size(); ++i) {
+    hosted.set_colour(made.value()[i], request.bodies(static_cast<int>(i)).color());
+    ids->push_back(hosted.ids.wire(made.value()[i]));
+  }
+  return Status::ok();
+}
+
+Status remove_bodies(HostedWorld& hosted, const WireIds& wire_ids) {
+  if (Status twice = refuse_repeats(wire_ids); !twice) return twice;
+  // Every id is checked before anything is removed: all or nothing.
+  std::vector<BodyId> ids;
+  if (Status found = find_bodies(hosted, wire_ids, &ids); !found) return found;
+  for (BodyId id : ids)
+    hosted.world.remove_body(id);
+  return Status::ok();
+}
+
+Status get_bodies(const HostedWorld& hosted, const v1::GetBodiesRequest& request,
+                  v1::GetBodiesResponse* response) {
+  // An id asked for twice would be answered twice: the reply could grow past any bound.
+  if (Status twice = refuse_repeats(request.ids()); !twice) return twice;
+  const World& world = hosted.world;
+  std::vector<BodyId> ids;
+  if (request.ids_size() == 0) {
+    for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot)
+      if (world.id_at(slot).is_valid()) ids.push_back(world.id_at(slot));
+  } else if (Status found = find_bodies(hosted, request.ids(), &ids); !found) {
+    return found;
+  }
+  response->set_step(world.step_count());
+  for (BodyId id : ids) {
+    const BodyView body = world.body(id);
+    const std::uint32_t colour = id.index < hosted.colours.size() ? hosted.colours[id.index] : 0;
+    describe(hosted.ids.wire(id), look_of(body, colour), response->add_descriptions());
+    v1::BodyState* state = response->add_states();
+    state->set_id(hosted.ids.wire(id));
+    set_vec(body.position(), state->mutable_position());
+    const Quat q = body.orientation();
+    state->mutable_orientation()->set_w(q.w());
+    state->mutable_orientation()->set_x(q.x());
+    state->mutable_orientation()->set_y(q.y());
+    state->mutable_orientation()->set_z(q.z());
+    set_vec(body.linear_velocity(), state->mutable_linear_velocity());
+    set_vec(body.angular_velocity(), state->mutable_angular_velocity());
+    state->set_asleep(body.asleep());
+  }
+  return Status::ok();
+}
+
+Status set_body_states(HostedWorld& hosted, const v1::SetBodyStateRequest& request) {
+  std::vector<BodyId> ids;
+  if (Status found = find_entries(hosted, "updates", request.updates(), &ids); !found) return found;
+  for (int i = 0; i < request.updates_size(); ++i)
+    if (Status s = hosted.world.check_motion(ids[i], motion_from_proto(request.updates(i))); !s)
+      return s.within(entry("updates", i) + ".");
+  for (int i = 0; i < request.updates_size(); ++i)
+    hosted.world.set_motion(ids[i], motion_from_proto(request.updates(i)));
+  return Status::ok();
+}
+
+Status apply_impulses(HostedWorld& hosted, const v1::ApplyImpulseRequest& request) {
+  std::vector<BodyId> ids;
+  if (Status found = find_entries(hosted, "impulses", request.impulses(), &ids); !found)
+    return found;
+  std::vector<ImpulseAt> impulses;
+  impulses.reserve(ids.size());
+  for (int i = 0; i < request.impulses_size(); ++i) {
+    const v1::Impulse& impulse = request.impulses(i);
+    impulses.push_back(
+        {ids[i], vec(impulse.impulse()),
+         impulse.has_point() ? std::optional<Vec3>(vec(impulse.point())) : std::nullopt});
+  }
+  // Several impulses on one body add up, and are checked as their sum: all or nothing.
+  if (Status s = hosted.world.apply_impulses(impulses); !s) return s.within("impulses");
+  return Status::ok();
+}
+
+Result<SceneDef> scene_of(const v1::LoadSceneRequest& request, std::size_t max_bodies) {
+  Result<SceneDef> scene = Status::error("source: required (scene_json or builtin)");
+  if (request.has_scene_json())
+    scene = parse_scene(request.scene_json(), max_bodies);
+  else if (request.has_builtin())
+    scene = standard_scene(request.builtin(), max_bodies);
+  if (!scene) {
+    const char* field = request.has_scene_json() ? "scene_json: "
+                        : request.has_builtin()  ? "builtin: "
+                                                 : "";
+    return scene.status().within(field);
+  }
+  return scene;
+}
+
+Result<World> world_of_scene(SceneDef scene, const WorldLimits& limits, std::size_t max_bodies) {
+  scene.world.limits = limits;
+  if (Status t = check_time_step(scene.dt, limits); !t)
+    return Status::error("scene: " + t.message());
+  if (scene.bodies.size() > max_bodies)
+    return Status::error("scene: " + std::to_string(scene.bodies.size()) +
+                             " bodies, more than the " + std::to_string(max_bodies) + " allowed",
+                         StatusCode::kResourceExhausted);
+  Result<World> made = make_world(scene);
+  if (!made) return Status::error("scene: " + made.error());
+  return made;
+}
+
+Status replace_world(HostedWorld& hosted, World world, double dt, std::vector<std::uint64_t>* ids) {
+  WorldSettings settings = world.settings();
+  settings.threads = hosted.world.settings().threads;  // the host's choice, not the scene's
+  if (Status s = world.set_settings(settings); !s) return s;
+  hosted.replace(std::move(world), dt, {});
+  for (std::uint32_t slot = 0; slot < hosted.world.slot_count(); ++slot)
+    if (const BodyId id = hosted.world.id_at(slot); id.is_valid())
+      ids->push_back(hosted.ids.wire(id));
+  return Status::ok();
+}
+
+SavedWorld save_world(const HostedWorld& hosted) {
+  return {hosted.world.settings(), hosted.world.save_state(), hosted.dt,
+          hosted.colours,          hosted.ids.by_slot(),      hosted.ids.next(),
+          hosted.server_instance};
+}
+
+Result<RestoredWorld> decode_restore(std::string_view bytes, const WorldLimits& limits,
+                                     std::size_t max_bodies) {
+  // The snapshot's slots (live or free) are counted, and what decoding it would take is
+  // bounded, before it is decoded: every slot costs memory and every step's time.
+  const Result<WireScan> scan = scan_wire(bytes, *v1::snapshot::WorldSnapshot::descriptor(),
+                                          parsed_bound(bytes.size()), max_bodies);
+  if (!scan) {
+    if (scan.status().code() == StatusCode::kResourceExhausted)
+      return Status::error("state: " + scan.error() + " (slots, live or free, count against the " +
+                               std::to_string(max_bodies) + " bodies allowed)",
+                           StatusCode::kResourceExhausted);
+    return Status::error("state: not a snapshot (" + scan.error() + ")");
+  }
+  Result<SavedWorld> decoded = decode_snapshot(bytes);
+  if (!decoded) return Status::error("state." + decoded.error());
+  SavedWorld& saved = decoded.value();
+  saved.settings.limits = limits;
+  if (Status t = check_time_step(saved.dt, limits); !t)
+    return Status::error("state." + t.message());
+  Result<World> world = World::from_state(saved.settings, std::move(saved.state));
+  if (!world) return Status::error("state." + world.error());
+  return RestoredWorld{std::move(world).value(), std::move(saved)};
+}
+
+Status restore_world(HostedWorld& hosted, RestoredWorld restored,
+                     google::protobuf::Map<std::uint64_t, std::uint64_t>* new_ids) {
+  World& world = restored.world;
+  SavedWorld& saved = restored.saved;
+  WorldSettings settings = world.settings();
+  settings.threads = hosted.world.settings().threads;  // the host's choice
+  if (Status t = world.set_settings(settings); !t) return t;
+  if (saved.server_instance == hosted.server_instance) {
+    // Ids this host gave to these very bodies: they keep them.
+    hosted.restore(std::move(world), saved.dt, std::move(saved.colours), saved.ids, saved.next_id);
+    return Status::ok();
+  }
+  // Another host's ids could name bodies of ours: every body gets a new one.
+  hosted.replace(std::move(world), saved.dt, std::move(saved.colours));
+  for (std::uint32_t slot = 0; slot < saved.ids.size(); ++slot)
+    if (const BodyId id = hosted.world.id_at(slot); id.is_valid() && saved.ids[slot] != 0)
+      (*new_ids)[saved.ids[slot]] = hosted.ids.wire(id);
+  return Status::ok();
+}
+
+}  // namespace tumble::server
