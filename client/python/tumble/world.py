@@ -1,4 +1,6 @@
-"""A connection to one Tumble server and the world it steps (the tumble.v1.World service)."""
+"""The world's calls (WorldCalls), shared by a connection to a Tumble server and the world it
+steps (RemoteWorld, the tumble.v1.World service) and the engine in this process (tumble.World,
+tumble/local.py): both take and answer the same tumble.v1 messages."""
 
 import json
 import os
@@ -7,6 +9,7 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import grpc
+import numpy as np
 
 from tumble import convert
 from tumble.bodies import Body, BodySpec, aliased
@@ -79,6 +82,23 @@ class LoadedScene:
     ids: list  # the scene's bodies, in its order
 
 
+@dataclass
+class States:
+    """Bodies' states as parallel arrays: ids[i] is at positions[i] (m, centre of mass) with
+    orientations[i] (w, x, y, z), linear_velocities[i] (m/s) and angular_velocities[i] (rad/s,
+    world); asleep[i] says whether it sleeps."""
+
+    ids: np.ndarray  # (N,) uint64
+    positions: np.ndarray  # (N, 3)
+    orientations: np.ndarray  # (N, 4)
+    linear_velocities: np.ndarray  # (N, 3)
+    angular_velocities: np.ndarray  # (N, 3)
+    asleep: np.ndarray  # (N,) bool
+
+    def __len__(self):
+        return len(self.ids)
+
+
 def connect(address=None, token=None, *, tls_ca=None, timeout=5.0):
     """Connects to a Tumble server and checks that it answers: an unreachable server, or one
     that refuses the token, raises tumble.Error here (naming the address), not on first use.
@@ -102,7 +122,7 @@ def connect(address=None, token=None, *, tls_ca=None, timeout=5.0):
         channel = grpc.secure_channel(address, grpc.ssl_channel_credentials(authority), options)
     else:
         channel = grpc.insecure_channel(address, options)
-    world = World(channel, address, token)
+    world = RemoteWorld(channel, address, token)
     try:
         world._rpc("GetInfo", pb.GetInfoRequest(), timeout=timeout)
     except Error as error:
@@ -112,19 +132,12 @@ def connect(address=None, token=None, *, tls_ca=None, timeout=5.0):
     return world
 
 
-class World:
-    """The world of one server. Every change is applied between two steps, all at once: a refused
-    call raises tumble.Error and leaves the world exactly as it was."""
+class WorldCalls:
+    """What a world answers, remote or in this process. Every change is applied between two steps,
+    all at once: a refused call raises tumble.Error and leaves the world exactly as it was."""
 
-    def __init__(self, channel, address, token=None):
-        self.address = address
-        self._channel = channel
-        self._stub = pb_grpc.WorldStub(channel)
-        self._raw_frames = channel.unary_stream(
-            "/tumble.v1.World/StreamFrames",
-            request_serializer=pb.StreamFramesRequest.SerializeToString,
-            response_deserializer=None)
-        self._metadata = (("authorization", f"Bearer {token}"),) if token else ()
+    def _rpc(self, method, request, timeout=None):
+        raise NotImplementedError
 
     # --- bodies -------------------------------------------------------------------------------
 
@@ -283,25 +296,7 @@ class World:
                     plain(response.last_step), response.subscribers,
                     response.achieved_real_time_factor, response.behind)
 
-    # --- frames, snapshots --------------------------------------------------------------------
-
-    def frames(self, rate=0.0, velocities=False, contacts=False, stats=False, ids=(), count=None,
-               duration=None):
-        """Subscribes to the world's frames: every step's, or at most `rate` per second. A slow
-        reader loses frames (Frame.dropped counts them), never slows the world. Frames come only
-        while the world steps. The subscription ends after `count` frames or `duration` seconds,
-        whichever comes first (default: when closed or when the server stops)."""
-        request = pb.StreamFramesRequest(max_rate=convert.number(rate, "rate"),
-                                         velocities=bool(velocities), contacts=bool(contacts),
-                                         stats=bool(stats), ids=convert.ids(ids))
-        if count is not None and (isinstance(count, bool) or not isinstance(count, int)
-                                  or count < 0):
-            raise ArgumentError(f"count: expected an integer >= 0, got {count!r}", "frames")
-        if duration is not None:
-            duration = convert.number(duration, "duration")
-        # Undecoded: FrameStream reads the arrays from the bytes (tumble.wire).
-        call = self._raw_frames(request, metadata=self._metadata, timeout=duration)
-        return FrameStream(call, request, count, duration is not None, "frames")
+    # --- snapshots ---------------------------------------------------------------------------
 
     def snapshot(self):
         response = self._rpc("Snapshot", pb.SnapshotRequest())
@@ -315,17 +310,6 @@ class World:
             raise ArgumentError(f"snapshot: expected a Snapshot or bytes, got {type(state)!r}",
                                 "restore")
         return dict(self._rpc("Restore", pb.RestoreRequest(state=bytes(state))).new_ids)
-
-    # --- the connection -----------------------------------------------------------------------
-
-    def close(self):
-        self._channel.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
     def _control(self, request):
         return self._rpc("Control", request)
@@ -345,6 +329,115 @@ class World:
 
     def _loaded(self, response):
         return LoadedScene(response.name, list(response.ids))
+
+
+def _checked_ids(ids, call):
+    array = np.asarray(ids)
+    if array.ndim != 1 or not (array.size == 0 or np.issubdtype(array.dtype, np.integer)):
+        raise ArgumentError("ids: expected a 1-D sequence of body ids", call)
+    return [int(i) for i in array]
+
+
+def _checked_rows(values, n, width, name, call):
+    if values is None:
+        return None
+    array = np.asarray(values, dtype=float)
+    if array.shape != (n, width):
+        raise ArgumentError(f"{name}: expected shape ({n}, {width}), got {array.shape}", call)
+    return array
+
+
+class RemoteWorld(WorldCalls):
+    """The world of one server, through a gRPC channel (tumble.connect makes one)."""
+
+    def __init__(self, channel, address, token=None):
+        self.address = address
+        self._channel = channel
+        self._stub = pb_grpc.WorldStub(channel)
+        self._raw_frames = channel.unary_stream(
+            "/tumble.v1.World/StreamFrames",
+            request_serializer=pb.StreamFramesRequest.SerializeToString,
+            response_deserializer=None)
+        self._metadata = (("authorization", f"Bearer {token}"),) if token else ()
+
+    def states(self, ids=None):
+        """The states of every body (or of `ids`) as arrays (States)."""
+        bodies = self.bodies(() if ids is None else _checked_ids(ids, "states"))
+        return States(np.array([b.id for b in bodies], dtype=np.uint64),
+                      np.array([b.position for b in bodies]).reshape(-1, 3),
+                      np.array([b.orientation for b in bodies]).reshape(-1, 4),
+                      np.array([b.linear_velocity for b in bodies]).reshape(-1, 3),
+                      np.array([b.angular_velocity for b in bodies]).reshape(-1, 3),
+                      np.array([b.asleep for b in bodies], dtype=bool))
+
+    def set_states(self, ids, positions=None, orientations=None, linear_velocities=None,
+                   angular_velocities=None):
+        """Sets the given arrays' rows on the bodies of `ids`, all or nothing."""
+        ids = _checked_ids(ids, "set_states")
+        columns = [(name, _checked_rows(values, len(ids), width, name, "set_states"))
+                   for name, values, width in (("position", positions, 3),
+                                               ("orientation", orientations, 4),
+                                               ("linear_velocity", linear_velocities, 3),
+                                               ("angular_velocity", angular_velocities, 3))]
+        request = pb.SetBodyStateRequest()
+        for row, body_id in enumerate(ids):
+            update = request.updates.add(id=body_id)
+            for name, values in columns:
+                if values is None:
+                    continue
+                if name == "orientation":
+                    w, x, y, z = values[row]
+                    update.orientation.w, update.orientation.x = w, x
+                    update.orientation.y, update.orientation.z = y, z
+                else:
+                    field = getattr(update, name)
+                    field.x, field.y, field.z = values[row]
+        self._rpc("SetBodyState", request)
+
+    def apply_impulses(self, ids, impulses, points=None):
+        """Impulses (N s, world) at points (m, world; default the centres of mass), one row per
+        id, applied together before the next step, all or nothing."""
+        ids = _checked_ids(ids, "apply_impulses")
+        impulses = _checked_rows(impulses, len(ids), 3, "impulses", "apply_impulses")
+        points = _checked_rows(points, len(ids), 3, "points", "apply_impulses")
+        request = pb.ApplyImpulseRequest()
+        for row, body_id in enumerate(ids):
+            entry = request.impulses.add(id=body_id)
+            entry.impulse.x, entry.impulse.y, entry.impulse.z = impulses[row]
+            if points is not None:
+                entry.point.x, entry.point.y, entry.point.z = points[row]
+        self._rpc("ApplyImpulse", request)
+
+    # --- frames -----------------------------------------------------------------------------
+
+    def frames(self, rate=0.0, velocities=False, contacts=False, stats=False, ids=(), count=None,
+               duration=None):
+        """Subscribes to the world's frames: every step's, or at most `rate` per second. A slow
+        reader loses frames (Frame.dropped counts them), never slows the world. Frames come only
+        while the world steps. The subscription ends after `count` frames or `duration` seconds,
+        whichever comes first (default: when closed or when the server stops)."""
+        request = pb.StreamFramesRequest(max_rate=convert.number(rate, "rate"),
+                                         velocities=bool(velocities), contacts=bool(contacts),
+                                         stats=bool(stats), ids=convert.ids(ids))
+        if count is not None and (isinstance(count, bool) or not isinstance(count, int)
+                                  or count < 0):
+            raise ArgumentError(f"count: expected an integer >= 0, got {count!r}", "frames")
+        if duration is not None:
+            duration = convert.number(duration, "duration")
+        # Undecoded: FrameStream reads the arrays from the bytes (tumble.wire).
+        call = self._raw_frames(request, metadata=self._metadata, timeout=duration)
+        return FrameStream(call, request, count, duration is not None, "frames")
+
+    # --- the connection -----------------------------------------------------------------------
+
+    def close(self):
+        self._channel.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
     def _rpc(self, method, request, timeout=None):
         try:
