@@ -10,7 +10,7 @@ all: build
 # The peer engines (bench) are installed for the tests too: the quick report in `make test`
 # measures them beside ours.
 deps:
-	@scripts/install-deps core service viewer dds bench python
+	@scripts/install-deps core service viewer dds bench mcap python
 
 configure: deps
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null

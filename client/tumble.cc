@@ -435,6 +435,7 @@ int main(int argc, char** argv) {
       return written && (record_options.frames == 0 || ++received < record_options.frames);
     });
     if (!written) return fail("record", written);
+    if (Status finished = writer.value().finish(); !finished) return fail("record", finished);
     if (!ended) return fail("record", ended);
     std::fprintf(stderr, "tumble: recorded %llu frames to %s (%llu dropped on the way)\n",
                  static_cast<unsigned long long>(received), recording_file.c_str(),

@@ -23,7 +23,13 @@ Status FrameRecorder::finish() {
   }
   changed_.notify_all();
   if (thread_.joinable()) thread_.join();
-  return status();
+  std::lock_guard lock(mutex_);
+  if (!closed_) {
+    closed_ = true;
+    // The last chunk, the indexes and the summary (unless a write already failed).
+    if (status_) status_ = writer_.finish();
+  }
+  return status_;
 }
 
 FrameRecorder::~FrameRecorder() {

@@ -42,6 +42,7 @@ class FrameRecorder final : public FrameSink {
   void write_frames();
 
   RecordingWriter writer_;
+  bool closed_ = false;  // finish() has finished the file
   FrameOptions options_;
   CatalogueDiff catalogue_;
   mutable std::mutex mutex_;

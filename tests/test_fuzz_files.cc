@@ -16,6 +16,7 @@
 #include "recording.h"
 #include "scene_runner.h"
 #include "snapshot.h"
+#include "tumble/mcap.h"
 #include "tumble/v1/snapshot.pb.h"
 
 namespace tumble {
@@ -211,9 +212,12 @@ TEST(FuzzFiles, Recordings) {
   const std::string path = (dir / "damaged.rec").string();
   for (int i = 0; i < 1000; ++i) {
     std::string bytes = h.mutate(good);
-    if (h.chance(0.2)) {  // a frame length that claims far more than the file holds
-      const std::size_t header = std::string("tumble-recording 1\n").size();
-      if (bytes.size() > header) bytes.replace(header, 1, "\xff\xff\xff\xff\x0f");
+    if (h.chance(0.2)) {  // a record length that claims far more than the file holds
+      const std::size_t at =
+          h.chance(0.5)
+              ? mcap::kMagicSize + 1
+              : static_cast<std::size_t>(h.integer(0, static_cast<int>(bytes.size()) - 1));
+      if (bytes.size() > at + 8) bytes.replace(at, 8, "\xff\xff\xff\xff\xff\xff\xff\x0f");
     }
     {
       std::FILE* file = std::fopen(path.c_str(), "wb");

@@ -150,12 +150,12 @@ TEST(ServerProcess, CliCommandsHealthSnapshotRecordAndReplay) {
   const Output csv =
       run(std::string(TUMBLE_CLI_BINARY) + " replay --format csv " + dir / "run.rec");
   EXPECT_EQ(std::count(csv.text.begin(), csv.text.end(), '\n'), 1 + 5 * 51);
-  // A recording cut inside its last frame replays the whole frames, says so and fails.
+  // A recording cut short (here, in its footer) replays the whole frames, says so and fails.
   fs::resize_file(dir / "run.rec", fs::file_size(dir / "run.rec") - 10);
   const Output cut = run(std::string(TUMBLE_CLI_BINARY) + " replay " + dir / "run.rec");
   EXPECT_NE(cut.code, 0);
-  EXPECT_EQ(std::count(cut.text.begin(), cut.text.end(), '\n'), 5);  // 4 frames and the error
-  EXPECT_NE(cut.text.find("(frame 5)"), std::string::npos) << cut.text;
+  EXPECT_EQ(std::count(cut.text.begin(), cut.text.end(), '\n'), 6);  // 5 frames and the error
+  EXPECT_NE(cut.text.find("(frame 6)"), std::string::npos) << cut.text;
   EXPECT_NE(cut.text.find("cut short"), std::string::npos) << cut.text;
   // CSV has a row per body: asking it for contacts or statistics is refused, by name.
   for (const char* extra : {"--contacts", "--stats"}) {

@@ -50,7 +50,7 @@ class LocalWorld {
 
   LocalLimits limits_;
   server::HostedWorld hosted_;
-  SceneDef scene_;  // what Control's reset goes back to: the last scene loaded
+  SceneDef scene_;        // what Control's reset goes back to: the last scene loaded
   bool running_ = false;  // play() was called: frames() steps; the world does not run by itself
   double real_time_factor_ = 0;
   std::shared_ptr<const server::Catalogue> catalogue_;

@@ -22,10 +22,18 @@ struct Refused : std::exception {
   std::string code, message;
   Refused(const tumble::Status& status) : message(status.message()) {
     switch (status.code()) {
-      case tumble::StatusCode::kNotFound: code = "NOT_FOUND"; break;
-      case tumble::StatusCode::kResourceExhausted: code = "RESOURCE_EXHAUSTED"; break;
-      case tumble::StatusCode::kInvalidArgument: code = "INVALID_ARGUMENT"; break;
-      default: code = "INTERNAL"; break;
+      case tumble::StatusCode::kNotFound:
+        code = "NOT_FOUND";
+        break;
+      case tumble::StatusCode::kResourceExhausted:
+        code = "RESOURCE_EXHAUSTED";
+        break;
+      case tumble::StatusCode::kInvalidArgument:
+        code = "INVALID_ARGUMENT";
+        break;
+      default:
+        code = "INTERNAL";
+        break;
     }
   }
   const char* what() const noexcept override { return message.c_str(); }
@@ -153,9 +161,9 @@ void apply_impulses(LocalWorld& local, const Ids& ids, const Doubles& impulses,
     if (!hosted.world.contains(body))
       check(tumble::Status::not_found("ids[" + std::to_string(i) + "]: no body " +
                                       std::to_string(ids.at(i))));
-    batch.push_back({body, tumble::Vec3(j[3 * i], j[3 * i + 1], j[3 * i + 2]),
-                     r ? std::optional(tumble::Vec3(r[3 * i], r[3 * i + 1], r[3 * i + 2]))
-                       : std::nullopt});
+    batch.push_back(
+        {body, tumble::Vec3(j[3 * i], j[3 * i + 1], j[3 * i + 2]),
+         r ? std::optional(tumble::Vec3(r[3 * i], r[3 * i + 1], r[3 * i + 2])) : std::nullopt});
   }
   check(local.hosted().world.apply_impulses(batch).within("impulses"));
 }
