@@ -40,7 +40,7 @@ int run_reader(double seconds) {
   dds_qos_t* qos = tumble_states_qos();
   const dds_entity_t poses_topic = dds_create_topic(
       participant, &geometry_msgs_msg_dds__PoseArray__desc, "rt/tumble/poses", qos, nullptr);
-  const dds_entity_t ids_topic = dds_create_topic(participant, &tumble_msg_dds__BodyIds__desc,
+  const dds_entity_t ids_topic = dds_create_topic(participant, &tumble_msgs_msg_dds__BodyIds__desc,
                                                   "rt/tumble/pose_ids", qos, nullptr);
   const dds_entity_t poses = dds_create_reader(participant, poses_topic, qos, nullptr);
   const dds_entity_t ids = dds_create_reader(participant, ids_topic, qos, nullptr);
@@ -70,7 +70,7 @@ int run_reader(double seconds) {
     for (dds_return_t i = 0; i < n; ++i)
       if (infos[i].valid_data)
         latencies_ms.push_back(
-            (now - static_cast<tumble_msg_dds__BodyIds_*>(samples[i])->stepped_at_unix_ns) * 1e-6);
+            (now - static_cast<tumble_msgs_msg_dds__BodyIds_*>(samples[i])->stepped_at_unix_ns) * 1e-6);
     if (n > 0) dds_return_loan(ids, samples, n);
   }
   std::sort(latencies_ms.begin(), latencies_ms.end());

@@ -52,12 +52,12 @@ Json poses_json(const geometry_msgs_msg_dds__PoseArray_& m) {
   return {{"topic", "poses"}, {"time", stamp(m.header)}, {"poses", poses}};
 }
 
-Json ids_json(const tumble_msg_dds__BodyIds_& m) {
+Json ids_json(const tumble_msgs_msg_dds__BodyIds_& m) {
   return {
       {"topic", "pose_ids"}, {"step", m.step}, {"time", stamp(m.header)}, {"ids", numbers(m.ids)}};
 }
 
-Json contacts_json(const tumble_msg_dds__Contacts_& m) {
+Json contacts_json(const tumble_msgs_msg_dds__Contacts_& m) {
   return {{"topic", "contacts"},
           {"step", m.step},
           {"time", stamp(m.header)},
@@ -69,7 +69,7 @@ Json contacts_json(const tumble_msg_dds__Contacts_& m) {
           {"impulses", numbers(m.impulses)}};
 }
 
-Json stats_json(const tumble_msg_dds__StepStats_& m) {
+Json stats_json(const tumble_msgs_msg_dds__StepStats_& m) {
   return {{"topic", "stats"},
           {"step", m.step},
           {"time", stamp(m.header)},
@@ -82,7 +82,7 @@ Json stats_json(const tumble_msg_dds__StepStats_& m) {
           {"step_seconds", m.step_seconds}};
 }
 
-Json body_json(const tumble_msg_dds__Body_& m) {
+Json body_json(const tumble_msgs_msg_dds__Body_& m) {
   const char* shapes[] = {"sphere", "capsule", "box", "hull", "plane"};
   Json out = {{"topic", "bodies"},      {"id", m.id},
               {"instance", m.instance}, {"shape", m.shape < 5 ? shapes[m.shape] : "unknown"},
@@ -108,6 +108,26 @@ Json convert(const void* sample) {
 
 }  // namespace
 
+Json clock_json(const rosgraph_msgs_msg_dds__Clock_& m) {
+  return {{"topic", "clock"}, {"time", m.clock.sec + m.clock.nanosec * 1e-9}};
+}
+
+Json tf_json(const tf2_msgs_msg_dds__TFMessage_& m) {
+  Json transforms = Json::array();
+  double time = 0;
+  for (std::uint32_t i = 0; i < m.transforms._length; ++i) {
+    const auto& t = m.transforms._buffer[i];
+    time = stamp(t.header);
+    const auto& v = t.transform.translation;
+    const auto& q = t.transform.rotation;
+    transforms.push_back({{"parent", t.header.frame_id},
+                          {"child", t.child_frame_id},
+                          {"p", {v.x, v.y, v.z}},
+                          {"q", {q.w, q.x, q.y, q.z}}});
+  }
+  return {{"topic", "tf"}, {"time", time}, {"transforms", transforms}};
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"Prints what tumble-server --dds publishes, as JSON lines."};
   tumble::cli::keep_conventions(app, "tumble-dds-echo");
@@ -116,9 +136,10 @@ int main(int argc, char** argv) {
   long count = 0;
   double timeout = 0;
   app.add_option("--domain", domain, "the DDS domain")->envname("TUMBLE_DDS_DOMAIN");
-  app.add_option("--topics", topics, "which of poses, pose_ids, contacts, stats, bodies")
+  app.add_option("--topics", topics,
+                 "which of poses, pose_ids, contacts, stats, bodies, and of ROS 2's clock and tf")
       ->delimiter(',')
-      ->check(CLI::IsMember({"poses", "pose_ids", "contacts", "stats", "bodies"}));
+      ->check(CLI::IsMember({"poses", "pose_ids", "contacts", "stats", "bodies", "clock", "tf"}));
   app.add_option("--count", count, "stop after this many samples (0: never)")
       ->check(tumble::cli::non_negative);
   app.add_option("--timeout", timeout,
@@ -135,6 +156,7 @@ int main(int argc, char** argv) {
   }
   dds_qos_t* states = tumble_states_qos();
   dds_qos_t* catalogue = tumble_catalogue_qos(DDS_SECS(1));
+  dds_qos_t* ros2 = tumble_ros2_default_qos(DDS_SECS(1));
 
   const std::set<std::string> wanted(topics.begin(), topics.end());
   const dds_entity_t waitset = dds_create_waitset(participant);
@@ -157,16 +179,21 @@ int main(int argc, char** argv) {
   using geometry_msgs_msg_dds__PoseArray = geometry_msgs_msg_dds__PoseArray_;
   const bool ok = subscribe("poses", "rt/tumble/poses", &geometry_msgs_msg_dds__PoseArray__desc,
                             states, convert<geometry_msgs_msg_dds__PoseArray, poses_json>) &&
-                  subscribe("pose_ids", "rt/tumble/pose_ids", &tumble_msg_dds__BodyIds__desc,
-                            states, convert<tumble_msg_dds__BodyIds_, ids_json>) &&
-                  subscribe("contacts", "rt/tumble/contacts", &tumble_msg_dds__Contacts__desc,
-                            states, convert<tumble_msg_dds__Contacts_, contacts_json>) &&
-                  subscribe("stats", "rt/tumble/stats", &tumble_msg_dds__StepStats__desc, states,
-                            convert<tumble_msg_dds__StepStats_, stats_json>) &&
-                  subscribe("bodies", "rt/tumble/bodies", &tumble_msg_dds__Body__desc, catalogue,
-                            convert<tumble_msg_dds__Body_, body_json>);
+                  subscribe("pose_ids", "rt/tumble/pose_ids", &tumble_msgs_msg_dds__BodyIds__desc,
+                            states, convert<tumble_msgs_msg_dds__BodyIds_, ids_json>) &&
+                  subscribe("contacts", "rt/tumble/contacts", &tumble_msgs_msg_dds__Contacts__desc,
+                            states, convert<tumble_msgs_msg_dds__Contacts_, contacts_json>) &&
+                  subscribe("stats", "rt/tumble/stats", &tumble_msgs_msg_dds__StepStats__desc,
+                            states, convert<tumble_msgs_msg_dds__StepStats_, stats_json>) &&
+                  subscribe("bodies", "rt/tumble/bodies", &tumble_msgs_msg_dds__Body__desc,
+                            catalogue, convert<tumble_msgs_msg_dds__Body_, body_json>) &&
+                  subscribe("clock", "rt/clock", &rosgraph_msgs_msg_dds__Clock__desc, ros2,
+                            convert<rosgraph_msgs_msg_dds__Clock_, clock_json>) &&
+                  subscribe("tf", "rt/tf", &tf2_msgs_msg_dds__TFMessage__desc, ros2,
+                            convert<tf2_msgs_msg_dds__TFMessage_, tf_json>);
   dds_delete_qos(states);
   dds_delete_qos(catalogue);
+  dds_delete_qos(ros2);
   if (!ok) {
     dds_delete(participant);
     return 1;
@@ -208,7 +235,7 @@ int main(int argc, char** argv) {
           if (s.name == "bodies") {
             // An instance that held another body: that body is gone (its dispose may have been
             // overwritten before it was read).
-            const auto& body = *static_cast<const tumble_msg_dds__Body_*>(samples[i]);
+            const auto& body = *static_cast<const tumble_msgs_msg_dds__Body_*>(samples[i]);
             const auto held = body_at.find(body.instance);
             if (held != body_at.end() && held->second != body.id)
               lines.push_back({{"topic", "bodies"}, {"id", held->second}, {"removed", true}});
@@ -216,7 +243,7 @@ int main(int argc, char** argv) {
           }
           lines.push_back(s.to_json(samples[i]));
         } else if (infos[i].instance_state != DDS_IST_ALIVE && s.name == "bodies") {
-          tumble_msg_dds__Body_ key{};
+          tumble_msgs_msg_dds__Body_ key{};
           dds_instance_get_key(s.reader, infos[i].instance_handle, &key);
           const auto held = body_at.find(key.instance);
           if (held == body_at.end()) continue;  // a body this reader never saw

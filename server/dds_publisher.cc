@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "tumble_qos.h"
@@ -21,10 +22,23 @@ using PoseArray = geometry_msgs_msg_dds__PoseArray_;
 using Pose = geometry_msgs_msg_dds__Pose_;
 using Point = geometry_msgs_msg_dds__Point_;
 using Vector3 = geometry_msgs_msg_dds__Vector3_;
-using PoseIds = tumble_msg_dds__BodyIds_;
-using Contacts = tumble_msg_dds__Contacts_;
-using Stats = tumble_msg_dds__StepStats_;
-using BodySample = tumble_msg_dds__Body_;
+using PoseIds = tumble_msgs_msg_dds__BodyIds_;
+using Contacts = tumble_msgs_msg_dds__Contacts_;
+using Stats = tumble_msgs_msg_dds__StepStats_;
+using BodySample = tumble_msgs_msg_dds__Body_;
+using Transform = geometry_msgs_msg_dds__TransformStamped_;
+using TfMessage = tf2_msgs_msg_dds__TFMessage_;
+using Clock = rosgraph_msgs_msg_dds__Clock_;
+using Marker = visualization_msgs_msg_dds__Marker_;
+using MarkerArray = visualization_msgs_msg_dds__MarkerArray_;
+
+// visualization_msgs/Marker's types and actions.
+constexpr std::int32_t kCube = 1, kSphere = 2, kCylinder = 3, kTriangleList = 11;
+constexpr std::int32_t kAdd = 0, kDelete = 2;
+constexpr char kEmpty[] = "";
+constexpr char kMarkerNamespace[] = "tumble";
+// The ground (a half-space) drawn as a slab this wide and this thin, its top at the surface.
+constexpr double kGroundWidth = 200, kGroundThickness = 0.01;
 
 std_msgs_msg_dds__Header_ header_at(double time) {
   std_msgs_msg_dds__Header_ header;
@@ -46,6 +60,31 @@ Sequence view(std::vector<T>& items) {
   return s;
 }
 
+// A marker's id: the body's (ids stay far below 2^31 in any world a viewer shows).
+std::int32_t marker_id(std::uint64_t id) {
+  return static_cast<std::int32_t>(id % 2147483647u);
+}
+
+std_msgs_msg_dds__ColorRGBA_ colour_of(const BodyLook& look) {
+  if (look.colour == 0)  // the viewer's choice: grey, darker when static
+    return look.type == BodyType::kStatic ? std_msgs_msg_dds__ColorRGBA_{0.45f, 0.45f, 0.45f, 1}
+                                          : std_msgs_msg_dds__ColorRGBA_{0.75f, 0.75f, 0.75f, 1};
+  auto channel = [&](int shift) { return static_cast<float>((look.colour >> shift) & 0xFF) / 255; };
+  return {channel(24), channel(16), channel(8), channel(0)};
+}
+
+// A marker with every string and sequence empty, as DDS must find them.
+Marker empty_marker(const std_msgs_msg_dds__Header_& header) {
+  Marker marker{};
+  marker.header = header;
+  marker.ns = const_cast<char*>(kMarkerNamespace);
+  marker.texture_resource = marker.text = marker.mesh_resource = const_cast<char*>(kEmpty);
+  marker.texture.header = header;
+  marker.texture.format = const_cast<char*>(kEmpty);
+  marker.mesh_file.filename = const_cast<char*>(kEmpty);
+  return marker;
+}
+
 std::string dds_error(const char* what, dds_return_t code) {
   return std::string(what) + ": " + dds_strretcode(code);
 }
@@ -55,6 +94,18 @@ std::string dds_error(const char* what, dds_return_t code) {
 struct DdsPublisher::Writers {
   dds_entity_t participant = 0;
   dds_entity_t poses = 0, ids = 0, contacts = 0, stats = 0, bodies = 0;
+  dds_entity_t tf = 0, clock = 0, markers = 0;  // ROS 2's own types
+  // What each body looks like to ROS 2, made when the catalogue changes: its frame's name, and
+  // its marker (type, scale, colour, the triangles of a hull), the pose filled in per step.
+  struct RosLook {
+    std::string frame;
+    Marker marker;
+    std::vector<Point> triangles;
+  };
+  std::unordered_map<std::uint64_t, RosLook> ros_looks;
+  std::vector<std::uint64_t> deleted_markers;  // bodies gone since the last markers went out
+  std::vector<Transform> transform_buffer;
+  std::vector<Marker> marker_buffer;
   // Buffers kept from step to step, so a steady world publishes without allocating.
   std::vector<Pose> pose_buffer;
   std::vector<std::uint64_t> id_buffer;
@@ -92,10 +143,16 @@ Result<std::unique_ptr<DdsPublisher>> DdsPublisher::start(WorldHost& host, DdsOp
     return w;
   };
   writers->poses = writer(&geometry_msgs_msg_dds__PoseArray__desc, "rt/tumble/poses", states);
-  writers->ids = writer(&tumble_msg_dds__BodyIds__desc, "rt/tumble/pose_ids", states);
-  writers->contacts = writer(&tumble_msg_dds__Contacts__desc, "rt/tumble/contacts", states);
-  writers->stats = writer(&tumble_msg_dds__StepStats__desc, "rt/tumble/stats", states);
-  writers->bodies = writer(&tumble_msg_dds__Body__desc, "rt/tumble/bodies", catalogue);
+  writers->ids = writer(&tumble_msgs_msg_dds__BodyIds__desc, "rt/tumble/pose_ids", states);
+  writers->contacts = writer(&tumble_msgs_msg_dds__Contacts__desc, "rt/tumble/contacts", states);
+  writers->stats = writer(&tumble_msgs_msg_dds__StepStats__desc, "rt/tumble/stats", states);
+  writers->bodies = writer(&tumble_msgs_msg_dds__Body__desc, "rt/tumble/bodies", catalogue);
+  dds_qos_t* ros2 = tumble_ros2_default_qos(DDS_MSECS(10));
+  writers->tf = writer(&tf2_msgs_msg_dds__TFMessage__desc, "rt/tf", ros2);
+  writers->clock = writer(&rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", ros2);
+  writers->markers =
+      writer(&visualization_msgs_msg_dds__MarkerArray__desc, "rt/tumble/markers", ros2);
+  dds_delete_qos(ros2);
   dds_delete_qos(states);
   dds_delete_qos(catalogue);
   if (!failed) return failed;
@@ -196,6 +253,114 @@ void DdsPublisher::publish(const FrameData& frame) {
               s.bodies_at_edge,
               s.time.total};
   dds_write(w.stats, &stats);
+  publish_ros2(frame, header);
+}
+
+void DdsPublisher::publish_ros2(const FrameData& frame, const std_msgs_msg_dds__Header_& header) {
+  Writers& w = *writers_;
+  Clock clock{header.stamp};
+  dds_write(w.clock, &clock);
+
+  const std::size_t n = frame.ids.size();
+  w.transform_buffer.resize(n);
+  w.marker_buffer.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto look = w.ros_looks.find(frame.ids[i]);
+    if (look == w.ros_looks.end()) continue;  // not in the catalogue published: next step
+    const geometry_msgs_msg_dds__Vector3_ at{frame.positions[3 * i], frame.positions[3 * i + 1],
+                                             frame.positions[3 * i + 2]};
+    // Ours are stored w x y z; ROS 2's Quaternion is x y z w.
+    const geometry_msgs_msg_dds__Quaternion_ turn{
+        frame.orientations[4 * i + 1], frame.orientations[4 * i + 2], frame.orientations[4 * i + 3],
+        frame.orientations[4 * i]};
+    Transform& t = w.transform_buffer[i];
+    t.header = header;
+    t.child_frame_id = look->second.frame.data();
+    t.transform = {at, turn};
+    Marker marker = look->second.marker;
+    marker.header = header;
+    marker.texture.header = header;
+    marker.pose = {{at.x, at.y, at.z}, turn};
+    if (look->second.marker.type == kCube &&
+        frame.catalogue->at(frame.ids[i]).shape.type() == ShapeType::kHalfSpace) {
+      // The slab's top at the ground's surface: its centre half its thickness below, along the
+      // ground's normal (its frame's z).
+      const Quat q(frame.orientations[4 * i], frame.orientations[4 * i + 1],
+                   frame.orientations[4 * i + 2], frame.orientations[4 * i + 3]);
+      const Vec3 centre = Vec3(at.x, at.y, at.z) - q * Vec3(0, 0, kGroundThickness / 2);
+      marker.pose.position = {centre.x(), centre.y(), centre.z()};
+    }
+    w.marker_buffer.push_back(marker);
+  }
+  TfMessage tf{view<dds_sequence_geometry_msgs_msg_dds__TransformStamped_>(w.transform_buffer)};
+  dds_write(w.tf, &tf);
+  for (std::uint64_t gone : w.deleted_markers) {
+    Marker marker = empty_marker(header);
+    marker.id = marker_id(gone);
+    marker.action = kDelete;
+    w.marker_buffer.push_back(marker);
+  }
+  w.deleted_markers.clear();
+  MarkerArray markers{view<dds_sequence_visualization_msgs_msg_dds__Marker_>(w.marker_buffer)};
+  dds_write(w.markers, &markers);
+}
+
+void DdsPublisher::describe_for_ros2(const Catalogue& now) {
+  Writers& w = *writers_;
+  for (auto it = w.ros_looks.begin(); it != w.ros_looks.end();) {
+    if (now.contains(it->first)) {
+      ++it;
+      continue;
+    }
+    w.deleted_markers.push_back(it->first);
+    it = w.ros_looks.erase(it);
+  }
+  for (const auto& [id, look] : now) {
+    if (w.ros_looks.contains(id)) continue;
+    Writers::RosLook& ros = w.ros_looks[id];
+    ros.frame = "body_" + std::to_string(id);
+    Marker& marker = ros.marker = empty_marker({});
+    marker.id = marker_id(id);
+    marker.action = kAdd;
+    marker.color = colour_of(look);
+    const Shape& shape = look.shape;
+    switch (shape.type()) {
+      case ShapeType::kSphere:
+        marker.type = kSphere;
+        marker.scale = {2 * shape.radius(), 2 * shape.radius(), 2 * shape.radius()};
+        break;
+      case ShapeType::kCapsule:  // its length, ends included, as a cylinder
+        marker.type = kCylinder;
+        marker.scale = {2 * shape.radius(), 2 * shape.radius(),
+                        2 * (shape.half_height() + shape.radius())};
+        break;
+      case ShapeType::kBox:
+        marker.type = kCube;
+        marker.scale = {2 * shape.half_extents().x(), 2 * shape.half_extents().y(),
+                        2 * shape.half_extents().z()};
+        break;
+      case ShapeType::kHalfSpace:
+        marker.type = kCube;
+        marker.scale = {kGroundWidth, kGroundWidth, kGroundThickness};
+        break;
+      case ShapeType::kHull: {
+        // Each face's loop as a fan of triangles, in the body's frame.
+        marker.type = kTriangleList;
+        marker.scale = {1, 1, 1};
+        const ConvexPolyhedron& hull = *shape.polyhedron();
+        for (const ConvexPolyhedron::Face& face : hull.faces)
+          for (std::uint32_t k = 1; k + 1 < face.count; ++k)
+            for (std::uint32_t corner : {0u, k, k + 1}) {
+              const Vec3& v = hull.vertices[hull.face_vertices[face.first + corner]];
+              ros.triangles.push_back({v.x(), v.y(), v.z()});
+            }
+        break;
+      }
+    }
+  }
+  // The points' buffers are final now (the map does not move its values).
+  for (auto& [id, ros] : w.ros_looks)
+    ros.marker.points = view<dds_sequence_geometry_msgs_msg_dds__Point_>(ros.triangles);
 }
 
 void DdsPublisher::publish_catalogue(const FrameData& frame) {
@@ -244,6 +409,7 @@ void DdsPublisher::publish_catalogue(const FrameData& frame) {
     dds_write(w.bodies, &sample);
     described_.emplace(id, sample.instance);
   }
+  describe_for_ros2(now);
   catalogue_ = frame.catalogue;
 }
 

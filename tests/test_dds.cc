@@ -79,9 +79,15 @@ class DdsTest : public ::testing::Test {
   }
 };
 
-// Steps a paused server 30 times while `subscriber` listens, and returns how many steps it
-// received whole (ids and poses) and equal, bit for bit, to the gRPC frame of the same step.
-int steps_equal_to_grpc_frames(const std::string& subscriber_args, const std::string& program) {
+// What a subscriber printed while a paused server stepped 30 times, and the gRPC frame of every
+// step, as a gRPC subscriber received them.
+struct Received {
+  std::vector<Json> lines;
+  std::map<std::uint64_t, v1::Frame> frames;
+  std::map<std::uint64_t, v1::BodyDescription> bodies;  // every body the frames described
+};
+
+Received thirty_steps(const std::string& subscriber_args, const std::string& program) {
   Server server;
   server.start({"--paused", "--dds", "--dds-domain", own_domain()});
   auto stub =
@@ -90,12 +96,15 @@ int steps_equal_to_grpc_frames(const std::string& subscriber_args, const std::st
   // The gRPC frames of every step, as a subscriber receives them.
   std::mutex mutex;
   std::map<std::uint64_t, v1::Frame> frames;
+  std::map<std::uint64_t, v1::BodyDescription> bodies;
   grpc::ClientContext stream_context;
   auto reader = stub->StreamFrames(&stream_context, {});
   std::thread streaming([&] {
     v1::Frame frame;
     while (reader->Read(&frame)) {
       std::lock_guard lock(mutex);
+      for (const v1::BodyDescription& body : frame.added())
+        bodies[body.id()] = body;
       frames[frame.step()] = frame;
     }
   });
@@ -110,9 +119,21 @@ int steps_equal_to_grpc_frames(const std::string& subscriber_args, const std::st
     EXPECT_TRUE(stub->Control(&context, step, &response).ok());
     std::this_thread::sleep_for(100ms);
   }
-  const std::vector<Json> lines = echo.finish();
+  Received received{echo.finish(), {}};
   stream_context.TryCancel();
   streaming.join();
+  received.frames = std::move(frames);
+  received.bodies = std::move(bodies);
+  return received;
+}
+
+// How many steps `subscriber` received whole (ids and poses) and equal, bit for bit, to the gRPC
+// frame of the same step.
+int steps_equal_to_grpc_frames(const std::string& subscriber_args, const std::string& program) {
+  Received received = thirty_steps(subscriber_args, program);
+  const std::vector<Json>& lines = received.lines;
+  std::map<std::uint64_t, v1::Frame>& frames = received.frames;
+  std::mutex mutex;
 
   // Pair each step's ids with its poses (the same stamp), then compare with the gRPC frame.
   std::map<double, Json> ids_at;
@@ -154,6 +175,71 @@ TEST_F(DdsTest, PosesEqualTheGrpcFrameOfTheSameStep) {
 // same IDL, receives the same poses.
 TEST_F(DdsTest, AFastDdsSubscriberReceivesTheSamePoses) {
   EXPECT_GE(steps_equal_to_grpc_frames("--seconds 6", TUMBLE_FASTDDS_POSES_BINARY), 20);
+}
+
+// ROS 2's own topics, read by Fast DDS with ROS 2's default QoS (as RViz2 subscribes): /clock
+// says each step's simulated time, /tf holds one transform per body from "world" to "body_<id>"
+// equal to the step's gRPC frame, and /tumble/markers draws each body with the marker its shape
+// calls for, at the same pose.
+TEST_F(DdsTest, RosTopicsTfClockAndMarkersReachAFastDdsReader) {
+  Received received = thirty_steps("--seconds 6 --ros2 1", TUMBLE_FASTDDS_POSES_BINARY);
+  // The frames by simulated time (a header's stamp is it, to the nanosecond).
+  std::map<long long, const v1::Frame*> at_time;
+  const std::map<std::uint64_t, v1::BodyDescription>& bodies = received.bodies;
+  for (const auto& [step, frame] : received.frames)
+    at_time[std::llround(frame.time() * 1e6)] = &frame;
+  ASSERT_EQ(bodies.size(), 51u);  // the default scene
+  auto frame_at = [&](const Json& line) -> const v1::Frame* {
+    const auto found = at_time.find(std::llround(line["time"].get<double>() * 1e6));
+    return found == at_time.end() || found->second->step() == 0 ? nullptr : found->second;
+  };
+  int clocks = 0, transforms = 0, markers = 0;
+  for (const Json& line : received.lines) {
+    const v1::Frame* frame = frame_at(line);
+    if (frame == nullptr) continue;
+    if (line["topic"] == "clock") ++clocks;
+    if (line["topic"] == "tf") {
+      const Json& list = line["transforms"];
+      ASSERT_EQ(list.size(), static_cast<std::size_t>(frame->ids_size()));
+      for (int i = 0; i < frame->ids_size(); ++i) {
+        EXPECT_EQ(list[i]["parent"], "world");
+        EXPECT_EQ(list[i]["child"], "body_" + std::to_string(frame->ids(i)));
+        for (int k = 0; k < 3; ++k)
+          EXPECT_EQ(list[i]["p"][k].get<double>(), frame->positions(3 * i + k));
+        for (int k = 0; k < 4; ++k)
+          EXPECT_EQ(list[i]["q"][k].get<double>(), frame->orientations(4 * i + k));
+      }
+      ++transforms;
+    }
+    if (line["topic"] == "markers") {
+      const Json& list = line["markers"];
+      ASSERT_EQ(list.size(), static_cast<std::size_t>(frame->ids_size()));
+      for (int i = 0; i < frame->ids_size(); ++i) {
+        const Json& marker = list[i];
+        const v1::Shape& shape = bodies.at(frame->ids(i)).shape();
+        EXPECT_EQ(marker["id"].get<std::uint64_t>(), frame->ids(i));
+        EXPECT_EQ(marker["action"], 0);  // ADD
+        const int expected_type = shape.has_sphere() ? 2 : shape.has_capsule() ? 3 : 1;
+        EXPECT_EQ(marker["type"], expected_type) << shape.ShortDebugString();
+        if (shape.has_box())
+          for (int k = 0; k < 3; ++k)
+            EXPECT_EQ(marker["scale"][k].get<double>(), k == 0   ? shape.box().size().x()
+                                                        : k == 1 ? shape.box().size().y()
+                                                                 : shape.box().size().z());
+        if (shape.has_sphere())
+          EXPECT_EQ(marker["scale"][0].get<double>(), 2 * shape.sphere().radius());
+        if (!shape.has_plane())  // the ground's slab sits below its surface
+          for (int k = 0; k < 3; ++k)
+            EXPECT_EQ(marker["p"][k].get<double>(), frame->positions(3 * i + k));
+        EXPECT_EQ(marker["color"][3].get<double>(), 1.0);
+      }
+      ++markers;
+    }
+  }
+  // Reliable and keep last 10 on loopback: nearly every one of the 30 steps arrives.
+  EXPECT_GE(clocks, 20);
+  EXPECT_GE(transforms, 20);
+  EXPECT_GE(markers, 20);
 }
 #endif
 

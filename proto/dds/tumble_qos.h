@@ -22,3 +22,15 @@ static inline dds_qos_t* tumble_catalogue_qos(dds_duration_t max_blocking) {
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
   return qos;
 }
+
+// ROS 2's default QoS (rmw_qos_profile_default: reliable, volatile, keep last 10), for the topics
+// of ROS 2's own types (rt/tf, rt/clock, rt/tumble/markers), so that RViz2's and rclcpp's default
+// subscriptions match them. A reliable write waits at most `max_blocking` for a slow reader: past
+// it the sample is dropped for that reader, and the world goes on.
+static inline dds_qos_t* tumble_ros2_default_qos(dds_duration_t max_blocking) {
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, max_blocking);
+  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+  return qos;
+}
