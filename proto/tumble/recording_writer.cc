@@ -168,11 +168,17 @@ Status RecordingWriter::write(const v1::Frame& frame) {
     *changes.mutable_removed() = frame.removed();
     add_message(mcap::kBodiesChannel, sequence, log_time, simulated, changes);
   }
-  v1::Frame poses = frame;
-  poses.clear_added();
-  poses.clear_removed();
-  poses.clear_contacts();
-  poses.clear_stats();
+  // The frame's own fields, copied one by one: a copy of the whole frame would copy its contacts.
+  v1::Frame poses;
+  poses.set_step(frame.step());
+  poses.set_time(frame.time());
+  *poses.mutable_ids() = frame.ids();
+  *poses.mutable_positions() = frame.positions();
+  *poses.mutable_orientations() = frame.orientations();
+  *poses.mutable_linear_velocities() = frame.linear_velocities();
+  *poses.mutable_angular_velocities() = frame.angular_velocities();
+  poses.set_dropped(frame.dropped());
+  poses.set_stepped_at_unix_ns(frame.stepped_at_unix_ns());
   add_message(mcap::kFramesChannel, sequence, log_time, simulated, poses);
   if (frame.has_contacts())
     add_message(mcap::kContactsChannel, sequence, log_time, simulated, frame.contacts());

@@ -98,7 +98,10 @@ Result<std::string> LocalWorld::call(std::string_view method, std::string_view b
       return restore_world(hosted_, std::move(restored).value(), a->mutable_new_ids());
     });
   }
-  refresh_catalogue();
+  // The ids and the catalogue follow the bodies: only these calls add or remove any.
+  if (method == "SpawnBodies" || method == "RemoveBodies" || method == "LoadScene" ||
+      method == "Restore" || method == "Control")
+    refresh_catalogue();
   return answer;
 }
 

@@ -12,6 +12,7 @@ files, snapshots (bytes that move between the two) and refusals (tumble.Error wi
 the server would send). It does not run by itself: step(n) runs n steps before it returns, and
 frames() steps once per frame it yields."""
 
+import os
 import time
 
 import grpc
@@ -21,6 +22,11 @@ from tumble.errors import ArgumentError, Error
 from tumble.frames import Contacts, FrameStream
 from tumble.v1 import world_pb2 as pb
 from tumble.world import States, WorldCalls
+
+# The step's OpenMP threads wait for work passively, as tumble-server's do: spinning, they fight the
+# Python thread and anything else on the machine for the cores (docs/PERFORMANCE.md, "Threads on
+# a busy machine"). libgomp reads this when the module loads it; a value already set is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 try:
     from tumble import _engine
