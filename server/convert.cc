@@ -297,4 +297,24 @@ void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Fra
   if (options.stats) stats_to_proto(frame.stats, out->mutable_stats());
 }
 
+Vec3 vec_from_proto(const v1::Vec3& v) {
+  return vec(v);
+}
+
+void vec_to_proto(const Vec3& v, v1::Vec3* out) {
+  set(v, out);
+}
+
+BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
+  BodyMotion motion;
+  if (update.has_position()) motion.position = vec(update.position());
+  if (update.has_orientation()) {
+    const v1::Quat& q = update.orientation();
+    motion.orientation = Quat(q.w(), q.x(), q.y(), q.z());
+  }
+  if (update.has_linear_velocity()) motion.linear_velocity = vec(update.linear_velocity());
+  if (update.has_angular_velocity()) motion.angular_velocity = vec(update.angular_velocity());
+  return motion;
+}
+
 }  // namespace tumble::server

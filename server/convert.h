@@ -13,6 +13,11 @@ namespace tumble::server {
 
 Result<BodyDef> body_from_proto(const v1::BodySpec& spec);
 
+Vec3 vec_from_proto(const v1::Vec3& v);
+void vec_to_proto(const Vec3& v, v1::Vec3* out);
+// The fields an update sets (SetBodyState); its own checks are World::check_motion's.
+BodyMotion motion_from_proto(const v1::BodyStateUpdate& update);
+
 // What a viewer needs to draw the body with wire id `id`.
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
 

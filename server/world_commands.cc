@@ -14,28 +14,6 @@ std::string entry(const char* list, int i) {
   return std::string(list) + "[" + std::to_string(i) + "]";
 }
 
-Vec3 vec(const v1::Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-void set_vec(const Vec3& v, v1::Vec3* out) {
-  out->set_x(v.x());
-  out->set_y(v.y());
-  out->set_z(v.z());
-}
-
-BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
-  BodyMotion motion;
-  if (update.has_position()) motion.position = vec(update.position());
-  if (update.has_orientation()) {
-    const v1::Quat& q = update.orientation();
-    motion.orientation = Quat(q.w(), q.x(), q.y(), q.z());
-  }
-  if (update.has_linear_velocity()) motion.linear_velocity = vec(update.linear_velocity());
-  if (update.has_angular_velocity()) motion.angular_velocity = vec(update.angular_velocity());
-  return motion;
-}
-
 // The body each entry's id names, refusing the first unknown one ("updates[2].id: no body 9").
 template <class Entries>
 Status find_entries(const HostedWorld& hosted, const char* list, const Entries& entries,
@@ -128,14 +106,14 @@ Status get_bodies(const HostedWorld& hosted, const v1::GetBodiesRequest& request
     describe(hosted.ids.wire(id), look_of(body, colour), response->add_descriptions());
     v1::BodyState* state = response->add_states();
     state->set_id(hosted.ids.wire(id));
-    set_vec(body.position(), state->mutable_position());
+    vec_to_proto(body.position(), state->mutable_position());
     const Quat q = body.orientation();
     state->mutable_orientation()->set_w(q.w());
     state->mutable_orientation()->set_x(q.x());
     state->mutable_orientation()->set_y(q.y());
     state->mutable_orientation()->set_z(q.z());
-    set_vec(body.linear_velocity(), state->mutable_linear_velocity());
-    set_vec(body.angular_velocity(), state->mutable_angular_velocity());
+    vec_to_proto(body.linear_velocity(), state->mutable_linear_velocity());
+    vec_to_proto(body.angular_velocity(), state->mutable_angular_velocity());
     state->set_asleep(body.asleep());
   }
   return Status::ok();
@@ -160,9 +138,9 @@ Status apply_impulses(HostedWorld& hosted, const v1::ApplyImpulseRequest& reques
   impulses.reserve(ids.size());
   for (int i = 0; i < request.impulses_size(); ++i) {
     const v1::Impulse& impulse = request.impulses(i);
-    impulses.push_back(
-        {ids[i], vec(impulse.impulse()),
-         impulse.has_point() ? std::optional<Vec3>(vec(impulse.point())) : std::nullopt});
+    impulses.push_back({ids[i], vec_from_proto(impulse.impulse()),
+                        impulse.has_point() ? std::optional<Vec3>(vec_from_proto(impulse.point()))
+                                            : std::nullopt});
   }
   // Several impulses on one body add up, and are checked as their sum: all or nothing.
   if (Status s = hosted.world.apply_impulses(impulses); !s) return s.within("impulses");
