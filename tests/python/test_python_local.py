@@ -124,3 +124,27 @@ def test_every_solver_and_a_reset_and_two_worlds_alike():
         assert np.array_equal(one.states().positions, two.states().positions), solver
     one.reset()
     assert one.info().step == 0 and one.info().body_count == two.info().body_count
+
+
+def test_threads_sharing_a_world_take_turns():
+    import threading
+
+    world = tumble.World(builtin="pile:50")
+    reads = []
+
+    def stepper():
+        for _ in range(40):
+            world.step(1)
+
+    def reader():
+        for _ in range(200):
+            reads.append(world.states().positions.shape)
+
+    threads = [threading.Thread(target=stepper), threading.Thread(target=stepper),
+               threading.Thread(target=reader)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert world.info().step == 80
+    assert reads == [(51, 3)] * 200

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 
@@ -40,6 +41,9 @@ class LocalWorld {
   std::shared_ptr<const server::FrameData> frame_data();
 
   server::HostedWorld& hosted() { return hosted_; }
+  // Held by every call into this world (tumble._engine takes it): Python threads that share a
+  // world take turns, since the GIL is let go while the world steps.
+  std::mutex& mutex() { return mutex_; }
   const LocalLimits& limits() const { return limits_; }
   bool running() const { return running_; }
 
@@ -48,6 +52,7 @@ class LocalWorld {
   Result<std::string> info() const;
   void refresh_catalogue();
 
+  std::mutex mutex_;
   LocalLimits limits_;
   server::HostedWorld hosted_;
   SceneDef scene_;        // what Control's reset goes back to: the last scene loaded

@@ -92,6 +92,7 @@ py::array_t<T> array_of(const std::vector<T>& values, std::vector<py::ssize_t> s
 }
 
 py::dict states(LocalWorld& local, const std::optional<Ids>& ids) {
+  std::lock_guard turn(local.mutex());
   std::vector<std::uint64_t> wire;
   const std::vector<tumble::BodyId> bodies = bodies_of(local, ids, &wire);
   const auto n = static_cast<py::ssize_t>(bodies.size());
@@ -128,6 +129,7 @@ py::dict states(LocalWorld& local, const std::optional<Ids>& ids) {
 void set_states(LocalWorld& local, const Ids& ids, const std::optional<Doubles>& positions,
                 const std::optional<Doubles>& orientations, const std::optional<Doubles>& linear,
                 const std::optional<Doubles>& angular) {
+  std::lock_guard turn(local.mutex());
   std::vector<std::uint64_t> wire;
   const std::vector<tumble::BodyId> bodies = bodies_of(local, ids, &wire);
   const auto n = static_cast<py::ssize_t>(bodies.size());
@@ -150,6 +152,7 @@ void set_states(LocalWorld& local, const Ids& ids, const std::optional<Doubles>&
 
 void apply_impulses(LocalWorld& local, const Ids& ids, const Doubles& impulses,
                     const std::optional<Doubles>& points) {
+  std::lock_guard turn(local.mutex());
   if (ids.ndim() != 1) check(tumble::Status::error("ids: expected a 1-D array of body ids"));
   const py::ssize_t n = ids.shape(0);
   const double* j = rows(std::optional<Doubles>(impulses), n, 3, "impulses");
@@ -169,6 +172,7 @@ void apply_impulses(LocalWorld& local, const Ids& ids, const Doubles& impulses,
 }
 
 py::dict contacts(LocalWorld& local) {
+  std::lock_guard turn(local.mutex());
   const auto frame = local.frame_data();
   const auto n = static_cast<py::ssize_t>(frame->contact_depths.size());
   py::dict out;
@@ -230,6 +234,7 @@ PYBIND11_MODULE(_engine, module) {
              tumble::Result<std::string> out = tumble::Status::ok();
              {
                py::gil_scoped_release unlocked;
+               std::lock_guard turn(world.mutex());
                out = world.call(method, in);
              }
              check(out.status());
@@ -240,6 +245,7 @@ PYBIND11_MODULE(_engine, module) {
              tumble::Status stepped = tumble::Status::ok();
              {
                py::gil_scoped_release unlocked;
+               std::lock_guard turn(world.mutex());
                stepped = world.step(n);
              }
              check(stepped);
@@ -254,8 +260,14 @@ PYBIND11_MODULE(_engine, module) {
       .def("contacts", &contacts)
       .def_property_readonly("running", &LocalWorld::running)
       .def_property_readonly("step_count",
-                             [](LocalWorld& world) { return world.hosted().world.step_count(); })
-      .def_property_readonly("time", [](LocalWorld& world) { return world.hosted().world.time(); });
+                             [](LocalWorld& world) {
+                               std::lock_guard turn(world.mutex());
+                               return world.hosted().world.step_count();
+                             })
+      .def_property_readonly("time", [](LocalWorld& world) {
+        std::lock_guard turn(world.mutex());
+        return world.hosted().world.time();
+      });
 
   py::class_<Reader>(module, "Reader")
       .def(py::init([](LocalWorld& world, bool velocities, bool contacts, bool stats,
@@ -273,6 +285,7 @@ PYBIND11_MODULE(_engine, module) {
         tumble::Status stepped = tumble::Status::ok();
         {
           py::gil_scoped_release unlocked;
+          std::lock_guard turn(reader.world->mutex());
           if (step) stepped = reader.world->step(1);
           if (stepped) frame = reader.world->frame(reader.options, reader.diff);
         }
