@@ -10,6 +10,7 @@ temporary folder configured for the package alone (a few minutes on 2 cores)."""
 import base64
 import hashlib
 import os
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -31,9 +32,24 @@ def get_requires_for_build_sdist(config_settings=None):
     return []
 
 
+def prepare_metadata_for_build_wheel(metadata_directory, config_settings=None):
+    """The metadata alone, so that pip does not build the wheel twice to learn it."""
+    dist_info = Path(metadata_directory) / f"{NAME}-{VERSION}.dist-info"
+    dist_info.mkdir(parents=True, exist_ok=True)
+    (dist_info / "METADATA").write_text(_metadata())
+    return dist_info.name
+
+
 def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
-    build = _build_folder(config_settings or {})
-    package = build / "python" / "tumble"
+    build, temporary = _build_folder(config_settings or {})
+    try:
+        return _pack(build / "python" / "tumble", wheel_directory)
+    finally:
+        if temporary:
+            shutil.rmtree(build, ignore_errors=True)
+
+
+def _pack(package, wheel_directory):
     engine = list(package.glob("_engine*.so"))
     if engine and not engine[0].name.endswith(sysconfig.get_config_var("EXT_SUFFIX")):
         raise RuntimeError(f"{engine[0]} was built for another Python than {sys.executable}; "
@@ -67,18 +83,24 @@ def _build_folder(settings):
         build = Path(given).resolve()
         if not (build / "CMakeCache.txt").is_file():
             raise RuntimeError(f"build-dir: {build} is not a configured CMake build folder")
+        temporary = False
     else:
+        temporary = True
         build = Path(tempfile.mkdtemp(prefix="tumble-wheel-"))
         _run(["cmake", "-S", SOURCE, "-B", build, "-DCMAKE_BUILD_TYPE=Release",
               f"-DTUMBLE_PYTHON={sys.executable}", "-DTUMBLE_BUILD_TESTS=OFF",
               "-DTUMBLE_BUILD_BENCH=OFF", "-DTUMBLE_BUILD_VIEWER=OFF", "-DTUMBLE_BUILD_DDS=OFF"])
     _run(["cmake", "--build", build, "--target", "tumble_python", "-j", str(os.cpu_count() or 1)])
-    return build
+    return build, temporary
 
 
 def _run(command):
+    # pip runs this backend with PYTHONPATH pointing at its isolated environment, whose
+    # sitecustomize hides the interpreter's own site-packages; CMake's checks of grpc, protobuf and
+    # numpy (and pybind11's of the interpreter) must see the environment the package will run in.
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONNOUSERSITE")}
     done = subprocess.run([str(part) for part in command], stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, text=True)
+                          stderr=subprocess.STDOUT, text=True, env=env)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(map(str, command))} failed:\n{done.stdout[-4000:]}")
 
