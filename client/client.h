@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "physics/status.h"
+#include "tumble/wire_status.h"
 #include "tumble/v1/world.grpc.pb.h"
 
 namespace tumble::client {

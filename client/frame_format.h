@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "physics/status.h"
+#include "tumble/wire_status.h"
 #include "tumble/v1/world.pb.h"
 
 namespace tumble::client {

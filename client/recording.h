@@ -12,7 +12,7 @@
 #include <string>
 #include <string_view>
 
-#include "physics/status.h"
+#include "tumble/wire_status.h"
 #include "tumble/recording_writer.h"
 #include "tumble/v1/recording.pb.h"
 #include "tumble/v1/world.pb.h"

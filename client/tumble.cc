@@ -18,6 +18,8 @@
 #include "tumble/command_line.h"
 
 using namespace tumble;
+using tumble::wire::Result;
+using tumble::wire::Status;
 
 namespace {
 

@@ -18,8 +18,9 @@ if(TUMBLE_INSTALLS_CLIENT)
   install(TARGETS tumble_client tumble_proto tumble_recording_writer EXPORT TumbleClientTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
   install(FILES client/client.h client/recording.h client/frame_format.h
-    proto/tumble/recording_writer.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tumble)
-  foreach(proto world snapshot)
+    proto/tumble/recording_writer.h proto/tumble/mcap.h proto/tumble/wire_status.h
+    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tumble)
+  foreach(proto world snapshot recording)
     install(FILES ${PROJECT_BINARY_DIR}/proto/tumble/v1/${proto}.pb.h
                   ${PROJECT_BINARY_DIR}/proto/tumble/v1/${proto}.grpc.pb.h
             DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tumble/v1)

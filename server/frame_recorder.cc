@@ -3,10 +3,18 @@
 #include "log.h"
 
 namespace tumble::server {
+namespace {
+
+// The recording writer's failure (the clients' error type) as the server's.
+Status from_wire(const wire::Status& status) {
+  return status ? Status::ok() : Status::error(status.message());
+}
+
+}  // namespace
 
 Result<std::shared_ptr<FrameRecorder>> FrameRecorder::start(const std::string& path) {
-  Result<RecordingWriter> writer = RecordingWriter::create(path);
-  if (!writer) return writer.status();
+  wire::Result<RecordingWriter> writer = RecordingWriter::create(path);
+  if (!writer) return from_wire(writer.status());
   std::shared_ptr<FrameRecorder> recorder(new FrameRecorder(std::move(writer).value()));
   recorder->thread_ = std::thread([raw = recorder.get()] { raw->write_frames(); });
   return recorder;
@@ -27,7 +35,7 @@ Status FrameRecorder::finish() {
   if (!closed_) {
     closed_ = true;
     // The last chunk, the indexes and the summary (unless a write already failed).
-    if (status_) status_ = writer_.finish();
+    if (status_) status_ = from_wire(writer_.finish());
   }
   return status_;
 }
@@ -63,7 +71,7 @@ void FrameRecorder::write_frames() {
     v1::Frame frame;
     frame_to_proto(*data, options_, &frame);
     catalogue_.add_changes(*data, {}, &frame);
-    const Status written = writer_.write(frame);
+    const Status written = from_wire(writer_.write(frame));
     lock.lock();
     if (!written) {
       status_ = written;

@@ -232,13 +232,13 @@ TEST(Recording, EveryFieldOfEveryFrameComesBackFromTheFile) {
   }
   EXPECT_EQ(set_fields.size(), static_cast<std::size_t>(v1::Frame::descriptor()->field_count()));
   {
-    Result<client::RecordingWriter> writer = client::RecordingWriter::create(path);
+    client::Result<client::RecordingWriter> writer = client::RecordingWriter::create(path);
     ASSERT_TRUE(writer.ok()) << writer.error();
     for (const v1::Frame& frame : written)
       ASSERT_TRUE(writer.value().write(frame).is_ok());
     ASSERT_TRUE(writer.value().finish().is_ok());
   }
-  Result<client::RecordingReader> reader = client::RecordingReader::open(path);
+  client::Result<client::RecordingReader> reader = client::RecordingReader::open(path);
   ASSERT_TRUE(reader.ok()) << reader.error();
   v1::Frame frame;
   for (const v1::Frame& expected : written) {
@@ -258,7 +258,7 @@ TEST(FuzzFiles, Recordings) {
   std::filesystem::create_directories(dir);
   const std::string good_path = (dir / "good.rec").string();
   {
-    Result<client::RecordingWriter> writer = client::RecordingWriter::create(good_path);
+    client::Result<client::RecordingWriter> writer = client::RecordingWriter::create(good_path);
     ASSERT_TRUE(writer.ok()) << writer.error();
     for (int k = 0; k < 20; ++k) {
       v1::Frame frame;
@@ -302,7 +302,7 @@ TEST(FuzzFiles, Recordings) {
       std::fclose(file);
     }
     ++tally.tried;
-    Result<client::RecordingReader> reader = client::RecordingReader::open(path);
+    client::Result<client::RecordingReader> reader = client::RecordingReader::open(path);
     if (!reader) {
       ++tally.refused;
       continue;
@@ -394,7 +394,7 @@ TEST(FuzzFiles, CraftedRecordingsAreRefusedNamingWhatIsWrong) {
       std::ofstream file(path, std::ios::binary | std::ios::trunc);
       file << header << c.bytes;
     }
-    Result<client::RecordingReader> reader = client::RecordingReader::open(path);
+    client::Result<client::RecordingReader> reader = client::RecordingReader::open(path);
     ASSERT_TRUE(reader) << c.what;
     v1::Frame frame;
     while (reader.value().next(&frame))
@@ -407,7 +407,7 @@ TEST(FuzzFiles, CraftedRecordingsAreRefusedNamingWhatIsWrong) {
     std::ofstream file(path, std::ios::binary | std::ios::trunc);
     file << header << framed(sound) << framed(sound);
   }
-  Result<client::RecordingReader> whole = client::RecordingReader::open(path);
+  client::Result<client::RecordingReader> whole = client::RecordingReader::open(path);
   ASSERT_TRUE(whole);
   v1::Frame frame;
   while (whole.value().next(&frame)) {

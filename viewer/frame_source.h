@@ -14,6 +14,9 @@
 
 namespace tumble::viewer {
 
+using wire::Result;
+using wire::Status;
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;

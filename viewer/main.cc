@@ -21,6 +21,8 @@
 #include "world_view.h"
 
 using namespace tumble;
+using tumble::wire::Result;
+using tumble::wire::Status;
 
 int main(int argc, char** argv) {
   CLI::App app{"tumble-viewer: draws a running tumble-server's world, or plays a recording."};

@@ -74,9 +74,9 @@ void put_map(mcap::Bytes& out, const std::map<std::uint16_t, std::uint64_t>& map
 
 }  // namespace
 
-Result<RecordingWriter> RecordingWriter::create(const std::string& path) {
+wire::Result<RecordingWriter> RecordingWriter::create(const std::string& path) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) return Status::error(path + ": cannot create");
+  if (!file) return wire::Status::error(path + ": cannot create");
   RecordingWriter writer;
   writer.file_ = std::move(file);
   writer.open_ = true;
@@ -87,7 +87,8 @@ Result<RecordingWriter> RecordingWriter::create(const std::string& path) {
     put_schema(start, channel);
     put_channel(start, channel);
   }
-  if (Status s = writer.put(start.data()); !s) return Status::error(path + ": cannot write");
+  if (wire::Status s = writer.put(start.data()); !s)
+    return wire::Status::error(path + ": cannot write");
   return writer;
 }
 
@@ -115,20 +116,20 @@ RecordingWriter::~RecordingWriter() {
   if (open_) finish();
 }
 
-Status RecordingWriter::put(std::string_view bytes, bool data_section) {
+wire::Status RecordingWriter::put(std::string_view bytes, bool data_section) {
   file_.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   if (!file_.flush()) {
     open_ = false;
-    return Status::error("recording: cannot write (disk full?)");
+    return wire::Status::error("recording: cannot write (disk full?)");
   }
   if (data_section) data_crc_ = crc32_of(data_crc_, bytes);
   position_ += bytes.size();
-  return Status::ok();
+  return wire::Status::ok();
 }
 
-Status RecordingWriter::add_message(const mcap::ChannelInfo& channel, std::uint32_t sequence,
-                                    std::uint64_t log_time, std::uint64_t publish_time,
-                                    const google::protobuf::Message& message) {
+wire::Status RecordingWriter::add_message(const mcap::ChannelInfo& channel, std::uint32_t sequence,
+                                          std::uint64_t log_time, std::uint64_t publish_time,
+                                          const google::protobuf::Message& message) {
   if (chunk_.size() == 0) {
     chunk_start_time_ = log_time;
     chunk_end_time_ = log_time;
@@ -148,11 +149,11 @@ Status RecordingWriter::add_message(const mcap::ChannelInfo& channel, std::uint3
   ++messages_;
   start_time_ = std::min(start_time_, log_time);
   end_time_ = std::max(end_time_, log_time);
-  return Status::ok();
+  return wire::Status::ok();
 }
 
-Status RecordingWriter::write(const v1::Frame& frame) {
-  if (!open_) return Status::error("recording: not open (finished, or a write failed)");
+wire::Status RecordingWriter::write(const v1::Frame& frame) {
+  if (!open_) return wire::Status::error("recording: not open (finished, or a write failed)");
   // Wall-clock time (when the server stepped) orders the messages, as Foxglove's timeline wants;
   // the simulated time is in each message. A frame without it uses the simulated time.
   const std::uint64_t simulated = static_cast<std::uint64_t>(
@@ -187,11 +188,11 @@ Status RecordingWriter::write(const v1::Frame& frame) {
   const double age =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - chunk_opened_).count();
   if (chunk_.size() >= kChunkBytes || age >= kChunkSeconds) return flush_chunk();
-  return Status::ok();
+  return wire::Status::ok();
 }
 
-Status RecordingWriter::flush_chunk() {
-  if (chunk_.size() == 0) return Status::ok();
+wire::Status RecordingWriter::flush_chunk() {
+  if (chunk_.size() == 0) return wire::Status::ok();
   mcap::Bytes content, record;
   content.put(chunk_start_time_);
   content.put(chunk_end_time_);
@@ -202,7 +203,7 @@ Status RecordingWriter::flush_chunk() {
   content.append(chunk_.data());
   mcap::put_record(record, mcap::kChunk, content.data());
   ChunkIndex index{chunk_start_time_, chunk_end_time_, position_, record.size(), 0, {}};
-  if (Status s = put(record.data()); !s) return s;
+  if (wire::Status s = put(record.data()); !s) return s;
   // Each channel's messages in the chunk: (log time, offset within the chunk's records).
   mcap::Bytes indexes;
   for (const auto& [channel, entries] : chunk_messages_) {
@@ -217,23 +218,23 @@ Status RecordingWriter::flush_chunk() {
     mcap::put_record(indexes, mcap::kMessageIndex, entry.data());
   }
   index.index_length = indexes.size();
-  if (Status s = put(indexes.data()); !s) return s;
+  if (wire::Status s = put(indexes.data()); !s) return s;
   chunks_.push_back(std::move(index));
   chunk_.clear();
   chunk_messages_.clear();
-  return Status::ok();
+  return wire::Status::ok();
 }
 
-Status RecordingWriter::finish() {
-  if (!open_) return Status::error("recording: not open (finished, or a write failed)");
-  if (Status s = flush_chunk(); !s) return s;
+wire::Status RecordingWriter::finish() {
+  if (!open_) return wire::Status::error("recording: not open (finished, or a write failed)");
+  if (wire::Status s = flush_chunk(); !s) return s;
   mcap::Bytes data_end;
   {
     mcap::Bytes content;
     content.put(data_crc_);
     mcap::put_record(data_end, mcap::kDataEnd, content.data());
   }
-  if (Status s = put(data_end.data(), false); !s) return s;
+  if (wire::Status s = put(data_end.data(), false); !s) return s;
 
   // The summary: schemas, channels, statistics and chunk indexes, each group's place recorded
   // in the summary offsets.
@@ -304,7 +305,7 @@ Status RecordingWriter::finish() {
   footer.put(crc32_of(crc32_of(0, summary.data()), footer.data()));
   summary.append(footer.data());
   summary.append(std::string_view(mcap::kMagic, mcap::kMagicSize));
-  Status written = put(summary.data(), false);
+  wire::Status written = put(summary.data(), false);
   open_ = false;
   file_.close();
   return written;

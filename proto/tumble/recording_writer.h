@@ -12,35 +12,35 @@
 #include <string>
 #include <vector>
 
-#include "physics/status.h"
 #include "tumble/mcap.h"
 #include "tumble/v1/world.pb.h"
+#include "tumble/wire_status.h"
 
 namespace tumble {
 
 class RecordingWriter {
  public:
-  static Result<RecordingWriter> create(const std::string& path);
+  static wire::Result<RecordingWriter> create(const std::string& path);
   RecordingWriter(RecordingWriter&& other) noexcept { *this = std::move(other); }
   RecordingWriter& operator=(RecordingWriter&& other) noexcept;
   ~RecordingWriter();  // finishes the file if finish() was not called
 
   // A chunk goes to the file once it holds kChunkBytes or is kChunkSeconds old, so a recording
   // cut short (the process killed) loses at most that much; its readers still read it.
-  Status write(const v1::Frame& frame);
+  wire::Status write(const v1::Frame& frame);
   // The last chunk, the indexes and the summary: the file is whole.
-  Status finish();
+  wire::Status finish();
 
   static constexpr std::size_t kChunkBytes = 256 << 10;
   static constexpr double kChunkSeconds = 0.5;
 
  private:
   RecordingWriter() = default;
-  Status put(std::string_view bytes, bool data_section = true);
-  Status add_message(const mcap::ChannelInfo& channel, std::uint32_t sequence,
-                     std::uint64_t log_time, std::uint64_t publish_time,
-                     const google::protobuf::Message& message);
-  Status flush_chunk();
+  wire::Status put(std::string_view bytes, bool data_section = true);
+  wire::Status add_message(const mcap::ChannelInfo& channel, std::uint32_t sequence,
+                           std::uint64_t log_time, std::uint64_t publish_time,
+                           const google::protobuf::Message& message);
+  wire::Status flush_chunk();
 
   struct ChunkIndex {
     std::uint64_t start_time, end_time, offset, length, index_length;

@@ -1,7 +1,9 @@
-// Spawns a body in a running server and reads it back, with an installed Tumble's client library.
+// Spawns a body in a running server and reads it back, with an installed Tumble's client library
+// (which links none of the engine); and asks for a recording that is not there.
 #include <cstdio>
 
 #include "tumble/client.h"
+#include "tumble/recording.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) return 2;
@@ -15,5 +17,7 @@ int main(int argc, char** argv) {
   if (!bodies) return 1;
   std::printf("body %llu at z = %.2f m\n", static_cast<unsigned long long>(ids.value()[0]),
               bodies.value().states(0).position().z());
-  return 0;
+  auto missing = tumble::client::RecordingReader::open("/nonexistent.mcap");
+  std::printf("%s\n", missing.ok() ? "opened?" : missing.error().c_str());
+  return missing.ok() ? 1 : 0;
 }

@@ -64,7 +64,11 @@ def test_the_client_builds_against_an_install_and_talks_to_a_server(tmp_path):
     server = Server()
     try:
         for user in (build / "client_user", program):
-            assert "at z = 3.00 m" in run([user, server.address])
+            said = run([user, server.address])
+            assert "at z = 3.00 m" in said and "/nonexistent.mcap: cannot open" in said
     finally:
         code, rest = server.stop()
     assert code == 0, rest
+    # The client links none of the engine: its pkg-config file does not ask for it.
+    libs = run(["pkg-config", "--libs", "tumble-client"], env={"PKG_CONFIG_PATH": pc_dir})
+    assert "-ltumble_physics" not in libs and "-lqhull_r" not in libs
