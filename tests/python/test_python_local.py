@@ -148,3 +148,11 @@ def test_threads_sharing_a_world_take_turns():
         thread.join()
     assert world.info().step == 80
     assert reads == [(51, 3)] * 200
+
+
+def test_a_thread_count_beyond_reason_is_refused():
+    for threads in (-1, 10**6):
+        with pytest.raises(tumble.Error) as refused:
+            tumble.World(threads=threads)
+        assert refused.value.message.startswith("threads: must be in [0, 1024]")
+    assert tumble.World(threads=2).step(1) == 1

@@ -202,6 +202,8 @@ LocalLimits limits_of(std::size_t max_bodies, const std::map<std::string, double
   return limits;
 }
 
+constexpr int kMaxThreads = 1024;
+
 // Frames of one reader: each steps the world once and describes what is new to this reader.
 struct Reader {
   LocalWorld* world;
@@ -224,6 +226,10 @@ PYBIND11_MODULE(_engine, module) {
 
   py::class_<LocalWorld>(module, "LocalWorld")
       .def(py::init([](int threads, std::size_t max_bodies, std::map<std::string, double> limits) {
+             // Each thread of the team is a real thread: bounded as a request's cost is.
+             if (threads < 0 || threads > kMaxThreads)
+               check(tumble::Status::error("threads: must be in [0, " +
+                                           std::to_string(kMaxThreads) + "] (0: every core)"));
              return std::make_unique<LocalWorld>(threads, limits_of(max_bodies, limits));
            }),
            py::arg("threads") = 0, py::arg("max_bodies") = 100000,
