@@ -57,7 +57,9 @@ int main(int argc, char** argv) {
                  "bullet, slide, spin, bounce, default");
   app.add_option("--solver", solver, "exact, pgs, soft or auto (default: the scene's)");
   app.add_option("--duration", duration, "simulated seconds (default: the scene's)");
-  app.add_option("--threads", threads, "OpenMP threads (0 = all; default: the scene's)");
+  app.add_option("--threads", threads, "OpenMP threads (0 = all; default: the scene's)")
+      ->check(cli::non_negative)
+      ->check(CLI::Range(0, 1024));
   bool no_sleep = false;
   app.add_flag("--no-sleep", no_sleep, "keep every body awake");
   double manifold_reuse = -1;

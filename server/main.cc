@@ -100,7 +100,8 @@ int main(int argc, char** argv) {
       ->envname("TUMBLE_STANDARD");
   app.add_option("--threads", threads, "OpenMP threads for the step (0: all)")
       ->envname("TUMBLE_THREADS")
-      ->check(cli::non_negative);
+      ->check(cli::non_negative)
+      ->check(CLI::Range(0, 1024));
   app.add_option("--real-time-factor", real_time_factor,
                  "1: simulated time at wall-clock pace; 0: as fast as possible")
       ->envname("TUMBLE_REAL_TIME_FACTOR")

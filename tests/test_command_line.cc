@@ -81,6 +81,12 @@ TEST(CommandLine, MistakesAreNamedAsWhatTheyAre) {
   const Output negative = run(std::string(TUMBLE_SERVER_BINARY) + " --threads -2");
   EXPECT_EQ(negative.code, 2);
   EXPECT_NE(negative.text.find("must be 0 or more"), std::string::npos) << negative.text;
+  // Each thread of the team is made: a million is refused, not attempted.
+  for (const char* program : {TUMBLE_SERVER_BINARY, TUMBLE_RUN_BINARY}) {
+    const Output many = run(std::string(program) + " --threads 1000000");
+    EXPECT_EQ(many.code, 2) << program;
+    EXPECT_NE(many.text.find("not in range 0 to 1024"), std::string::npos) << many.text;
+  }
 }
 
 // Spinning OpenMP threads collapse a step on a busy machine (passive_wait.h): the programs that
