@@ -101,6 +101,7 @@ struct DdsPublisher::Writers {
     std::string frame;
     Marker marker;
     std::vector<Point> triangles;
+    bool ground = false;  // a half-space: its slab sits below the body's origin
   };
   std::unordered_map<std::uint64_t, RosLook> ros_looks;
   std::vector<std::uint64_t> deleted_markers;  // bodies gone since the last markers went out
@@ -281,8 +282,7 @@ void DdsPublisher::publish_ros2(const FrameData& frame, const std_msgs_msg_dds__
     marker.header = header;
     marker.texture.header = header;
     marker.pose = {{at.x, at.y, at.z}, turn};
-    if (look->second.marker.type == kCube &&
-        frame.catalogue->at(frame.ids[i]).shape.type() == ShapeType::kHalfSpace) {
+    if (look->second.ground) {
       // The slab's top at the ground's surface: its centre half its thickness below, along the
       // ground's normal (its frame's z).
       const Quat q(frame.orientations[4 * i], frame.orientations[4 * i + 1],
@@ -340,6 +340,7 @@ void DdsPublisher::describe_for_ros2(const Catalogue& now) {
                         2 * shape.half_extents().z()};
         break;
       case ShapeType::kHalfSpace:
+        ros.ground = true;
         marker.type = kCube;
         marker.scale = {kGroundWidth, kGroundWidth, kGroundThickness};
         break;

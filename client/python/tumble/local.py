@@ -114,8 +114,7 @@ class World(WorldCalls):
 
     def _rpc(self, method, request, timeout=None):
         answer = self._engine_call("call", method, request.SerializeToString())
-        return getattr(pb, f"{method}Response" if method != "SetBodyState" else
-                       "SetBodyStateResponse").FromString(answer)
+        return getattr(pb, f"{method}Response").FromString(answer)
 
     def _engine_call(self, name, *args):
         try:
