@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
   }
   for (int i = 0; i < from; ++i)
     (void)made.value().step(dt);
-  const WorldStateData saved = made.value().save_state();
+  const std::string saved = made.value().save_state();
   const WorldSettings settings = made.value().settings();
 
   std::printf("%s from step %d, %d steps a round, %d thread(s), sleeping off: ms per step\n",

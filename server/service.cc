@@ -273,8 +273,8 @@ grpc::Status WorldService::get_info(const v1::GetInfoRequest&, v1::GetInfoRespon
 grpc::Status WorldService::snapshot(const v1::SnapshotRequest&, v1::SnapshotResponse* response) {
   SavedWorld saved;
   host_.inspect([&](const HostedWorld& hosted) { saved = save_world(hosted); });
-  // Encoded off the stepping thread: the copy above is all the world waits for.
-  response->set_step(saved.state.step);
+  // The server's wrapping is encoded off the stepping thread; the world waits for its own bytes.
+  response->set_step(saved.step);
   response->set_state(encode_snapshot(saved));
   return grpc::Status::OK;
 }

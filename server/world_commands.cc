@@ -189,7 +189,7 @@ Status replace_world(HostedWorld& hosted, World world, double dt, std::vector<st
 SavedWorld save_world(const HostedWorld& hosted) {
   return {hosted.world.settings(), hosted.world.save_state(), hosted.dt,
           hosted.colours,          hosted.ids.by_slot(),      hosted.ids.next(),
-          hosted.server_instance};
+          hosted.server_instance,  hosted.world.step_count()};
 }
 
 Result<RestoredWorld> decode_restore(std::string_view bytes, const WorldLimits& limits,
@@ -211,8 +211,11 @@ Result<RestoredWorld> decode_restore(std::string_view bytes, const WorldLimits& 
   saved.settings.limits = limits;
   if (Status t = check_time_step(saved.dt, limits); !t)
     return Status::error("state." + t.message());
-  Result<World> world = World::from_state(saved.settings, std::move(saved.state));
-  if (!world) return Status::error("state." + world.error());
+  Result<World> world = World::from_state(saved.settings, saved.state);
+  if (!world) return Status::error("state.engine_state." + world.error());
+  for (std::uint32_t slot = 0; slot < saved.ids.size(); ++slot)
+    if (saved.ids[slot] != 0 && !world.value().id_at(slot).is_valid())
+      return Status::error("state.ids[" + std::to_string(slot) + "]: a free slot has no id");
   return RestoredWorld{std::move(world).value(), std::move(saved)};
 }
 

@@ -1,9 +1,11 @@
-// A snapshot damaged the ways the fuzzing suites try: its bytes mutated, or one field crafted
-// (hostile masses, inverses, inertia, poses, speeds, shape types and sizes, sleep and warm-start
-// indices, free slots, ids, the id counter, a thousand empty slots, settings, limits and dt).
+// A snapshot damaged the ways the fuzzing suites try: its bytes mutated, the engine's bytes
+// inside it mutated (the engine's own tests craft single fields of them: test_world_state.cc,
+// test_limits.cc), or one of the server's fields crafted (ids, colours, the id counter, settings,
+// limits and dt).
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "fuzz_support.h"
@@ -12,72 +14,45 @@
 namespace tumble::testing {
 
 inline std::string damaged_snapshot(Hostile& h, const std::string& good) {
-  if (h.chance(0.4)) return h.mutate(good);
+  if (h.chance(0.3)) return h.mutate(good);
   v1::snapshot::WorldSnapshot s;
-  if (!s.ParseFromString(good) || s.slots_size() == 0) return good;
-  v1::snapshot::Body* b = s.mutable_slots(h.integer(0, s.slots_size() - 1));
-  const auto hostile_entry = [&](auto* field, int size) {
-    if (field->size() == size) field->Set(h.integer(0, size - 1), h.special());
-  };
-  switch (h.integer(0, 17)) {
+  if (!s.ParseFromString(good) || s.ids_size() == 0) return good;
+  const int slot = h.integer(0, s.ids_size() - 1);
+  switch (h.integer(0, 9)) {
     case 0:
-      b->set_mass(h.special());
-      break;
     case 1:
-      b->set_inverse_mass(h.special());
+      *s.mutable_engine_state() = h.mutate(s.engine_state());
       break;
     case 2:
-      hostile_entry(b->mutable_position(), 3);
+    case 3: {
+      // A hostile number (NaN, 1e308, -0...) over any 8 bytes past the engine's 40-byte header,
+      // the length kept: a mass, a speed, an inertia entry, a count or an index of a body.
+      std::string& engine = *s.mutable_engine_state();
+      if (engine.size() < 48) break;
+      const double value = h.special();
+      std::memcpy(engine.data() + h.integer(40, static_cast<int>(engine.size()) - 8), &value, 8);
       break;
-    case 3:
-      hostile_entry(b->mutable_linear_velocity(), 3);
-      break;
+    }
     case 4:
-      hostile_entry(b->mutable_angular_velocity(), 3);
+      s.set_ids(slot, s.ids(h.integer(0, s.ids_size() - 1)));  // perhaps two slots with one id
       break;
     case 5:
-      hostile_entry(b->mutable_inertia_body(), 9);
+      for (int k = h.integer(1, 1000); k > 0; --k) {
+        s.add_ids(0);
+        s.add_colors(0);
+      }
       break;
     case 6:
-      hostile_entry(b->mutable_inverse_inertia_body(), 9);
-      break;
-    case 7:
-      b->mutable_shape()->set_type(static_cast<std::uint32_t>(h.integer(0, 9)));
-      break;
-    case 8:
-      hostile_entry(b->mutable_shape()->mutable_half_extents(), 3);
-      break;
-    case 9:
-      b->set_sleep_island(static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
-      break;
-    case 10:
-      if (s.warm_start().body_a_size() > 0)
-        s.mutable_warm_start()->set_body_a(0, static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
-      break;
-    case 11:
-      if (s.warm_start().normal_size() > 0) s.mutable_warm_start()->set_normal(0, h.special());
-      break;
-    case 12:
-      s.add_free_slots(static_cast<std::uint32_t>(h.integer(0, 1 << 30)));
-      break;
-    case 13:
-      for (int k = h.integer(1, 1000); k > 0; --k)
-        *s.add_slots() = v1::snapshot::Body();
-      break;
-    case 14:
-      b->set_id(s.slots(0).id());  // two slots with one id
-      break;
-    case 15:
       s.set_next_id(UINT64_MAX);
       break;
-    case 16:
+    case 7:
       s.mutable_settings()->mutable_solver()->set_iterations(h.integer(-5, 5000));
       break;
+    case 8:
+      s.mutable_settings()->mutable_limits()->set_max_size(h.special());
+      break;
     default:
-      if (h.chance(0.5))
-        s.mutable_settings()->mutable_limits()->set_max_size(h.special());
-      else
-        s.set_dt(h.special());
+      s.set_dt(h.special());
   }
   return s.SerializeAsString();
 }

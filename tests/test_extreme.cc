@@ -237,7 +237,7 @@ TEST(HeapedBodies, AStepConsidersAtMostTheBoundOfPairs) {
   }
   EXPECT_GT(hits, 0u);
   EXPECT_TRUE(all_finite(one));
-  EXPECT_EQ(one.save_state().slots.size(), two.save_state().slots.size());
+  EXPECT_EQ(one.slot_count(), two.slot_count());
   for (std::uint32_t slot = 0; slot < one.slot_count(); ++slot) {
     const BodyId a = one.id_at(slot), b = two.id_at(slot);
     ASSERT_EQ(a.is_valid(), b.is_valid());

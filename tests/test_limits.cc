@@ -9,6 +9,7 @@
 
 #include "physics/world.h"
 #include "scene_runner.h"
+#include "state_format.h"
 #include "step_limits.h"
 
 namespace tumble {
@@ -221,9 +222,9 @@ TEST(Limits, ARestoredStateIsCheckedAgainstTheLimitsAndForConsistency) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.what);
-    WorldStateData state = world.save_state();
+    WorldStateData state = decode_state(world.save_state()).value();
     c.tamper(state.slots[1].body);
-    Result<World> restored = World::from_state(world.settings(), std::move(state));
+    Result<World> restored = World::from_state(world.settings(), encode_state(state));
     ASSERT_FALSE(restored.ok());
     EXPECT_NE(restored.error().find(std::string("slots[1].") + c.field), std::string::npos)
         << restored.error();

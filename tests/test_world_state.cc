@@ -2,13 +2,25 @@
 // refused with the field named.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <map>
+#include <random>
 #include <set>
 
 #include "scene_runner.h"
+#include "state_format.h"
 
 namespace tumble::testing {
 namespace {
+
+// The engine's state as data, through its own bytes both ways: these tests craft states no
+// world would save.
+WorldStateData data_of(const World& world) {
+  return decode_state(world.save_state()).value();
+}
+Result<World> world_of(const WorldSettings& settings, const WorldStateData& state) {
+  return World::from_state(settings, encode_state(state));
+}
 
 // The default scene plus a tetrahedral hull (an off-centre centroid, so the stored polyhedron is
 // the re-centred one) and two removed bodies (free slots to reuse).
@@ -30,8 +42,8 @@ constexpr double kDt = 1.0 / 60;
 
 TEST(WorldState, RestoredWorldStepsOnBitForBit) {
   World original = busy_world();
-  const WorldStateData saved = original.save_state();
-  ASSERT_FALSE(saved.contact_pairs.empty());
+  const std::string saved = original.save_state();
+  ASSERT_FALSE(data_of(original).contact_pairs.empty());
   Result<World> restored = World::from_state(original.settings(), saved);
   ASSERT_TRUE(restored) << restored.error();
   EXPECT_EQ(restored.value().step_count(), original.step_count());
@@ -54,9 +66,9 @@ TEST(WorldState, RestoredWorldStepsOnBitForBit) {
 // without them the run differs.
 TEST(WorldState, WarmStartCacheChangesTheRun) {
   World original = busy_world();
-  WorldStateData saved = original.save_state();
+  WorldStateData saved = data_of(original);
   saved.contact_pairs.clear();
-  World cold = World::from_state(original.settings(), std::move(saved)).value();
+  World cold = world_of(original.settings(), saved).value();
   run(original, kDt, 30);
   run(cold, kDt, 30);
   EXPECT_NE(state_hash(cold), state_hash(original));
@@ -72,7 +84,7 @@ TEST(WorldState, TouchingPairsKeepTheirColoursFromStepToStep) {
   for (int step = 0; step < 60; ++step) {
     ASSERT_TRUE(world.step(kDt));
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint8_t> now;
-    for (const ContactPairRecord& record : world.save_state().contact_pairs) {
+    for (const ContactPairRecord& record : data_of(world).contact_pairs) {
       ASSERT_LT(record.colour, kContactColours);
       now[{record.a.index, record.b.index}] = record.colour;
       seen.insert(record.colour);
@@ -86,21 +98,21 @@ TEST(WorldState, TouchingPairsKeepTheirColoursFromStepToStep) {
   EXPECT_GT(kept, 1000u);
   EXPECT_GT(seen.size(), 3u);
 
-  WorldStateData uncoloured = world.save_state();
+  WorldStateData uncoloured = data_of(world);
   for (ContactPairRecord& record : uncoloured.contact_pairs)
     record.colour = kNoContactColour;
-  World resumed = World::from_state(world.settings(), std::move(uncoloured)).value();
+  World resumed = world_of(world.settings(), uncoloured).value();
   ASSERT_TRUE(resumed.step(kDt));
-  ASSERT_FALSE(resumed.save_state().contact_pairs.empty());
-  for (const ContactPairRecord& record : resumed.save_state().contact_pairs)
+  ASSERT_FALSE(data_of(resumed).contact_pairs.empty());
+  for (const ContactPairRecord& record : data_of(resumed).contact_pairs)
     EXPECT_LT(record.colour, kContactColours);
 }
 
 TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   const World original = busy_world();
-  const WorldStateData good = original.save_state();
-  auto refused = [&](WorldStateData state, const std::string& field) {
-    Result<World> world = World::from_state(original.settings(), std::move(state));
+  const WorldStateData good = data_of(original);
+  auto refused = [&](const WorldStateData& state, const std::string& field) {
+    Result<World> world = world_of(original.settings(), state);
     ASSERT_FALSE(world) << field;
     EXPECT_NE(world.error().find(field), std::string::npos) << world.error();
   };
@@ -143,7 +155,7 @@ TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   refused(s, "time");
   WorldSettings bad_settings = original.settings();
   bad_settings.solver.iterations = 0;
-  Result<World> world = World::from_state(bad_settings, good);
+  Result<World> world = world_of(bad_settings, good);
   ASSERT_FALSE(world);
   EXPECT_NE(world.error().find("settings.solver.iterations"), std::string::npos);
 }
@@ -190,6 +202,188 @@ TEST(WorldState, ShapeStateRoundTripsAndBadPolyhedraAreRefused) {
   refused(state, "polyhedron");
   ShapeState box{ShapeType::kBox, 0, 0, Vec3(1, -1, 1), nullptr};
   refused(box, "half_extents[1]");
+}
+
+// The bytes' header: magic, version, header size, whole length, the three counts, flags.
+constexpr std::size_t kVersionAt = 8, kLengthAt = 16, kSlotsAt = 24;
+
+template <class T>
+void poke(std::string& bytes, std::size_t at, T value) {
+  std::memcpy(bytes.data() + at, &value, sizeof value);
+}
+
+TEST(StateFormat, HeaderStatesTheVersionAndTheSizes) {
+  const World world = busy_world();
+  const std::string bytes = world.save_state();
+  ASSERT_EQ(bytes.compare(0, 8, "TUMBLEWS"), 0);
+  const StateSizes sizes = World::state_sizes(bytes).value();
+  const WorldStateData data = data_of(world);
+  EXPECT_EQ(sizes.bytes, bytes.size());
+  EXPECT_EQ(sizes.slots, data.slots.size());
+  EXPECT_EQ(sizes.free_slots, 2u);
+  EXPECT_EQ(sizes.contact_pairs, data.contact_pairs.size());
+  // Encoding what was decoded gives the same bytes: nothing is lost or reordered.
+  EXPECT_EQ(encode_state(data), bytes);
+}
+
+TEST(StateFormat, AnotherVersionIsRefusedNamingBoth) {
+  const World world = busy_world();
+  for (std::uint32_t version : {0u, World::kStateFormatVersion + 1, 7u}) {
+    std::string bytes = world.save_state();
+    poke(bytes, kVersionAt, version);
+    Result<World> restored = World::from_state(world.settings(), bytes);
+    ASSERT_FALSE(restored);
+    EXPECT_NE(restored.error().find("format version " + std::to_string(version)), std::string::npos)
+        << restored.error();
+    EXPECT_NE(restored.error().find("reads version " + std::to_string(World::kStateFormatVersion)),
+              std::string::npos)
+        << restored.error();
+  }
+}
+
+TEST(StateFormat, EveryTruncationAndLyingHeaderIsRefused) {
+  World world = busy_world();
+  const std::string bytes = world.save_state();
+  // Cut anywhere (the header's length then disagrees, so fix it too: the body must be checked).
+  for (std::size_t n = 0; n < bytes.size(); n += 1 + n / 64) {
+    std::string cut = bytes.substr(0, n);
+    if (n >= kLengthAt + 8) poke(cut, kLengthAt, std::uint64_t{n});
+    EXPECT_FALSE(World::from_state(world.settings(), cut)) << "cut at " << n;
+  }
+  std::string longer = bytes + "x";
+  EXPECT_FALSE(World::from_state(world.settings(), longer));
+  poke(longer, kLengthAt, std::uint64_t{longer.size()});
+  Result<World> trailing = World::from_state(world.settings(), longer);
+  ASSERT_FALSE(trailing);
+  EXPECT_NE(trailing.error().find("after the last pair"), std::string::npos) << trailing.error();
+  // Counts the bytes cannot hold are refused from the header, before anything is allocated.
+  std::string lying = bytes;
+  poke(lying, kSlotsAt, std::uint32_t{4000000000u});
+  Result<StateSizes> sizes = World::state_sizes(lying);
+  ASSERT_FALSE(sizes);
+  EXPECT_NE(sizes.error().find("do not fit"), std::string::npos) << sizes.error();
+  EXPECT_FALSE(World::from_state(world.settings(), "TUMBLEWS"));
+  EXPECT_FALSE(World::from_state(world.settings(), ""));
+}
+
+TEST(StateFormat, RestoreStateIsAllOrNothing) {
+  World world = busy_world();
+  const std::string before = world.save_state();
+  const std::uint64_t hash = state_hash(world);
+  std::string bad = before;
+  bad[bad.size() / 2] ^= 0x5a;
+  bad[bad.size() / 3] ^= 0x7f;
+  WorldStateData broken = data_of(world);
+  broken.slots[3].body.mass = -1;
+  for (const std::string& bytes : {bad, encode_state(broken), std::string("nonsense")}) {
+    if (world.restore_state(bytes)) continue;  // a flip may land on a value still valid
+    EXPECT_EQ(state_hash(world), hash);
+    EXPECT_EQ(world.save_state(), before);
+  }
+  World other = busy_world();
+  run(other, kDt, 30);
+  ASSERT_TRUE(world.restore_state(other.save_state()));
+  EXPECT_EQ(state_hash(world), state_hash(other));
+}
+
+// Random damage to saved bytes never crashes or leaves an unchecked value: every state either is
+// refused or steps within the limits (fuzz, as the server's snapshots are fuzzed).
+TEST(StateFormat, DamagedBytesAreRefusedOrStepSafely) {
+  const World world = busy_world();
+  const std::string good = world.save_state();
+  std::mt19937_64 random(36);
+  int refused = 0, accepted = 0;
+  for (int round = 0; round < 400; ++round) {
+    std::string bytes = good;
+    const int flips = 1 + static_cast<int>(random() % 8);
+    for (int k = 0; k < flips; ++k) {
+      const std::size_t at = random() % bytes.size();
+      switch (random() % 3) {
+        case 0:
+          bytes[at] = static_cast<char>(random());
+          break;
+        case 1:
+          bytes[at] ^= static_cast<char>(1 << (random() % 8));
+          break;
+        default:
+          bytes.erase(at, 1 + random() % 16);
+          break;
+      }
+    }
+    Result<World> restored = World::from_state(world.settings(), bytes);
+    if (!restored) {
+      EXPECT_FALSE(restored.error().empty());
+      ++refused;
+      continue;
+    }
+    ++accepted;
+    for (int step = 0; step < 5; ++step)
+      ASSERT_TRUE(restored.value().step(kDt));
+    for (std::uint32_t slot = 0; slot < restored.value().slot_count(); ++slot)
+      if (const BodyId id = restored.value().id_at(slot); id.is_valid())
+        EXPECT_TRUE(check_limits(restored.value().body(id), world.settings().limits));
+  }
+  EXPECT_GT(refused, 100);
+  EXPECT_GT(accepted, 0);  // some flips land on values still valid (a velocity's low bits)
+}
+
+// Issue 31 (8): a restored hull must be the hull its vertices make, not whatever was stored.
+// Each damage is made in the bytes of a world holding one hull, at the place the format puts it.
+TEST(StateFormat, ARestoredHullMustBeTheHullItsVerticesMake) {
+  World world;
+  BodyDef rock;
+  std::vector<Vec3> points;
+  for (double x : {-1.0, 1.0})
+    for (double y : {-1.0, 1.0})
+      for (double z : {-1.0, 1.0})
+        points.emplace_back(x * 0.5, y * 0.7, z * 0.9);
+  points.emplace_back(0, 0, 1);  // a roof
+  rock.shape = HullDef{points};
+  ASSERT_TRUE(world.create_body(rock));
+  const std::string good = world.save_state();
+  const ConvexPolyhedron& hull = *world.body(world.id_at(0)).shape().polyhedron();
+  // Header, time, step, generation, alive; then the shape: type, radius, half height, extents.
+  const std::size_t vertex_count_at = kStateHeaderBytes + 8 + 8 + 4 + 1 + 1 + 8 + 8 + 24;
+  const std::size_t vertices_at = vertex_count_at + 4;
+  const std::size_t faces_at = vertices_at + 24 * hull.vertices.size() + 4;
+  const std::size_t centroid_at = faces_at + 40 * hull.faces.size() + 4 +
+                                  4 * hull.face_vertices.size() + 4 + 16 * hull.edges.size();
+  const std::size_t volume_at = centroid_at + 24;
+  ASSERT_EQ(good.substr(vertices_at, 8),
+            std::string(reinterpret_cast<const char*>(&hull.vertices[0].x()), 8));
+  ASSERT_EQ(good.substr(volume_at, 8), std::string(reinterpret_cast<const char*>(&hull.volume), 8));
+  struct Damage {
+    const char* what;
+    std::size_t at;
+    double add;
+    const char* named;
+  };
+  const Damage damages[] = {
+      {"a vertex 1e4 m off its faces", vertices_at, 1e4, "polyhedron."},
+      {"a face offset shifted by 100 m", faces_at + 24, 100, "off its plane"},
+      {"a volume of 1e300", volume_at, 1e300, "polyhedron.volume"},
+      {"a centroid 1 m away", centroid_at, 1, "polyhedron.centroid"},
+  };
+  for (const Damage& damage : damages) {
+    std::string bytes = good;
+    double value;
+    std::memcpy(&value, bytes.data() + damage.at, 8);
+    value += damage.add;
+    std::memcpy(bytes.data() + damage.at, &value, 8);
+    Result<World> restored = World::from_state(world.settings(), bytes);
+    ASSERT_FALSE(restored) << damage.what;
+    EXPECT_NE(restored.error().find(damage.named), std::string::npos)
+        << damage.what << ": " << restored.error();
+    EXPECT_NE(restored.error().find("slots[0].shape."), std::string::npos) << restored.error();
+  }
+  // A million more vertices than there are: refused from the count, before any is read.
+  std::string bytes = good;
+  poke(bytes, vertex_count_at, std::uint32_t{1000000});
+  Result<World> many = World::from_state(world.settings(), bytes);
+  ASSERT_FALSE(many);
+  EXPECT_NE(many.error().find("polyhedron.vertices: 1000000 entries"), std::string::npos)
+      << many.error();
+  EXPECT_TRUE(World::from_state(world.settings(), good));
 }
 
 }  // namespace

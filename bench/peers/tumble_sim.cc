@@ -23,9 +23,9 @@ class TumbleSimulation final : public Simulation {
         settings_ = "pgs, " + std::to_string(s.iterations) + " iterations";
         break;
       case SolverKind::kAuto:
-        settings_ = "soft; exact where soft would differ (<= " +
-                    std::to_string(s.exact_max_points) +
-                    " points, a mass ratio > 4 or a body under 100 soft sags)";
+        settings_ =
+            "soft; exact where soft would differ (<= " + std::to_string(s.exact_max_points) +
+            " points, a mass ratio > 4 or a body under 100 soft sags)";
         break;
       case SolverKind::kExact:
         settings_ = "Lemke, " + std::to_string(s.friction_directions) + "-sided friction pyramid";
@@ -68,9 +68,9 @@ PeerScene peer_scene(const SceneDef& scene) {
   PeerScene peer;
   peer.scene = &scene;
   for (const BodyDef& def : scene.bodies) {
-    Result<Body> body = make_body(def);
+    Result<MassProperties> body = body_mass_properties(def);
     peer.mass.push_back(body ? body.value().mass : 0);
-    peer.inertia.push_back(body ? Vec3(body.value().inertia_body.diagonal()) : Vec3::Zero());
+    peer.inertia.push_back(body ? Vec3(body.value().inertia.diagonal()) : Vec3::Zero());
   }
   return peer;
 }

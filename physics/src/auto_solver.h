@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <span>
 
+#include "body_state.h"
 #include "islands.h"
-#include "physics/body.h"
 #include "physics/step.h"
 
 namespace tumble {

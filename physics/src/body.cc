@@ -1,7 +1,7 @@
 #include <cmath>
 #include <string>
 
-#include "physics/body.h"
+#include "body_state.h"
 
 namespace tumble {
 namespace {
@@ -71,6 +71,17 @@ Result<Body> make_body(const BodyDef& def) {
   }
   body.update_world_inertia();
   return body;
+}
+
+Result<MassProperties> body_mass_properties(const BodyDef& def) {
+  Result<Body> body = make_body(def);
+  if (!body) return body.status();
+  MassProperties props;
+  props.mass = body.value().mass;
+  props.inertia = body.value().inertia_body;
+  if (!body.value().is_static() || std::isfinite(body.value().shape.volume()))
+    props.center_of_mass = Shape::create(def.shape).value().mass_properties(1.0).center_of_mass;
+  return props;
 }
 
 }  // namespace tumble

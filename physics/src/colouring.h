@@ -16,8 +16,8 @@
 #include <span>
 #include <vector>
 
+#include "contact_record.h"
 #include "islands.h"
-#include "physics/world_state.h"
 
 namespace tumble {
 

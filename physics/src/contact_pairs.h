@@ -1,13 +1,13 @@
-// Touching pairs kept from step to step (ContactPairRecord, world_state.h): matching this step's
+// Touching pairs kept from step to step (ContactPairRecord, contact_record.h): matching this step's
 // pairs to last step's records, how far the pair has moved since, and recording a manifold.
 #pragma once
 
 #include <cstdint>
 #include <span>
 
+#include "contact_record.h"
 #include "narrow_phase.h"
 #include "physics/world.h"
-#include "physics/world_state.h"
 
 namespace tumble {
 

@@ -12,11 +12,11 @@
 #include <span>
 #include <vector>
 
-#include "physics/body.h"
+#include "body_state.h"
+#include "contact_record.h"
 #include "physics/collision.h"
 #include "physics/math.h"
 #include "physics/step.h"
-#include "physics/world_state.h"
 
 namespace tumble {
 

@@ -1,8 +1,8 @@
 // Time integration of one body: symplectic Euler with an implicit-midpoint gyroscopic step.
 #pragma once
 
+#include "body_state.h"
 #include "contact_solver.h"
-#include "physics/body.h"
 
 namespace tumble {
 

@@ -1,5 +1,7 @@
 #include "physics/limits.h"
 
+#include "body_state.h"
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -97,13 +99,17 @@ Status validate(const WorldLimits& l) {
   return Status::ok();
 }
 
+double speed_of(const Vec3& velocity) {
+  return std::hypot(velocity.x(), velocity.y(), velocity.z());
+}
+
 Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,
                     const WorldLimits& limits) {
   if (!is_finite(linear_velocity)) return Status::error("linear_velocity: must be finite");
   if (!is_finite(angular_velocity)) return Status::error("angular_velocity: must be finite");
-  if (const double v = linear_velocity.stableNorm(); v > limits.max_linear_speed)
+  if (const double v = speed_of(linear_velocity); v > limits.max_linear_speed)
     return above("linear_velocity", v, "m/s", "max_linear_speed", limits.max_linear_speed);
-  if (const double w = angular_velocity.stableNorm(); w > limits.max_angular_speed)
+  if (const double w = speed_of(angular_velocity); w > limits.max_angular_speed)
     return above("angular_velocity", w, "rad/s", "max_angular_speed", limits.max_angular_speed);
   return Status::ok();
 }
@@ -149,6 +155,12 @@ struct BodyFields {
 
 Status check_limits(const Body& body, const WorldLimits& limits) {
   return check_body_limits(BodyFields{body}, limits);
+}
+
+Status check_definition(const BodyDef& def, const WorldLimits& limits) {
+  Result<Body> body = make_body(def);
+  if (!body) return body.status();
+  return check_limits(body.value(), limits);
 }
 
 Status check_limits(BodyView body, const WorldLimits& limits) {

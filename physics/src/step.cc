@@ -17,6 +17,7 @@
 #include "step_limits.h"
 #include "step_scratch.h"
 #include "tall_stacks.h"
+#include "world_slot.h"
 
 namespace tumble {
 namespace {

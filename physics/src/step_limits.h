@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "physics/body.h"
+#include "body_state.h"
 #include "physics/limits.h"
 
 namespace tumble {

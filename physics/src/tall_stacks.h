@@ -17,8 +17,8 @@
 #include <span>
 #include <vector>
 
+#include "body_state.h"
 #include "islands.h"
-#include "physics/body.h"
 #include "physics/math.h"
 #include "physics/step.h"
 

@@ -1,4 +1,5 @@
 #include "physics/world.h"
+#include "world_slot.h"
 
 #include <omp.h>
 
@@ -452,6 +453,10 @@ Status World::wake(BodyId id) {
 bool World::contains(BodyId id) const {
   return id.index < bodies_.size() && bodies_[id.index].alive &&
          bodies_[id.index].generation == id.generation;
+}
+
+std::uint32_t World::slot_count() const {
+  return static_cast<std::uint32_t>(bodies_.size());
 }
 
 BodyView World::body(BodyId id) const {

@@ -7,6 +7,7 @@
 #include "parallel.h"
 #include "physics/world.h"
 #include "step_scratch.h"
+#include "world_slot.h"
 
 namespace tumble {
 

@@ -8,7 +8,10 @@
 
 #include "contact_pairs.h"
 #include "physics/world.h"
+#include "state_format.h"
 #include "step_scratch.h"
+#include "world_slot.h"
+#include "world_state_data.h"
 
 namespace tumble {
 namespace {
@@ -89,19 +92,19 @@ Status check_contact_pair(const ContactPairRecord& record, std::span<const BodyS
 
 }  // namespace
 
-WorldStateData World::save_state() const {
+WorldStateData WorldInternals::state_of(const World& world) {
   WorldStateData state;
-  state.slots.reserve(bodies_.size());
-  for (const Slot& slot : bodies_)
+  state.slots.reserve(world.bodies_.size());
+  for (const World::Slot& slot : world.bodies_)
     state.slots.push_back({slot.generation, slot.alive, slot.alive ? slot.body : Body{}});
-  state.free_slots = free_slots_;
-  state.time = time_;
-  state.step = stats_.step;
-  state.contact_pairs = scratch_->pairs;
+  state.free_slots = world.free_slots_;
+  state.time = world.time_;
+  state.step = world.stats_.step;
+  state.contact_pairs = world.scratch_->pairs;
   return state;
 }
 
-Result<World> World::from_state(const WorldSettings& settings, WorldStateData state) {
+Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldStateData state) {
   if (Status s = validate(settings); !s) return s.within("settings.");
   if (!(state.time >= 0) || !std::isfinite(state.time))
     return Status::error("time: must be finite and >= 0");
@@ -145,8 +148,8 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
     world.bodies_.push_back({std::move(slot.body), slot.generation, slot.alive});
   world.free_slots_ = std::move(state.free_slots);
   world.resting_log_.reserve(256 + slot_count / 4);  // as create_bodies reserves it
-  world.sleeper_head_.assign(slot_count, kNoSlot);
-  world.sleeper_next_.assign(slot_count, kNoSlot);
+  world.sleeper_head_.assign(slot_count, World::kNoSlot);
+  world.sleeper_next_.assign(slot_count, World::kNoSlot);
   for (std::uint32_t i = 0; i < slot_count; ++i) {
     if (!world.bodies_[i].alive) continue;
     if (world.bodies_[i].body.asleep) world.link_sleeper(i, world.bodies_[i].body.sleep_island);
@@ -157,6 +160,27 @@ Result<World> World::from_state(const WorldSettings& settings, WorldStateData st
   world.stats_.step = state.step;
   world.scratch_->pairs = std::move(state.contact_pairs);
   return world;
+}
+
+std::string World::save_state() const {
+  return encode_state(WorldInternals::state_of(*this));
+}
+
+Result<StateSizes> World::state_sizes(std::string_view bytes) {
+  return read_state_header(bytes);
+}
+
+Result<World> World::from_state(const WorldSettings& settings, std::string_view bytes) {
+  Result<WorldStateData> state = decode_state(bytes);
+  if (!state) return state.status();
+  return WorldInternals::world_from(settings, std::move(state).value());
+}
+
+Status World::restore_state(std::string_view bytes) {
+  Result<World> restored = from_state(settings_, bytes);
+  if (!restored) return restored.status();
+  *this = std::move(restored).value();
+  return Status::ok();
 }
 
 }  // namespace tumble

@@ -173,9 +173,7 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   def.restitution = r.number("restitution", def.restitution);
   r.reject_unknown();
   // The engine's own checks (mass, friction, orientation, hull degeneracy...) with this path.
-  Result<Body> body = make_body(def);
-  if (!body) throw FieldError{path + "." + body.error()};
-  if (Status s = check_limits(body.value(), limits); !s) throw FieldError{path + "." + s.message()};
+  if (Status s = check_definition(def, limits); !s) throw FieldError{path + "." + s.message()};
   return def;
 }
 

@@ -87,7 +87,7 @@ Result<std::string> LocalWorld::call(std::string_view method, std::string_view b
   } else if (method == "Snapshot") {
     v1::SnapshotResponse response;
     const SavedWorld saved = save_world(hosted_);
-    response.set_step(saved.state.step);
+    response.set_step(saved.step);
     response.set_state(encode_snapshot(saved));
     answer = serialized(response);
   } else if (method == "Restore") {

@@ -1,9 +1,9 @@
-// Rigid bodies: the definition a body is made from, its id, and the state the engine keeps.
+// Rigid bodies: the definition a body is made from and its id. How the world stores a body is its
+// own business (physics/src/body_state.h); read a body through World::body (body_view.h).
 #pragma once
 
 #include <compare>
 #include <cstdint>
-#include <memory>
 
 #include "physics/math.h"
 #include "physics/shape.h"
@@ -45,39 +45,9 @@ struct BodyDef {
 // Checks a definition without creating anything; the message names the field.
 Status validate(const BodyDef& def);
 
-// The state of one body. The shape is re-centred on the centre of mass, so `position` is the
-// centre of mass (for a hull it differs from BodyDef::position by the rotated centroid offset).
-struct Body {
-  Shape shape;
-  BodyType type = BodyType::kDynamic;
-  double mass = 0, inverse_mass = 0;  // kg, 1/kg (0 for static)
-  Mat3 inertia_body = Mat3::Zero();   // kg m^2, body frame, about the centre of mass
-  Mat3 inverse_inertia_body = Mat3::Zero();
-  Mat3 inverse_inertia_world = Mat3::Zero();  // kept current with the orientation
-  Vec3 position = Vec3::Zero();               // m, centre of mass
-  Quat orientation = Quat::Identity();
-  Vec3 linear_velocity = Vec3::Zero();   // m/s
-  Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
-  double friction = 0.5;
-  double restitution = 0;
-  // The inertia is a multiple of the identity (sphere, cube): no gyroscopic torque.
-  bool spherical_inertia = false;
-  // Sleeping: how long the body has been slower than the sleep thresholds (s), whether it sleeps,
-  // and the island it fell asleep with (its lowest slot), which wakes as one.
-  double sleep_timer = 0;
-  bool asleep = false;
-  std::uint32_t sleep_island = 0;
-
-  bool is_static() const { return type == BodyType::kStatic; }
-  bool is_moving() const { return type == BodyType::kDynamic && !asleep; }
-  Pose pose() const { return {position, orientation}; }
-  void update_world_inertia() {
-    const Mat3 r = orientation.toRotationMatrix();
-    inverse_inertia_world = r * inverse_inertia_body * r.transpose();
-  }
-};
-
-// Builds a body from a validated definition.
-Result<Body> make_body(const BodyDef& def);
+// What a body made from `def` weighs: its mass (kg; 0 for a static body), its inertia about the
+// centre of mass in the shape's axes (kg m^2; zero for a static body), and where that centre lies
+// in the shape's frame (m). Fails as World::create_body would for an invalid definition.
+Result<MassProperties> body_mass_properties(const BodyDef& def);
 
 }  // namespace tumble

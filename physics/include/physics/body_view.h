@@ -13,6 +13,7 @@
 namespace tumble {
 
 class World;
+struct Body;  // the world's own storage (physics/src/body_state.h)
 
 class BodyView {
  public:
@@ -23,34 +24,31 @@ class BodyView {
   // So that `world.body(id)->position()` reads like the pointer it replaces.
   const BodyView* operator->() const { return this; }
 
-  BodyType type() const { return body().type; }
-  bool is_static() const { return body().is_static(); }
-  bool asleep() const { return body().asleep; }
+  BodyType type() const;
+  bool is_static() const;
+  bool asleep() const;
   // Dynamic and awake: what the step moves.
-  bool is_moving() const { return body().is_moving(); }
+  bool is_moving() const;
 
   // The shape, re-centred on the centre of mass.
-  const Shape& shape() const { return body().shape; }
-  double mass() const { return body().mass; }                  // kg; 0 for static
-  double inverse_mass() const { return body().inverse_mass; }  // 1/kg; 0 for static
-  Mat3 inertia_body() const { return body().inertia_body; }    // kg m^2, body frame
-  Mat3 inverse_inertia_world() const { return body().inverse_inertia_world; }
-  double friction() const { return body().friction; }
-  double restitution() const { return body().restitution; }
+  const Shape& shape() const;
+  double mass() const;          // kg; 0 for static
+  double inverse_mass() const;  // 1/kg; 0 for static
+  Mat3 inertia_body() const;    // kg m^2, body frame
+  Mat3 inverse_inertia_world() const;
+  double friction() const;
+  double restitution() const;
 
-  Vec3 position() const { return body().position; }  // m, centre of mass
-  Quat orientation() const { return body().orientation; }
-  Pose pose() const { return body().pose(); }
-  Vec3 linear_velocity() const { return body().linear_velocity; }    // m/s
-  Vec3 angular_velocity() const { return body().angular_velocity; }  // rad/s, world
+  Vec3 position() const;  // m, centre of mass
+  Quat orientation() const;
+  Pose pose() const;
+  Vec3 linear_velocity() const;   // m/s
+  Vec3 angular_velocity() const;  // rad/s, world
 
  private:
   friend class World;
   explicit BodyView(const Body* body) : body_(body) {}
-  const Body& body() const {
-    TUMBLE_ASSERT(body_ != nullptr);
-    return *body_;
-  }
+  const Body& body() const;
 
   const Body* body_ = nullptr;
 };

@@ -46,11 +46,17 @@ std::span<const LimitField> limit_fields();
 // Checks the limits themselves; the message names the field ("max_size: must be > min_size").
 Status validate(const WorldLimits& limits);
 
-// Checks a built body against the limits; the message names the field and the limit
-// ("shape.radius: 1e+18 m is above limits.max_size (100000 m)").
-Status check_limits(const Body& body, const WorldLimits& limits);
-// The same for a body of a world (after a step, say).
+// Everything World::create_body checks of one definition (validate, the shape, its mass) and the
+// body it would make against the limits, without a world; the message names the field and the
+// limit ("shape.radius: 1e+18 m is above limits.max_size (100000 m)").
+Status check_definition(const BodyDef& def, const WorldLimits& limits);
+// The same limits for a body of a world (after a step, say).
 Status check_limits(BodyView body, const WorldLimits& limits);
+
+// The length of a velocity as the limits measure it: without overflow for any finite vector, and
+// the same bits wherever it is computed (Eigen's stableNorm sums in an order that depends on the
+// vector's alignment, so a speed held at the limit in the step read a hair above it elsewhere).
+double speed_of(const Vec3& velocity);
 
 // Checks velocities a body would take ("linear_velocity: ... above limits.max_linear_speed").
 Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,

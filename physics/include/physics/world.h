@@ -5,6 +5,8 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "physics/body.h"
@@ -14,7 +16,6 @@
 #include "physics/math.h"
 #include "physics/status.h"
 #include "physics/step.h"
-#include "physics/world_state.h"
 
 namespace tumble {
 
@@ -64,6 +65,14 @@ struct ImpulseAt {
 
 struct StepScratch;
 
+// The sizes in the header of a saved state (World::state_sizes).
+struct StateSizes {
+  std::uint64_t bytes = 0;
+  std::uint32_t slots = 0;  // body slots, live or free
+  std::uint32_t free_slots = 0;
+  std::uint32_t contact_pairs = 0;
+};
+
 class World {
  public:
   explicit World(const WorldSettings& settings = {});
@@ -95,18 +104,26 @@ class World {
   // The message names the entry ("[3].impulse: ...").
   Status apply_impulses(std::span<const ImpulseAt> impulses);
 
-  // The whole state (settings apart: settings()), and a world made from one. from_state checks
-  // everything (the state may come from a file or the network) and names what is wrong; a world
-  // restored from save_state() steps on exactly as this one would, bit for bit.
-  WorldStateData save_state() const;
-  static Result<World> from_state(const WorldSettings& settings, WorldStateData state);
+  // The whole state (settings apart: settings()) as bytes in the engine's own versioned format
+  // (docs/STATE_FORMAT.md): a world made from them steps on exactly as this one would, bit for bit.
+  // from_state checks everything (the bytes may come from a file or the network) and names what
+  // is wrong; bytes of another format version are refused with a message naming both versions.
+  // restore_state replaces this world's bodies, contacts and clock, keeping its settings, and
+  // changes nothing when it fails.
+  static constexpr std::uint32_t kStateFormatVersion = 1;
+  std::string save_state() const;
+  // What saved bytes hold, from their header alone (checked as from_state checks it), so that a
+  // caller can bound what restoring them would cost before paying it.
+  static Result<StateSizes> state_sizes(std::string_view bytes);
+  static Result<World> from_state(const WorldSettings& settings, std::string_view bytes);
+  Status restore_state(std::string_view bytes);
 
   bool contains(BodyId id) const;
   // A look at the body, false when `id` is stale or was never made.
   BodyView body(BodyId id) const;
   BodyId id_at(std::uint32_t index) const;  // the live body in slot `index`, or an invalid id
   std::size_t body_count() const { return live_count_; }
-  std::uint32_t slot_count() const { return static_cast<std::uint32_t>(bodies_.size()); }
+  std::uint32_t slot_count() const;
 
   const WorldSettings& settings() const { return settings_; }
   // Applies all settings or none: new limits are refused while a body lies beyond them.
@@ -150,12 +167,9 @@ class World {
   std::uint32_t collision_flags() const { return collision_flags_; }
 
  private:
+  friend struct WorldInternals;  // the engine's own state encoding and tests (physics/src)
   static constexpr std::uint32_t kNoSlot = UINT32_MAX;
-  struct Slot {
-    Body body;
-    std::uint32_t generation = 0;
-    bool alive = false;
-  };
+  struct Slot;  // a body and its slot's generation (physics/src/world_slot.h)
   std::uint32_t wake_island(std::uint32_t island);
   // Links the bodies that fall asleep together into their island's set (sleepers_).
   void link_sleeper(std::uint32_t slot, std::uint32_t island);

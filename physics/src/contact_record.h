@@ -1,18 +1,14 @@
-// A world's whole state as plain data: what World::save_state gives and World::from_state takes
-// back, so that a run can be saved and resumed bit for bit. The engine does no I/O; encoding this
-// for a file or the network is its callers' business.
+// A touching pair as the last step left it, kept from step to step (warm starting, feature reuse,
+// the solver's graph colour). Private to the engine; World::save_state carries it.
 #pragma once
 
 #include <array>
 #include <cstdint>
-#include <vector>
 
 #include "physics/body.h"
-#include "physics/step.h"
+#include "physics/math.h"
 
 namespace tumble {
-
-struct WorldSettings;
 
 // One contact point of a touching pair with the impulses the last step left in it: the next
 // step starts from them (warm start), matched to its points by feature id, or else by position in
@@ -48,20 +44,6 @@ struct ContactPairRecord {
   // resting pile's manifolds in the same order every step: below kContactColours, or
   // kNoContactColour (none free then, or an older snapshot: the next step colours it).
   std::uint8_t colour = kNoContactColour;
-};
-
-struct BodySlotState {
-  std::uint32_t generation = 0;
-  bool alive = false;
-  Body body;  // meaningful when alive
-};
-
-struct WorldStateData {
-  std::vector<BodySlotState> slots;
-  std::vector<std::uint32_t> free_slots;  // reused last first
-  double time = 0;                        // s
-  std::uint64_t step = 0;
-  std::vector<ContactPairRecord> contact_pairs;  // sorted by (a.index, b.index), each pair once
 };
 
 }  // namespace tumble

@@ -1,0 +1,55 @@
+// The state the world keeps of one body. Private to the engine: users read bodies through
+// BodyView and save them through World::save_state, so that a field can be added, split off or
+// packed differently without touching anything outside physics/src.
+#pragma once
+
+#include <cstdint>
+
+#include "physics/body.h"
+#include "physics/limits.h"
+#include "physics/math.h"
+#include "physics/shape.h"
+#include "physics/status.h"
+
+namespace tumble {
+
+// The state of one body. The shape is re-centred on the centre of mass, so `position` is the
+// centre of mass (for a hull it differs from BodyDef::position by the rotated centroid offset).
+struct Body {
+  Shape shape;
+  BodyType type = BodyType::kDynamic;
+  double mass = 0, inverse_mass = 0;  // kg, 1/kg (0 for static)
+  Mat3 inertia_body = Mat3::Zero();   // kg m^2, body frame, about the centre of mass
+  Mat3 inverse_inertia_body = Mat3::Zero();
+  Mat3 inverse_inertia_world = Mat3::Zero();  // kept current with the orientation
+  Vec3 position = Vec3::Zero();               // m, centre of mass
+  Quat orientation = Quat::Identity();
+  Vec3 linear_velocity = Vec3::Zero();   // m/s
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
+  double friction = 0.5;
+  double restitution = 0;
+  // The inertia is a multiple of the identity (sphere, cube): no gyroscopic torque.
+  bool spherical_inertia = false;
+  // Sleeping: how long the body has been slower than the sleep thresholds (s), whether it sleeps,
+  // and the island it fell asleep with (its lowest slot), which wakes as one.
+  double sleep_timer = 0;
+  bool asleep = false;
+  std::uint32_t sleep_island = 0;
+
+  bool is_static() const { return type == BodyType::kStatic; }
+  bool is_moving() const { return type == BodyType::kDynamic && !asleep; }
+  Pose pose() const { return {position, orientation}; }
+  void update_world_inertia() {
+    const Mat3 r = orientation.toRotationMatrix();
+    inverse_inertia_world = r * inverse_inertia_body * r.transpose();
+  }
+};
+
+// Builds a body from a validated definition.
+Result<Body> make_body(const BodyDef& def);
+
+// Checks a built body against the limits; the message names the field and the limit
+// ("shape.radius: 1e+18 m is above limits.max_size (100000 m)").
+Status check_limits(const Body& body, const WorldLimits& limits);
+
+}  // namespace tumble

@@ -1,0 +1,367 @@
+#include "state_format.h"
+
+#include <bit>
+#include <cstring>
+#include <memory>
+#include <utility>
+
+#include "physics/world.h"
+
+namespace tumble {
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "the state format is little-endian; a big-endian host would need byte swaps here");
+
+class Writer {
+ public:
+  explicit Writer(std::string* out) : out_(out) {}
+  template <class T>
+  void put(T value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    out_->append(bytes, sizeof(T));
+  }
+  void put(const Vec3& v) {
+    for (int k = 0; k < 3; ++k)
+      put(v[k]);
+  }
+  void put(const Quat& q) {
+    for (double c : {q.w(), q.x(), q.y(), q.z()})
+      put(c);
+  }
+  void put(const Mat3& m) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        put(m(r, c));
+  }
+
+ private:
+  std::string* out_;
+};
+
+// Reads what a Writer wrote; the first shortfall names the field and stops every later read.
+class Reader {
+ public:
+  explicit Reader(std::string_view bytes) : bytes_(bytes) {}
+
+  std::size_t left() const { return bytes_.size() - at_; }
+  const Status& status() const { return status_; }
+  bool ok() const { return status_.is_ok(); }
+
+  template <class T>
+  T take(const char* field) {
+    T value{};
+    if (!ok()) return value;
+    if (left() < sizeof(T)) {
+      fail(std::string(field) + ": the bytes end early (at byte " + std::to_string(at_) + ")");
+      return value;
+    }
+    std::memcpy(&value, bytes_.data() + at_, sizeof(T));
+    at_ += sizeof(T);
+    return value;
+  }
+  Vec3 vec3(const char* field) {
+    Vec3 v;
+    for (int k = 0; k < 3; ++k)
+      v[k] = take<double>(field);
+    return v;
+  }
+  Quat quat(const char* field) {
+    double c[4];
+    for (double& x : c)
+      x = take<double>(field);
+    return Quat(c[0], c[1], c[2], c[3]);
+  }
+  Mat3 mat3(const char* field) {
+    Mat3 m;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        m(r, c) = take<double>(field);
+    return m;
+  }
+  // A count of items of at least `item_bytes` each, refused when the bytes left cannot hold them,
+  // so that nothing is allocated for items that are not there.
+  std::uint32_t count(const char* field, std::size_t item_bytes) {
+    const auto n = take<std::uint32_t>(field);
+    if (ok() && n > left() / item_bytes)
+      fail(std::string(field) + ": " + std::to_string(n) + " entries of at least " +
+           std::to_string(item_bytes) + " bytes, but " + std::to_string(left()) + " bytes left");
+    return ok() ? n : 0;
+  }
+  void fail(std::string message) {
+    if (ok()) status_ = Status::error(std::move(message));
+  }
+
+ private:
+  std::string_view bytes_;
+  std::size_t at_ = 0;
+  Status status_ = Status::ok();
+};
+
+void put_shape(Writer& w, const Shape& shape) {
+  const ShapeState s = shape.state();
+  w.put(static_cast<std::uint8_t>(s.type));
+  w.put(s.radius);
+  w.put(s.half_height);
+  w.put(s.half_extents);
+  if (s.type != ShapeType::kHull) return;
+  const ConvexPolyhedron& p = *s.polyhedron;
+  w.put(static_cast<std::uint32_t>(p.vertices.size()));
+  for (const Vec3& v : p.vertices)
+    w.put(v);
+  w.put(static_cast<std::uint32_t>(p.faces.size()));
+  for (const ConvexPolyhedron::Face& f : p.faces) {
+    w.put(f.normal);
+    w.put(f.offset);
+    w.put(f.first);
+    w.put(f.count);
+  }
+  w.put(static_cast<std::uint32_t>(p.face_vertices.size()));
+  for (std::uint32_t index : p.face_vertices)
+    w.put(index);
+  w.put(static_cast<std::uint32_t>(p.edges.size()));
+  for (const ConvexPolyhedron::Edge& e : p.edges)
+    for (std::uint32_t index : {e.tail, e.head, e.left, e.right})
+      w.put(index);
+  w.put(p.centroid);
+  w.put(p.volume);
+}
+
+Result<Shape> take_shape(Reader& r) {
+  ShapeState s;
+  const auto type = r.take<std::uint8_t>("type");
+  s.radius = r.take<double>("radius");
+  s.half_height = r.take<double>("half_height");
+  s.half_extents = r.vec3("half_extents");
+  if (!r.ok()) return r.status();
+  if (type > static_cast<std::uint8_t>(ShapeType::kHalfSpace))
+    return Status::error("type: unknown shape type " + std::to_string(type));
+  s.type = static_cast<ShapeType>(type);
+  if (s.type == ShapeType::kHull) {
+    auto p = std::make_shared<ConvexPolyhedron>();
+    p->vertices.resize(r.count("polyhedron.vertices", 24));
+    for (Vec3& v : p->vertices)
+      v = r.vec3("polyhedron.vertices");
+    p->faces.resize(r.count("polyhedron.faces", 40));
+    for (ConvexPolyhedron::Face& f : p->faces) {
+      f.normal = r.vec3("polyhedron.faces");
+      f.offset = r.take<double>("polyhedron.faces");
+      f.first = r.take<std::uint32_t>("polyhedron.faces");
+      f.count = r.take<std::uint32_t>("polyhedron.faces");
+    }
+    p->face_vertices.resize(r.count("polyhedron.face_vertices", 4));
+    for (std::uint32_t& index : p->face_vertices)
+      index = r.take<std::uint32_t>("polyhedron.face_vertices");
+    p->edges.resize(r.count("polyhedron.edges", 16));
+    for (ConvexPolyhedron::Edge& e : p->edges)
+      for (std::uint32_t* index : {&e.tail, &e.head, &e.left, &e.right})
+        *index = r.take<std::uint32_t>("polyhedron.edges");
+    p->centroid = r.vec3("polyhedron.centroid");
+    p->volume = r.take<double>("polyhedron.volume");
+    if (!r.ok()) return r.status();
+    s.polyhedron = std::move(p);
+  }
+  return Shape::from_state(s);  // checks every number and index
+}
+
+void put_body(Writer& w, const Body& b) {
+  put_shape(w, b.shape);
+  w.put(static_cast<std::uint8_t>(b.type));
+  w.put(b.mass);
+  w.put(b.inverse_mass);
+  w.put(b.inertia_body);
+  w.put(b.inverse_inertia_body);
+  w.put(b.inverse_inertia_world);
+  w.put(b.position);
+  w.put(b.orientation);
+  w.put(b.linear_velocity);
+  w.put(b.angular_velocity);
+  w.put(b.friction);
+  w.put(b.restitution);
+  w.put(static_cast<std::uint8_t>(b.spherical_inertia));
+  w.put(b.sleep_timer);
+  w.put(static_cast<std::uint8_t>(b.asleep));
+  w.put(b.sleep_island);
+}
+
+// A byte that must be 0 or 1.
+bool take_flag(Reader& r, const char* field) {
+  const auto value = r.take<std::uint8_t>(field);
+  if (value > 1) r.fail(std::string(field) + ": must be 0 or 1, is " + std::to_string(value));
+  return value == 1;
+}
+
+Status take_body(Reader& r, Body* b) {
+  Result<Shape> shape = take_shape(r);
+  if (!shape) return shape.status().within("shape.");
+  b->shape = std::move(shape).value();
+  const auto type = r.take<std::uint8_t>("type");
+  if (r.ok() && type > static_cast<std::uint8_t>(BodyType::kDynamic))
+    return Status::error("type: unknown body type " + std::to_string(type));
+  b->type = static_cast<BodyType>(type);
+  b->mass = r.take<double>("mass");
+  b->inverse_mass = r.take<double>("inverse_mass");
+  b->inertia_body = r.mat3("inertia_body");
+  b->inverse_inertia_body = r.mat3("inverse_inertia_body");
+  b->inverse_inertia_world = r.mat3("inverse_inertia_world");
+  b->position = r.vec3("position");
+  b->orientation = r.quat("orientation");
+  b->linear_velocity = r.vec3("linear_velocity");
+  b->angular_velocity = r.vec3("angular_velocity");
+  b->friction = r.take<double>("friction");
+  b->restitution = r.take<double>("restitution");
+  b->spherical_inertia = take_flag(r, "spherical_inertia");
+  b->sleep_timer = r.take<double>("sleep_timer");
+  b->asleep = take_flag(r, "asleep");
+  b->sleep_island = r.take<std::uint32_t>("sleep_island");
+  return r.status();  // the values are checked with the whole state (world_from)
+}
+
+void put_pair(Writer& w, const ContactPairRecord& p) {
+  w.put(p.a.index);
+  w.put(p.a.generation);
+  w.put(p.b.index);
+  w.put(p.b.generation);
+  w.put(p.relative_position);
+  w.put(p.relative_orientation);
+  w.put(p.feature_kind);
+  w.put(p.feature_first);
+  w.put(p.feature_second);
+  w.put(p.colour);
+  w.put(static_cast<std::uint8_t>(p.count));
+  for (int i = 0; i < p.count; ++i) {
+    const ContactPointRecord& point = p.points[i];
+    w.put(point.feature);
+    w.put(point.local_a);
+    w.put(point.normal_impulse);
+    w.put(point.friction_impulse);
+  }
+}
+
+Status take_pair(Reader& r, ContactPairRecord* p) {
+  p->a.index = r.take<std::uint32_t>("a");
+  p->a.generation = r.take<std::uint32_t>("a");
+  p->b.index = r.take<std::uint32_t>("b");
+  p->b.generation = r.take<std::uint32_t>("b");
+  p->relative_position = r.vec3("relative_position");
+  p->relative_orientation = r.quat("relative_orientation");
+  p->feature_kind = r.take<std::uint8_t>("feature_kind");
+  p->feature_first = r.take<std::uint32_t>("feature_first");
+  p->feature_second = r.take<std::uint32_t>("feature_second");
+  p->colour = r.take<std::uint8_t>("colour");
+  p->count = r.take<std::uint8_t>("count");
+  if (r.ok() && (p->count < 1 || p->count > 4))
+    return Status::error("count: must be 1 to 4, is " + std::to_string(p->count));
+  for (int i = 0; i < p->count; ++i) {
+    ContactPointRecord& point = p->points[i];
+    point.feature = r.take<std::uint64_t>("points");
+    point.local_a = r.vec3("points");
+    point.normal_impulse = r.take<double>("points");
+    point.friction_impulse = r.vec3("points");
+  }
+  return r.status();
+}
+
+// The least bytes of one entry, so that counts are checked against what is left.
+constexpr std::size_t kLeastSlotBytes = 5;   // generation, alive
+constexpr std::size_t kLeastPairBytes = 83;  // ids, pose, feature, colour, count
+
+}  // namespace
+
+std::string encode_state(const WorldStateData& state) {
+  std::string out;
+  out.reserve(kStateHeaderBytes + 16 + state.slots.size() * 400 + state.contact_pairs.size() * 200);
+  Writer w(&out);
+  out.append(kStateMagic, sizeof kStateMagic);
+  w.put(World::kStateFormatVersion);
+  w.put(static_cast<std::uint32_t>(kStateHeaderBytes));
+  const std::size_t length_at = out.size();
+  w.put(std::uint64_t{0});  // the whole length, filled in below
+  w.put(static_cast<std::uint32_t>(state.slots.size()));
+  w.put(static_cast<std::uint32_t>(state.free_slots.size()));
+  w.put(static_cast<std::uint32_t>(state.contact_pairs.size()));
+  w.put(static_cast<std::uint32_t>(0));  // flags: none yet
+  w.put(state.time);
+  w.put(state.step);
+  for (const BodySlotState& slot : state.slots) {
+    w.put(slot.generation);
+    w.put(static_cast<std::uint8_t>(slot.alive));
+    if (slot.alive) put_body(w, slot.body);
+  }
+  for (std::uint32_t slot : state.free_slots)
+    w.put(slot);
+  for (const ContactPairRecord& pair : state.contact_pairs)
+    put_pair(w, pair);
+  const std::uint64_t length = out.size();
+  std::memcpy(out.data() + length_at, &length, sizeof length);
+  return out;
+}
+
+Result<StateSizes> read_state_header(std::string_view bytes) {
+  if (bytes.size() < kStateHeaderBytes || std::memcmp(bytes.data(), kStateMagic, 8) != 0)
+    return Status::error("magic: not a Tumble world state (no TUMBLEWS header)");
+  Reader r(bytes.substr(8, kStateHeaderBytes - 8));
+  const auto version = r.take<std::uint32_t>("version");
+  if (version != World::kStateFormatVersion)
+    return Status::error("version: format version " + std::to_string(version) +
+                         "; this engine reads version " +
+                         std::to_string(World::kStateFormatVersion) + " only");
+  const auto header_bytes = r.take<std::uint32_t>("header");
+  StateSizes sizes;
+  sizes.bytes = r.take<std::uint64_t>("length");
+  sizes.slots = r.take<std::uint32_t>("slots");
+  sizes.free_slots = r.take<std::uint32_t>("free_slots");
+  sizes.contact_pairs = r.take<std::uint32_t>("contact_pairs");
+  const auto flags = r.take<std::uint32_t>("flags");
+  if (header_bytes != kStateHeaderBytes)
+    return Status::error("header: " + std::to_string(header_bytes) + " bytes, expected " +
+                         std::to_string(kStateHeaderBytes));
+  if (sizes.bytes != bytes.size())
+    return Status::error("length: the header says " + std::to_string(sizes.bytes) +
+                         " bytes, there are " + std::to_string(bytes.size()));
+  if (flags != 0) return Status::error("flags: unknown flags " + std::to_string(flags));
+  // Every entry takes bytes: counts the length cannot hold are refused before anything is made.
+  const std::size_t body = bytes.size() - kStateHeaderBytes;
+  if (sizes.slots > body / kLeastSlotBytes || sizes.free_slots > body / 4 ||
+      sizes.contact_pairs > body / kLeastPairBytes ||
+      std::uint64_t{sizes.slots} * kLeastSlotBytes + std::uint64_t{sizes.free_slots} * 4 +
+              std::uint64_t{sizes.contact_pairs} * kLeastPairBytes >
+          body)
+    return Status::error(
+        "counts: the header's counts (" + std::to_string(sizes.slots) + " slots, " +
+        std::to_string(sizes.free_slots) + " free, " + std::to_string(sizes.contact_pairs) +
+        " contact pairs) do not fit in its " + std::to_string(bytes.size()) + " bytes");
+  return sizes;
+}
+
+Result<WorldStateData> decode_state(std::string_view bytes) {
+  Result<StateSizes> sizes = read_state_header(bytes);
+  if (!sizes) return sizes.status();
+  Reader r(bytes.substr(kStateHeaderBytes));
+  WorldStateData state;
+  state.time = r.take<double>("time");
+  state.step = r.take<std::uint64_t>("step");
+  state.slots.resize(sizes.value().slots);
+  for (std::size_t i = 0; i < state.slots.size() && r.ok(); ++i) {
+    BodySlotState& slot = state.slots[i];
+    slot.generation = r.take<std::uint32_t>("generation");
+    slot.alive = take_flag(r, "alive");
+    Status s = slot.alive ? take_body(r, &slot.body) : r.status();
+    if (!s) return s.within("slots[" + std::to_string(i) + "].");
+  }
+  state.free_slots.resize(sizes.value().free_slots);
+  for (std::uint32_t& slot : state.free_slots)
+    slot = r.take<std::uint32_t>("free_slots");
+  state.contact_pairs.resize(sizes.value().contact_pairs);
+  for (std::size_t i = 0; i < state.contact_pairs.size() && r.ok(); ++i)
+    if (Status s = take_pair(r, &state.contact_pairs[i]); !s)
+      return s.within("contact_pairs[" + std::to_string(i) + "].");
+  if (!r.ok()) return r.status();
+  if (r.left() != 0)
+    return Status::error("length: " + std::to_string(r.left()) + " bytes after the last pair");
+  return state;
+}
+
+}  // namespace tumble
