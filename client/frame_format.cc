@@ -103,6 +103,7 @@ Status check_frame(const v1::Frame& frame) {
 
 std::string frame_to_json_line(const v1::Frame& frame) {
   Json line = {{"step", frame.step()}, {"time", frame.time()}, {"dropped", frame.dropped()}};
+  if (frame.changes_only()) line["changes_only"] = true;  // bodies not listed did not change
   const bool velocities = frame.linear_velocities_size() == 3 * frame.ids_size();
   Json bodies = Json::array();
   for (int i = 0; i < frame.ids_size(); ++i) {

@@ -80,6 +80,8 @@ struct StreamOptions {
   double rate = 0;
   bool velocities = false, contacts = false, stats = false;
   std::vector<std::uint64_t> ids;
+  bool changes_only = false;
+  double full_every = 0;
 
   void add_to(CLI::App* command, bool with_format) {
     if (with_format)
@@ -92,6 +94,14 @@ struct StreamOptions {
     command->add_flag("--contacts", contacts, "include contact points");
     command->add_flag("--stats", stats, "include the step statistics");
     command->add_option("--ids", ids, "only these bodies (default: all)")->delimiter(',');
+    command->add_flag("--changes-only", changes_only,
+                      "list only the bodies changed since the previous frame (the first frame, "
+                      "and the first after the world is replaced, list all)");
+    command
+        ->add_option("--full-every", full_every,
+                     "with --changes-only: a frame of every body at least every this many "
+                     "seconds (0: only when needed)")
+        ->check(cli::non_negative);
   }
   v1::StreamFramesRequest request() const {
     v1::StreamFramesRequest request;
@@ -100,6 +110,8 @@ struct StreamOptions {
     request.set_contacts(contacts);
     request.set_stats(stats);
     request.mutable_ids()->Add(ids.begin(), ids.end());
+    request.set_changes_only(changes_only);
+    request.set_full_frame_interval(full_every);
     return request;
   }
 };

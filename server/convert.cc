@@ -251,11 +251,14 @@ void run_settings_to_proto(double dt, double real_time_factor, const WorldSettin
   set(world.gravity, out->mutable_gravity());
 }
 
-void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out) {
+void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out,
+                    std::uint64_t changed_after) {
   out->set_step(frame.step);
   out->set_time(frame.time);
   out->set_stepped_at_unix_ns(frame.stepped_at_unix_ns);
-  const bool all = options.ids.empty();
+  if (changed_after > 0) out->set_changes_only(true);
+  const bool every_id = options.ids.empty();
+  const bool all = every_id && changed_after == 0;
   if (all) {  // whole arrays at once: the common case, and the one worth being fast
     out->mutable_ids()->Add(frame.ids.begin(), frame.ids.end());
     out->mutable_positions()->Add(frame.positions.begin(), frame.positions.end());
@@ -268,7 +271,9 @@ void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Fra
     }
   }
   for (std::size_t i = 0; !all && i < frame.ids.size(); ++i) {
-    if (!all && !std::binary_search(options.ids.begin(), options.ids.end(), frame.ids[i])) continue;
+    if (changed_after > 0 && frame.changed_at[i] <= changed_after) continue;
+    if (!every_id && !std::binary_search(options.ids.begin(), options.ids.end(), frame.ids[i]))
+      continue;
     out->add_ids(frame.ids[i]);
     for (int k = 0; k < 3; ++k)
       out->add_positions(frame.positions[3 * i + k]);
@@ -283,15 +288,13 @@ void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Fra
   }
   if (options.contacts) {
     v1::Contacts* contacts = out->mutable_contacts();
-    for (std::size_t c = 0; c < frame.contact_a.size(); ++c) {
-      contacts->add_body_a(frame.contact_a[c]);
-      contacts->add_body_b(frame.contact_b[c]);
-      for (int k = 0; k < 3; ++k) {
-        contacts->add_points(frame.contact_points[3 * c + k]);
-        contacts->add_normals(frame.contact_normals[3 * c + k]);
-      }
-      contacts->add_depths(frame.contact_depths[c]);
-      contacts->add_impulses(frame.contact_impulses[c]);
+    for (const ContactTable* table : frame.contact_tables()) {
+      contacts->mutable_body_a()->Add(table->a.begin(), table->a.end());
+      contacts->mutable_body_b()->Add(table->b.begin(), table->b.end());
+      contacts->mutable_points()->Add(table->points.begin(), table->points.end());
+      contacts->mutable_normals()->Add(table->normals.begin(), table->normals.end());
+      contacts->mutable_depths()->Add(table->depths.begin(), table->depths.end());
+      contacts->mutable_impulses()->Add(table->impulses.begin(), table->impulses.end());
     }
   }
   if (options.stats) stats_to_proto(frame.stats, out->mutable_stats());

@@ -24,10 +24,15 @@ void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
 struct FrameOptions {
   bool velocities = false, contacts = false, stats = false;
   std::vector<std::uint64_t> ids;  // sorted; empty: every body
+  bool changes_only = false;       // StreamFramesRequest.changes_only
+  double full_frame_interval = 0;  // s; 0: full frames only when needed
 };
 
-// The frame's bodies (and, when asked, velocities, contacts and statistics) into `out`.
-void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out);
+// The frame's bodies (and, when asked, velocities, contacts and statistics) into `out`; with
+// `changed_after` > 0, only the bodies changed after that tick of the change clock
+// (FrameData::changed_at), and the frame is marked changes_only.
+void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Frame* out,
+                    std::uint64_t changed_after = 0);
 
 void stats_to_proto(const StepStats& stats, v1::StepStats* out);
 

@@ -213,19 +213,25 @@ void DdsPublisher::publish(const FrameData& frame) {
   dds_write(w.ids, &ids);
   dds_write(w.poses, &poses);
 
-  const std::size_t points = frame.contact_a.size();
-  w.contact_points.resize(points);
-  w.contact_normals.resize(points);
-  for (std::size_t c = 0; c < points; ++c) {
-    w.contact_points[c] = {frame.contact_points[3 * c], frame.contact_points[3 * c + 1],
-                           frame.contact_points[3 * c + 2]};
-    w.contact_normals[c] = {frame.contact_normals[3 * c], frame.contact_normals[3 * c + 1],
-                            frame.contact_normals[3 * c + 2]};
+  w.contact_points.clear();
+  w.contact_normals.clear();
+  w.contact_a.clear();
+  w.contact_b.clear();
+  w.contact_depths.clear();
+  w.contact_impulses.clear();
+  for (const ContactTable* table : frame.contact_tables()) {
+    for (std::size_t c = 0; c < table->size(); ++c) {
+      w.contact_points.push_back(
+          {table->points[3 * c], table->points[3 * c + 1], table->points[3 * c + 2]});
+      w.contact_normals.push_back(
+          {table->normals[3 * c], table->normals[3 * c + 1], table->normals[3 * c + 2]});
+    }
+    w.contact_a.insert(w.contact_a.end(), table->a.begin(), table->a.end());
+    w.contact_b.insert(w.contact_b.end(), table->b.begin(), table->b.end());
+    w.contact_depths.insert(w.contact_depths.end(), table->depths.begin(), table->depths.end());
+    w.contact_impulses.insert(w.contact_impulses.end(), table->impulses.begin(),
+                              table->impulses.end());
   }
-  w.contact_a.assign(frame.contact_a.begin(), frame.contact_a.end());
-  w.contact_b.assign(frame.contact_b.begin(), frame.contact_b.end());
-  w.contact_depths.assign(frame.contact_depths.begin(), frame.contact_depths.end());
-  w.contact_impulses.assign(frame.contact_impulses.begin(), frame.contact_impulses.end());
   Contacts contacts{header,
                     frame.step,
                     view<dds_sequence_uint64>(w.contact_a),
@@ -262,10 +268,22 @@ void DdsPublisher::publish_ros2(const FrameData& frame, const std_msgs_msg_dds__
   Clock clock{header.stamp};
   dds_write(w.clock, &clock);
 
+  // /tf and the markers carry the bodies changed since the previous sample: tf buffers and RViz
+  // keep the last transform and marker of each body, so a world of sleeping bodies costs them
+  // nothing a step. Every body goes out on the first sample, after the world was replaced, and
+  // once a second (well within tf's ten-second buffer, for listeners that join late).
+  const auto now = std::chrono::steady_clock::now();
+  const bool full =
+      frame.epoch != ros_sent_epoch_ || now - ros_last_full_ >= std::chrono::seconds(1);
+  if (full) ros_last_full_ = now;
+  const std::uint64_t since = full ? 0 : ros_sent_tick_;
+  ros_sent_tick_ = frame.change_clock;
+  ros_sent_epoch_ = frame.epoch;
   const std::size_t n = frame.ids.size();
-  w.transform_buffer.resize(n);
+  w.transform_buffer.clear();
   w.marker_buffer.clear();
   for (std::size_t i = 0; i < n; ++i) {
+    if (since > 0 && i < frame.changed_at.size() && frame.changed_at[i] <= since) continue;
     const auto look = w.ros_looks.find(frame.ids[i]);
     if (look == w.ros_looks.end()) continue;  // not in the catalogue published: next step
     const geometry_msgs_msg_dds__Vector3_ at{frame.positions[3 * i], frame.positions[3 * i + 1],
@@ -274,7 +292,7 @@ void DdsPublisher::publish_ros2(const FrameData& frame, const std_msgs_msg_dds__
     const geometry_msgs_msg_dds__Quaternion_ turn{
         frame.orientations[4 * i + 1], frame.orientations[4 * i + 2], frame.orientations[4 * i + 3],
         frame.orientations[4 * i]};
-    Transform& t = w.transform_buffer[i];
+    Transform& t = w.transform_buffer.emplace_back();
     t.header = header;
     t.child_frame_id = look->second.frame.data();
     t.transform = {at, turn};

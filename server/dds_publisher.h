@@ -7,6 +7,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <thread>
@@ -60,6 +61,10 @@ class DdsPublisher {
   std::vector<std::uint32_t> free_instances_;  // a min-heap
   std::uint32_t next_instance_ = 0;
   std::atomic<std::uint64_t> published_{0}, skipped_{0};
+  // ROS 2's /tf and markers: the change clock's tick and the world's epoch of the last sample,
+  // and when every body last went out (publish_ros2).
+  std::uint64_t ros_sent_tick_ = 0, ros_sent_epoch_ = UINT64_MAX;
+  std::chrono::steady_clock::time_point ros_last_full_{};
   std::atomic<bool> stopping_{false};
   std::thread thread_;
 };

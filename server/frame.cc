@@ -1,5 +1,6 @@
 #include "frame.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace tumble::server {
@@ -34,7 +35,20 @@ std::shared_ptr<const Catalogue> updated_catalogue(HostedWorld& hosted,
   return fresh;
 }
 
-std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted, double dt,
+void note_changes(HostedWorld& hosted) {
+  World& world = hosted.world;
+  const std::uint64_t tick = ++hosted.change_clock;
+  hosted.changed_at.resize(world.slot_count(), tick);  // new slots hold new bodies
+  if (!world.body_events_complete()) {
+    std::fill(hosted.changed_at.begin(), hosted.changed_at.end(), tick);
+  } else {
+    for (const BodyEvent& event : world.body_events())
+      if (event.body.index < hosted.changed_at.size()) hosted.changed_at[event.body.index] = tick;
+  }
+  world.clear_body_events();
+}
+
+std::shared_ptr<const FrameData> make_frame(HostedWorld& hosted, double dt,
                                             std::shared_ptr<const Catalogue> catalogue) {
   const World& world = hosted.world;
   auto frame = std::make_shared<FrameData>();
@@ -47,7 +61,9 @@ std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted, double dt
   frame->step = world.step_count();
   frame->time = world.time();
   frame->stats = world.last_step();
+  frame->change_clock = hosted.change_clock;
   const std::size_t n = world.body_count();
+  frame->changed_at.reserve(n);
   frame->ids.reserve(n);
   frame->positions.reserve(3 * n);
   frame->orientations.reserve(4 * n);
@@ -58,6 +74,8 @@ std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted, double dt
     const BodyView body = world.body(id);
     if (!body) continue;
     frame->ids.push_back(hosted.ids.wire(id));
+    frame->changed_at.push_back(slot < hosted.changed_at.size() ? hosted.changed_at[slot]
+                                                                : hosted.change_clock);
     auto append = [](const Vec3& v, std::vector<double>& out) {
       out.insert(out.end(), {v.x(), v.y(), v.z()});
     };
@@ -68,26 +86,35 @@ std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted, double dt
     append(body.angular_velocity(), frame->angular_velocities);
   }
   // The step's contacts, then those of sleeping islands: they still carry their weight, as the
-  // impulse of a step of dt.
+  // impulse of a step of dt. The sleepers' are shared from frame to frame while they stay put.
   auto add_contacts = [&](std::span<const Contact> contacts, std::span<const double> impulses,
-                          double scale) {
+                          double scale, ContactTable& out) {
     std::size_t row = 0;
     for (const Contact& contact : contacts) {
       for (int i = 0; i < contact.manifold.count; ++i, ++row) {
         const ContactPoint& point = contact.manifold.points[i];
-        frame->contact_a.push_back(hosted.ids.wire(contact.a));
-        frame->contact_b.push_back(hosted.ids.wire(contact.b));
-        frame->contact_points.insert(frame->contact_points.end(), point.point_b.data(),
-                                     point.point_b.data() + 3);
-        frame->contact_normals.insert(frame->contact_normals.end(), contact.manifold.normal.data(),
-                                      contact.manifold.normal.data() + 3);
-        frame->contact_depths.push_back(point.depth);
-        frame->contact_impulses.push_back(row < impulses.size() ? scale * impulses[row] : 0.0);
+        out.a.push_back(hosted.ids.wire(contact.a));
+        out.b.push_back(hosted.ids.wire(contact.b));
+        out.points.insert(out.points.end(), point.point_b.data(), point.point_b.data() + 3);
+        out.normals.insert(out.normals.end(), contact.manifold.normal.data(),
+                           contact.manifold.normal.data() + 3);
+        out.depths.push_back(point.depth);
+        out.impulses.push_back(row < impulses.size() ? scale * impulses[row] : 0.0);
       }
     }
   };
-  add_contacts(world.contacts(), world.contact_impulses(), 1.0);
-  add_contacts(world.resting_contacts(), world.resting_contact_forces(), dt);
+  add_contacts(world.contacts(), world.contact_impulses(), 1.0, frame->contacts);
+  if (hosted.resting_table == nullptr ||
+      hosted.resting_table_version != world.resting_contacts_version() ||
+      hosted.resting_table_epoch != hosted.epoch || hosted.resting_table_dt != dt) {
+    auto resting = std::make_shared<ContactTable>();
+    add_contacts(world.resting_contacts(), world.resting_contact_forces(), dt, *resting);
+    hosted.resting_table = resting;
+    hosted.resting_table_version = world.resting_contacts_version();
+    hosted.resting_table_epoch = hosted.epoch;
+    hosted.resting_table_dt = dt;
+  }
+  frame->resting_contacts = hosted.resting_table;
   return frame;
 }
 

@@ -4,6 +4,7 @@
 // frame; neither reads the world itself.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -26,6 +27,14 @@ struct BodyLook {
 // Every live body's look by wire id. Shared by frames until the set of bodies changes.
 using Catalogue = std::unordered_map<std::uint64_t, BodyLook>;
 
+// Contact points, one entry per point, as parallel arrays.
+struct ContactTable {
+  std::vector<std::uint64_t> a, b;       // wire ids
+  std::vector<double> points, normals;   // m, x y z per point; unit, from a to b
+  std::vector<double> depths, impulses;  // m; N s over one step
+  std::size_t size() const { return a.size(); }
+};
+
 // One step of the world, shared read-only by every subscriber.
 struct FrameData {
   // Encodings of this frame made for one subscriber and kept for the others that asked for the
@@ -45,9 +54,22 @@ struct FrameData {
   std::vector<double> positions;                              // x y z per body, m
   std::vector<double> orientations;                           // w x y z per body
   std::vector<double> linear_velocities, angular_velocities;  // x y z per body
-  // One entry per contact point.
-  std::vector<std::uint64_t> contact_a, contact_b;
-  std::vector<double> contact_points, contact_normals, contact_depths, contact_impulses;
+  // Per body, the tick of HostedWorld::change_clock at which it last changed, and the tick of
+  // this frame: a subscriber that last got the frame of tick t needs only the bodies above t.
+  std::vector<std::uint64_t> changed_at;
+  std::uint64_t change_clock = 0;
+  // The step's contacts, then those sleeping islands rest on (shared by every frame until
+  // islands fall asleep or wake: a sleeping world's 400,000 resting points are not copied each
+  // step). Read both, in that order: contact_tables().
+  ContactTable contacts;
+  std::shared_ptr<const ContactTable> resting_contacts;
+  std::array<const ContactTable*, 2> contact_tables() const {
+    return {&contacts, resting_contacts != nullptr ? resting_contacts.get() : &contacts_none()};
+  }
+  static const ContactTable& contacts_none() {
+    static const ContactTable none;
+    return none;
+  }
   StepStats stats;
 };
 
@@ -59,10 +81,14 @@ std::shared_ptr<const Catalogue> updated_catalogue(HostedWorld& hosted,
                                                    std::shared_ptr<const Catalogue> current,
                                                    std::uint64_t current_epoch);
 
+// Takes the world's body events into hosted.changed_at at a new tick of its change clock, and
+// clears them: the cost is the bodies that changed, not the bodies there are.
+void note_changes(HostedWorld& hosted);
+
 // The frame of `hosted` as it is now. `dt`: the step's, which turns the resting contacts' forces
 // into the impulses of a step (passed in: the host changes hosted.dt under its lock, and the
 // stepping thread builds frames without it).
-std::shared_ptr<const FrameData> make_frame(const HostedWorld& hosted, double dt,
+std::shared_ptr<const FrameData> make_frame(HostedWorld& hosted, double dt,
                                             std::shared_ptr<const Catalogue> catalogue);
 
 }  // namespace tumble::server

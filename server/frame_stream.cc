@@ -161,8 +161,26 @@ void FrameStream::encode(const FrameData& data, std::uint64_t dropped) {
   own.set_dropped(dropped);
   // Bodies new to this subscriber get their descriptions; vanished ones are listed.
   catalogue_.add_changes(data, options_.ids, &own);
-  grpc::Slice parts[2] = {slice_of(shared_encoding(data, options_)),
-                          grpc::Slice(own.SerializeAsString())};
+  // Changes only: the bodies changed since the tick of this subscriber's previous frame (frames
+  // dropped between are covered: a body keeps the tick of its last change). Every body when it
+  // joins, when the world was replaced, and at the interval it asked for.
+  const auto now = std::chrono::steady_clock::now();
+  const bool full =
+      !options_.changes_only || !sent_any_ || data.epoch != sent_epoch_ ||
+      (options_.full_frame_interval > 0 &&
+       now - last_full_ >= std::chrono::duration<double>(options_.full_frame_interval));
+  std::shared_ptr<const std::string> bodies;
+  if (full) {
+    bodies = shared_encoding(data, options_);
+    last_full_ = now;
+  } else {
+    v1::Frame changed;
+    frame_to_proto(data, options_, &changed, sent_tick_);
+    bodies = std::make_shared<const std::string>(changed.SerializeAsString());
+  }
+  sent_tick_ = data.change_clock;
+  sent_epoch_ = data.epoch;
+  grpc::Slice parts[2] = {slice_of(std::move(bodies)), grpc::Slice(own.SerializeAsString())};
   buffer_ = grpc::ByteBuffer(parts, 2);
 }
 

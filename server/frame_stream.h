@@ -107,6 +107,10 @@ class FrameStream final : public RequestReader {
   CatalogueDiff catalogue_;  // what this subscriber was told about the bodies
   std::chrono::steady_clock::time_point last_sent_{};
   bool sent_any_ = false;  // the first frame (describing every body) goes whatever the rate
+  // Changes only: the change clock's tick and the world's epoch of the previous frame sent, and
+  // when the last full frame went.
+  std::uint64_t sent_tick_ = 0, sent_epoch_ = 0;
+  std::chrono::steady_clock::time_point last_full_{};
 };
 
 }  // namespace tumble::server

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -10,6 +11,8 @@
 #include "physics/world.h"
 
 namespace tumble::server {
+
+struct ContactTable;
 
 // The world and what the server keeps beside it. Only the stepping thread touches it: commands
 // run there.
@@ -28,6 +31,16 @@ struct HostedWorld {
   // Counts wholesale replacements (a scene loaded, a snapshot restored), so that a subscriber
   // forgets every body it knew.
   std::uint64_t epoch = 0;
+  // Which bodies changed when, for subscribers that ask for changes only: by slot, the tick of
+  // change_clock at which the body was last made, moved, woken or put to sleep (from the
+  // world's body events, note_changes in frame.h).
+  std::vector<std::uint64_t> changed_at;
+  std::uint64_t change_clock = 0;
+  // The resting contacts as frames carry them (ContactTable, frame.h), kept while the world's
+  // resting contacts, its ids (epoch) and the step are the same.
+  std::shared_ptr<const ContactTable> resting_table;
+  std::uint64_t resting_table_version = 0, resting_table_epoch = 0;
+  double resting_table_dt = 0;
 
   // A new world whose bodies all get new ids.
   void replace(World replacement, double new_dt, std::vector<std::uint32_t> new_colours) {

@@ -308,6 +308,10 @@ grpc::Status WorldService::read_stream_request(const std::string& bytes, FrameOp
   options->stats = request.stats();
   options->ids.assign(request.ids().begin(), request.ids().end());
   std::sort(options->ids.begin(), options->ids.end());
+  if (!(request.full_frame_interval() >= 0) || !std::isfinite(request.full_frame_interval()))
+    return invalid("full_frame_interval: must be finite and >= 0 (s; 0: only when needed)");
+  options->changes_only = request.changes_only();
+  options->full_frame_interval = request.full_frame_interval();
   *max_rate = request.max_rate();
   return grpc::Status::OK;
 }

@@ -185,7 +185,8 @@ void WorldHost::refresh_catalogue() {
   catalogue_epoch_ = hosted_.epoch;
 }
 
-std::shared_ptr<const FrameData> WorldHost::make_frame(double dt) const {
+std::shared_ptr<const FrameData> WorldHost::make_frame(double dt) {
+  note_changes(hosted_);
   return server::make_frame(hosted_, dt, catalogue_);
 }
 

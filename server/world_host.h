@@ -99,7 +99,7 @@ class WorldHost {
   void run();
   void apply_pending();
   // `dt`: the step's (hosted_.dt is read under the lock; a frame is built without it).
-  std::shared_ptr<const FrameData> make_frame(double dt) const;
+  std::shared_ptr<const FrameData> make_frame(double dt);
 
   HostedWorld hosted_;  // the world by the stepping thread only (commands run there); dt under
                         // the lock

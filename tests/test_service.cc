@@ -3,6 +3,8 @@
 // leaves the world as it was.
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
+#include <array>
+#include <map>
 
 #include <cstring>
 
@@ -304,6 +306,71 @@ TEST_F(ServiceTest, StreamDescribesBodiesThenSendsPoses) {
   while (frame.step() < 20 && reader->Read(&frame))
     EXPECT_EQ(frame.added_size(), 0);
   EXPECT_EQ(frame.step(), 20u);
+  context.TryCancel();
+  reader->Finish();
+}
+
+// Changes only: after the first frame, a frame lists the bodies changed since the previous one
+// sent, so a settled pile costs nothing and one falling ball one body a frame; merged in order,
+// the frames give every body exactly where the world has it, frames dropped on the way or not.
+TEST_F(ServiceTest, ChangesOnlyFramesCarryWhatChangedAndAddUpToTheWorld) {
+  v1::StreamFramesRequest request;
+  request.set_changes_only(true);
+  request.set_stats(true);
+  grpc::ClientContext context;
+  auto reader = stub_->StreamFrames(&context, request);
+  for (int i = 0; i < 500 && host_.status().subscribers == 0; ++i)
+    std::this_thread::sleep_for(10ms);
+  ASSERT_EQ(host_.status().subscribers, 1u);
+  auto step = [&](std::uint64_t n) {
+    v1::ControlRequest control;
+    control.set_step(n);
+    grpc::ClientContext control_context;
+    v1::ControlResponse response;
+    ASSERT_TRUE(stub_->Control(&control_context, control, &response).ok());
+    ASSERT_TRUE(host_.wait_idle(std::chrono::seconds(60)));
+  };
+  std::map<std::uint64_t, std::array<double, 3>> merged;
+  v1::Frame frame;
+  bool first = true;
+  // Frames up to step `last`, merged; whatever the stream coalesced on the way.
+  auto read_until = [&](std::uint64_t last) {
+    while (reader->Read(&frame)) {
+      EXPECT_EQ(frame.changes_only(), !first) << "step " << frame.step();
+      if (first) EXPECT_EQ(frame.ids_size(), 9);
+      first = false;
+      for (int i = 0; i < frame.ids_size(); ++i)
+        merged[frame.ids(i)] = {frame.positions(3 * i), frame.positions(3 * i + 1),
+                                frame.positions(3 * i + 2)};
+      if (frame.step() >= last) return;
+    }
+    ADD_FAILURE() << "the stream ended";
+  };
+  step(900);  // 15 s: the pile settles and sleeps
+  read_until(900);
+  ASSERT_EQ(frame.stats().sleeping_bodies(), 8u);  // the pile sleeps (the ground is static)
+  v1::SpawnBodiesRequest spawn;
+  *spawn.add_bodies() = ball(30);
+  spawn.mutable_bodies(0)->mutable_position()->set_x(40);  // far from the pile
+  grpc::ClientContext spawn_context;
+  v1::SpawnBodiesResponse spawned;
+  ASSERT_TRUE(stub_->SpawnBodies(&spawn_context, spawn, &spawned).ok());
+  for (std::uint64_t k = 901; k <= 930; ++k) {
+    step(1);
+    read_until(k);
+    ASSERT_EQ(frame.ids_size(), 1) << "step " << k;  // the falling ball alone
+    EXPECT_EQ(frame.ids(0), spawned.ids(0));
+  }
+  grpc::ClientContext get_context;
+  v1::GetBodiesResponse world;
+  ASSERT_TRUE(stub_->GetBodies(&get_context, {}, &world).ok());
+  ASSERT_EQ(merged.size(), static_cast<std::size_t>(world.states_size()));
+  for (const v1::BodyState& state : world.states()) {
+    const auto& p = merged.at(state.id());
+    EXPECT_EQ(p[0], state.position().x());
+    EXPECT_EQ(p[1], state.position().y());
+    EXPECT_EQ(p[2], state.position().z());
+  }
   context.TryCancel();
   reader->Finish();
 }

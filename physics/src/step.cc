@@ -989,6 +989,7 @@ void World::update_sleep(double dt) {
       if (sleepers_indexed_) recent_sleepers_.push_back(slot);
       body.linear_velocity.setZero();
       body.angular_velocity.setZero();
+      note_event(slot, kBodyFellAsleep);
       fell_asleep = true;
     }
   }
@@ -1039,6 +1040,9 @@ void World::finish_step(double dt) {
       }
     }
   });
+  // Every body the step integrated moved (listed after the parallel loop: the list is ordered).
+  for (std::int64_t k = 0; k < moving; ++k)
+    note_event(s.solver_slot[k], kBodyMoved);
   stats_.non_finite_bodies = non_finite;
   stats_.slowed_bodies = slowed;
   stats_.bodies_at_edge = stopped;

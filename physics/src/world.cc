@@ -177,6 +177,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
       resting_changed(index);
     ids.push_back({index, slot.generation});
     ++live_count_;
+    note_event(index, kBodyAdded);
   }
   return ids;
 }
@@ -198,6 +199,7 @@ Status World::remove_body(BodyId id) {
     fast_[id.index] = 0;
     motion_[id.index] = 0;
   }
+  note_event(id.index, kBodyRemoved);
   slot.alive = false;
   ++slot.generation;
   slot.body = Body();
@@ -277,6 +279,7 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
   else if (body.asleep)
     wake_island(body.sleep_island);
   body.sleep_timer = 0;
+  note_event(id.index, kBodyMoved);
   drop_woken_contacts();
   return Status::ok();
 }
@@ -300,6 +303,7 @@ Status World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3* point) {
   body.sleep_timer = 0;
   std::tie(body.linear_velocity, body.angular_velocity) =
       velocities_after_impulse(body, impulse, point);
+  note_event(id.index, kBodyMoved);
   drop_woken_contacts();
   return Status::ok();
 }
@@ -334,6 +338,7 @@ Status World::apply_impulses(std::span<const ImpulseAt> impulses) {
     if (body.asleep) wake_island(body.sleep_island);
     body.sleep_timer = 0;
     std::tie(body.linear_velocity, body.angular_velocity) = velocities;
+    note_event(slot, kBodyMoved);
   }
   drop_woken_contacts();
   return Status::ok();
@@ -352,6 +357,7 @@ std::uint32_t World::wake_island(std::uint32_t island) {
     --sleeping_count_;
     join_awake(next);
     resting_changed(next);
+    note_event(next, kBodyWoke);
     const std::uint32_t slot = next;
     next = sleeper_next_[slot];
     sleeper_next_[slot] = kNoSlot;
@@ -365,6 +371,7 @@ void World::keep_resting_contacts(std::uint32_t island, std::uint32_t island_ind
   for (std::uint32_t k = s.islands.link_begin[island_index];
        k < s.islands.link_begin[island_index + 1]; ++k) {
     const std::uint32_t m = s.islands.links[k];
+    ++resting_contacts_version_;
     resting_contacts_.push_back(contacts_[m]);
     resting_island_.push_back(island);
     for (std::uint32_t r = s.row_begin[m]; r < s.row_begin[m + 1]; ++r)
@@ -375,6 +382,7 @@ void World::keep_resting_contacts(std::uint32_t island, std::uint32_t island_ind
 void World::drop_woken_contacts() {
   if (!resting_woken_) return;
   resting_woken_ = false;
+  ++resting_contacts_version_;
   std::size_t kept = 0, kept_points = 0, point = 0;
   for (std::size_t m = 0; m < resting_contacts_.size(); ++m) {
     const int count = resting_contacts_[m].manifold.count;
@@ -453,6 +461,36 @@ Status World::wake(BodyId id) {
 bool World::contains(BodyId id) const {
   return id.index < bodies_.size() && bodies_[id.index].alive &&
          bodies_[id.index].generation == id.generation;
+}
+
+void World::note_event(std::uint32_t slot, std::uint8_t flag) {
+  if (!events_complete_) return;
+  if (event_of_slot_.size() < bodies_.size()) event_of_slot_.resize(bodies_.size(), kNoSlot);
+  const BodyId id{slot, bodies_[slot].generation};
+  std::uint32_t& entry = event_of_slot_[slot];
+  if (entry != kNoSlot && events_[entry].body == id) {
+    events_[entry].flags |= flag;
+    return;
+  }
+  if (events_.size() >= 2 * bodies_.size() + 4096) {  // the bound body_events() promises
+    events_.clear();
+    event_of_slot_.assign(event_of_slot_.size(), kNoSlot);
+    events_complete_ = false;
+    return;
+  }
+  entry = static_cast<std::uint32_t>(events_.size());
+  events_.push_back({id, flag});
+}
+
+void World::clear_body_events() {
+  if (events_complete_) {
+    for (const BodyEvent& event : events_)
+      if (event.body.index < event_of_slot_.size()) event_of_slot_[event.body.index] = kNoSlot;
+  } else {
+    event_of_slot_.assign(event_of_slot_.size(), kNoSlot);
+  }
+  events_.clear();
+  events_complete_ = true;
 }
 
 std::uint32_t World::slot_count() const {

@@ -159,6 +159,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
   world.time_ = state.time;
   world.stats_.step = state.step;
   world.scratch_->pairs = std::move(state.contact_pairs);
+  world.events_complete_ = false;  // every body is new to whoever mirrors this world
   return world;
 }
 

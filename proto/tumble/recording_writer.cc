@@ -180,6 +180,7 @@ wire::Status RecordingWriter::write(const v1::Frame& frame) {
   *poses.mutable_angular_velocities() = frame.angular_velocities();
   poses.set_dropped(frame.dropped());
   poses.set_stepped_at_unix_ns(frame.stepped_at_unix_ns());
+  poses.set_changes_only(frame.changes_only());  // bodies not listed are as before
   add_message(mcap::kFramesChannel, sequence, log_time, simulated, poses);
   if (frame.has_contacts())
     add_message(mcap::kContactsChannel, sequence, log_time, simulated, frame.contacts());

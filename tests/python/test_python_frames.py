@@ -141,3 +141,20 @@ def test_the_stream_ends_when_the_server_stops(server):
     code, _ = server.stop()
     assert code == 0
     assert list(frames) == []  # ended cleanly: no exception, no frame
+
+
+def test_changes_only_frames_list_what_moved(empty_world):
+    world = empty_world
+    world.spawn_ground()
+    resting = world.spawn_box(size=(1, 1, 1), mass=1.0, pos=(0, 0, 0.5))
+    world.step(120)  # the box settles and sleeps
+    falling = world.spawn_sphere(0.25, pos=(20, 0, 50))
+    with world.frames(changes_only=True) as frames:
+        first = next(frames)
+        assert not first.changes_only and len(first.ids) == 3  # joining: every body
+        world.step(1)
+        frame = until_step(frames, world.info().step)[-1]
+    assert frame.changes_only
+    assert frame.ids.tolist() == [falling]  # the sleeping box and the ground are not sent
+    np.testing.assert_array_equal(frame.position(falling), world.body(falling).position)
+    assert resting not in frame.ids.tolist()

@@ -169,6 +169,7 @@ void LocalWorld::refresh_catalogue() {
 
 std::shared_ptr<const server::FrameData> LocalWorld::frame_data() {
   refresh_catalogue();
+  server::note_changes(hosted_);
   return server::make_frame(hosted_, hosted_.dt, catalogue_);
 }
 

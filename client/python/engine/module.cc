@@ -174,14 +174,24 @@ void apply_impulses(LocalWorld& local, const Ids& ids, const Doubles& impulses,
 py::dict contacts(LocalWorld& local) {
   std::lock_guard turn(local.mutex());
   const auto frame = local.frame_data();
-  const auto n = static_cast<py::ssize_t>(frame->contact_depths.size());
+  // The step's contacts, then the sleepers' (FrameData::contact_tables), as one table.
+  tumble::server::ContactTable all;
+  for (const tumble::server::ContactTable* table : frame->contact_tables()) {
+    all.a.insert(all.a.end(), table->a.begin(), table->a.end());
+    all.b.insert(all.b.end(), table->b.begin(), table->b.end());
+    all.points.insert(all.points.end(), table->points.begin(), table->points.end());
+    all.normals.insert(all.normals.end(), table->normals.begin(), table->normals.end());
+    all.depths.insert(all.depths.end(), table->depths.begin(), table->depths.end());
+    all.impulses.insert(all.impulses.end(), table->impulses.begin(), table->impulses.end());
+  }
+  const auto n = static_cast<py::ssize_t>(all.size());
   py::dict out;
-  out["body_a"] = array_of(frame->contact_a, {n});
-  out["body_b"] = array_of(frame->contact_b, {n});
-  out["points"] = array_of(frame->contact_points, {n, 3});
-  out["normals"] = array_of(frame->contact_normals, {n, 3});
-  out["depths"] = array_of(frame->contact_depths, {n});
-  out["impulses"] = array_of(frame->contact_impulses, {n});
+  out["body_a"] = array_of(all.a, {n});
+  out["body_b"] = array_of(all.b, {n});
+  out["points"] = array_of(all.points, {n, 3});
+  out["normals"] = array_of(all.normals, {n, 3});
+  out["depths"] = array_of(all.depths, {n});
+  out["impulses"] = array_of(all.impulses, {n});
   return out;
 }
 

@@ -72,6 +72,9 @@ class Frame:
     removed: list  # ids removed since the previous frame
     dropped: int  # frames this subscriber missed since its previous one (it was too slow)
     stepped_at_unix_ns: int  # when the step ended, by the server's clock
+    # Only the bodies changed since the previous frame are in the arrays (frames(changes_only=
+    # True)); the others are where the previous frames left them.
+    changes_only: bool = False
 
     def index(self, body_id):
         """The row of `body_id` in this frame's arrays; KeyError if it is not in the frame."""
@@ -127,6 +130,7 @@ class Frame:
             removed=list(message.removed),
             dropped=message.dropped,
             stepped_at_unix_ns=message.stepped_at_unix_ns,
+            changes_only=message.changes_only,
             **arrays,
         )
 

@@ -411,14 +411,22 @@ class RemoteWorld(WorldCalls):
     # --- frames -----------------------------------------------------------------------------
 
     def frames(self, rate=0.0, velocities=False, contacts=False, stats=False, ids=(), count=None,
-               duration=None):
+               duration=None, changes_only=False, full_frame_interval=0.0):
         """Subscribes to the world's frames: every step's, or at most `rate` per second. A slow
         reader loses frames (Frame.dropped counts them), never slows the world. Frames come only
         while the world steps. The subscription ends after `count` frames or `duration` seconds,
-        whichever comes first (default: when closed or when the server stops)."""
+        whichever comes first (default: when closed or when the server stops).
+
+        With `changes_only`, a frame lists only the bodies that changed since the previous one
+        (Frame.changes_only is then True; the others are where earlier frames left them): a world
+        of sleeping bodies costs nothing a frame. The first frame, the first after the world is
+        replaced, and one every `full_frame_interval` seconds (0: never) list every body."""
         request = pb.StreamFramesRequest(max_rate=convert.number(rate, "rate"),
                                          velocities=bool(velocities), contacts=bool(contacts),
-                                         stats=bool(stats), ids=convert.ids(ids))
+                                         stats=bool(stats), ids=convert.ids(ids),
+                                         changes_only=bool(changes_only),
+                                         full_frame_interval=convert.number(
+                                             full_frame_interval, "full_frame_interval"))
         if count is not None and (isinstance(count, bool) or not isinstance(count, int)
                                   or count < 0):
             raise ArgumentError(f"count: expected an integer >= 0, got {count!r}", "frames")

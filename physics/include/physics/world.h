@@ -65,6 +65,20 @@ struct ImpulseAt {
 
 struct StepScratch;
 
+// What happened to a body since the world's events were last cleared (World::body_events): the
+// bits of BodyEvent::flags.
+enum BodyEventFlag : std::uint8_t {
+  kBodyAdded = 1,
+  kBodyRemoved = 2,
+  kBodyMoved = 4,  // pose or velocities changed: by a step, set_motion or an impulse
+  kBodyWoke = 8,
+  kBodyFellAsleep = 16,
+};
+struct BodyEvent {
+  BodyId body;
+  std::uint8_t flags = 0;
+};
+
 // The sizes in the header of a saved state (World::state_sizes).
 struct StateSizes {
   std::uint64_t bytes = 0;
@@ -157,6 +171,20 @@ class World {
   // made by from_state() lists its sleepers' contacts again once they wake and settle.
   std::span<const Contact> resting_contacts() const { return resting_contacts_; }
   std::span<const double> resting_contact_forces() const { return resting_forces_; }
+  // Changes whenever the two lists above do (islands falling asleep or waking): a caller that
+  // copies them (the server's frames) copies again only then.
+  std::uint64_t resting_contacts_version() const { return resting_contacts_version_; }
+
+  // What happened to bodies since clear_body_events(), each body once with every flag that
+  // applies (Box2D v3's body move events, widened): made, removed, moved (every body a step
+  // integrates, and those set_motion or an impulse changed), woken, fallen asleep. A caller that
+  // mirrors the world (the server's frames) touches only these: a world of sleeping bodies lists
+  // none. Between two clears the list holds at most 2 slots + 4096 entries; beyond that (bodies
+  // made and removed over and over) it is emptied and body_events_complete() turns false until
+  // the next clear: treat every body as changed then, as after from_state().
+  std::span<const BodyEvent> body_events() const { return events_; }
+  bool body_events_complete() const { return events_complete_; }
+  void clear_body_events();
 
   // Broad phase: pairs of bodies whose world bounds (grown by the contact margin) overlap, at
   // least one of them dynamic, sorted, unique.
@@ -192,6 +220,11 @@ class World {
 
   WorldSettings settings_;
   std::vector<Slot> bodies_;
+  // body_events(): per slot, the entry of its current body in events_ (kNoSlot: none).
+  std::vector<BodyEvent> events_;
+  std::vector<std::uint32_t> event_of_slot_;
+  bool events_complete_ = true;
+  void note_event(std::uint32_t slot, std::uint8_t flag);
   std::vector<std::uint32_t> free_slots_;
   // Sleeping islands as sets, so that waking one visits its bodies, not every slot: the island
   // with id i (its bodies' sleep_island) starts at sleeper_head_[i] and goes on through
@@ -222,6 +255,7 @@ class World {
   std::vector<double> resting_forces_;
   std::vector<std::uint32_t> resting_island_;
   bool resting_woken_ = false;
+  std::uint64_t resting_contacts_version_ = 0;
   void keep_resting_contacts(std::uint32_t island, std::uint32_t island_index, double dt);
   void drop_woken_contacts();
   std::vector<std::uint32_t> resting_log_;
