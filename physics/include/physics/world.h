@@ -210,9 +210,12 @@ class World {
   void compute_bounds(double dt);
   void run_broad_phase();
   void find_contacts(double dt);
-  // Stages of step().
-  void number_solver_bodies();  // StepScratch's solver indices, for prepare_contacts
-  void prepare_contacts(double dt);
+  // Stages of step(), in order (physics/src/step_stages.h lists them with their files).
+  void number_solver_bodies();  // StepScratch's solver indices, for load_solver_bodies
+  void load_solver_bodies();
+  void prepare_contact_rows();
+  void choose_island_solvers(double dt);
+  void group_for_sweeps();
   void solve_islands(double dt);
   void correct_positions();
   void sweep_fast_bodies(double dt);
