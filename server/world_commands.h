@@ -1,5 +1,5 @@
 // The service's requests applied to a hosted world: what the gRPC service runs on its stepping
-// thread, and what Python's in-process world (client/python/engine/) runs directly, so that both
+// thread, and what Python's in-process world (server/python/) runs directly, so that both
 // accept, refuse and answer alike. Each is all or nothing: a refusal changes nothing and names the
 // field at fault, with the engine's code (an unknown id is kNotFound, too many bodies
 // kResourceExhausted, anything else kInvalidArgument).

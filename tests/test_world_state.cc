@@ -8,6 +8,7 @@
 #include <set>
 
 #include "scene_runner.h"
+#include "shape_state.h"
 #include "state_format.h"
 
 namespace tumble::testing {

@@ -6,6 +6,7 @@
 
 #include "mass_integrals.h"
 #include "physics/shape.h"
+#include "shape_state.h"
 
 namespace tumble {
 namespace {

@@ -1,4 +1,5 @@
 #include "state_format.h"
+#include "shape_state.h"
 
 #include <bit>
 #include <cstring>

@@ -52,14 +52,7 @@ struct MassProperties {
   Mat3 inertia = Mat3::Zero();         // kg m^2, about the centre of mass, shape-frame axes
 };
 
-// Everything a Shape is made of, for saving a world and restoring it bit for bit (the radii
-// derived from it are recomputed).
-struct ShapeState {
-  ShapeType type = ShapeType::kSphere;
-  double radius = 0, half_height = 0;
-  Vec3 half_extents = Vec3::Zero();
-  std::shared_ptr<const ConvexPolyhedron> polyhedron;  // hulls only (a box rebuilds its own)
-};
+struct ShapeState;  // everything a shape is made of, for the state format (physics/src)
 
 class Shape {
  public:
@@ -91,9 +84,10 @@ class Shape {
   // The same shape moved so that `offset` (shape frame) becomes the origin.
   Shape recentred(const Vec3& offset) const;
 
-  ShapeState state() const;
-  // Rebuilds a shape from a state that may come from outside (a saved file, the network): every
+  // For World::save_state's bytes (physics/src/shape_state.h): what the shape is made of, and a
+  // shape rebuilt from that when it may come from outside (a saved file, the network): every
   // number and index is checked, and the message names what is wrong.
+  ShapeState state() const;
   static Result<Shape> from_state(const ShapeState& state);
 
  private:
