@@ -271,13 +271,11 @@ TEST(StateFormat, RestoreStateIsAllOrNothing) {
   World world = busy_world();
   const std::string before = world.save_state();
   const std::uint64_t hash = state_hash(world);
-  std::string bad = before;
-  bad[bad.size() / 2] ^= 0x5a;
-  bad[bad.size() / 3] ^= 0x7f;
+  std::string truncated = before.substr(0, before.size() / 2);
   WorldStateData broken = data_of(world);
   broken.slots[3].body.mass = -1;
-  for (const std::string& bytes : {bad, encode_state(broken), std::string("nonsense")}) {
-    if (world.restore_state(bytes)) continue;  // a flip may land on a value still valid
+  for (const std::string& bytes : {truncated, encode_state(broken), std::string("nonsense")}) {
+    EXPECT_FALSE(world.restore_state(bytes));  // each is refused, and leaves the world as it was
     EXPECT_EQ(state_hash(world), hash);
     EXPECT_EQ(world.save_state(), before);
   }
