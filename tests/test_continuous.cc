@@ -137,12 +137,28 @@ TEST(Continuous, FastBoxPassingBesideAnotherIsNotTouched) {
   EXPECT_EQ(box.position().y(), 0);
   EXPECT_GT(world.last_step().swept_bodies, 0u);
 
-  // Without the sweep, a speculative contact as long as the motion (16.7 m) stands in for it,
-  // and its plane, through the other box's nearest face, deflects the box: a ghost contact.
+  // Without the sweep, a speculative contact as long as the motion (16.7 m) stands in for it
+  // wherever the bounds swept along the path hold the other box. Flying along x, they do not
+  // (the bounds grow along the velocity, not on every side), and the box passes untouched.
   scene.world.solver.continuous = false;
+  World along_x = build(scene);
+  run(along_x, 1.0 / 60, 3);
+  EXPECT_EQ(dynamic_bodies(along_x)[0]->linear_velocity(), Vec3(1000, 0, 0));
+  EXPECT_EQ(along_x.last_step().pairs, 0u);
+  // Flying diagonally past it at the same 0.3 m, the swept bounds (axis-aligned) hold the other
+  // box, and the speculative contact's plane, through its nearest face, deflects the box: a ghost
+  // contact, which the sweep (first half) never makes.
+  const Vec3 diagonal = Vec3(1, 1, 0).normalized();
+  scene.bodies[0].position = -20 * diagonal;
+  scene.bodies[0].linear_velocity = 1000 * diagonal;
+  scene.bodies[1].position = 0.3 * Vec3(-1, 1, 0).normalized();
   World speculative_only = build(scene);
   run(speculative_only, 1.0 / 60, 3);
-  EXPECT_LT(dynamic_bodies(speculative_only)[0]->linear_velocity().x(), 999);
+  EXPECT_GT((dynamic_bodies(speculative_only)[0]->linear_velocity() - 1000 * diagonal).norm(), 0.1);
+  scene.world.solver.continuous = true;
+  World swept = build(scene);
+  run(swept, 1.0 / 60, 3);
+  EXPECT_EQ(dynamic_bodies(swept)[0]->linear_velocity(), 1000 * diagonal);
 }
 
 // A 1 cm thick plate spinning at 100 rad/s (1.7 rad per step) just above the floor: it never goes

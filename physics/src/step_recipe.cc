@@ -2,7 +2,9 @@
 // each a function in its own file, and times them into StepStats. Read this file as the table
 // of contents of a step; docs/DYNAMICS.md describes each stage.
 #include <chrono>
+#include <utility>
 
+#include "parallel.h"
 #include "physics/world.h"
 #include "step_stages.h"
 #include "world_slot.h"
@@ -15,11 +17,21 @@ Status World::step(double dt) {
   const std::uint64_t step_index = stats_.step + 1;
   stats_ = StepStats{};
   stats_.step = step_index;
+  // The team regions' times, each stage's read off as it ends (parallel.h).
+  RegionClock regions;
+  const RegionClockScope clock_scope(&regions);
+  const auto regions_since = [&regions](double* parallel, double* idle) {
+    *parallel += std::exchange(regions.region_seconds, 0.0);
+    *idle += std::exchange(regions.idle_thread_seconds, 0.0);
+  };
+  StageTimes& parallel = stats_.parallel_time;
+  StageTimes& idle = stats_.idle_time;
 
   auto stage = std::chrono::steady_clock::now();
   compute_bounds(dt);
   run_broad_phase();
   stats_.time.broad_phase = seconds_since(stage);
+  regions_since(&parallel.broad_phase, &idle.broad_phase);
 
   stage = std::chrono::steady_clock::now();
   find_contacts(dt);
@@ -35,6 +47,7 @@ Status World::step(double dt) {
     find_contacts(dt);
     stats_.time.narrow_phase += seconds_since(stage);
   }
+  regions_since(&parallel.narrow_phase, &idle.narrow_phase);
 
   stage = std::chrono::steady_clock::now();
   load_solver_bodies();
@@ -42,24 +55,33 @@ Status World::step(double dt) {
   choose_island_solvers(dt);
   group_for_sweeps();
   stats_.time.prepare = seconds_since(stage);
+  regions_since(&parallel.prepare, &idle.prepare);
 
   stage = std::chrono::steady_clock::now();
   solve_islands(dt);
   stats_.time.solve = seconds_since(stage);
+  regions_since(&parallel.solve, &idle.solve);
 
   stage = std::chrono::steady_clock::now();
   correct_positions();
   stats_.time.correct_positions = seconds_since(stage);
+  regions_since(&parallel.correct_positions, &idle.correct_positions);
 
   if (fast_count_ > 0) {
     stage = std::chrono::steady_clock::now();
     sweep_fast_bodies(dt);
     stats_.time.continuous = seconds_since(stage);
+    regions_since(&parallel.continuous, &idle.continuous);
   }
 
   finish_step(dt);
   update_sleep(dt);
   stats_.time.total = seconds_since(start);
+  regions_since(&parallel.total, &idle.total);
+  parallel.total += parallel.broad_phase + parallel.narrow_phase + parallel.prepare +
+                    parallel.solve + parallel.correct_positions + parallel.continuous;
+  idle.total += idle.broad_phase + idle.narrow_phase + idle.prepare + idle.solve +
+                idle.correct_positions + idle.continuous;
   return Status::ok();
 }
 

@@ -134,6 +134,10 @@ struct StepStats {
   // limits, and bodies held at the edge of the world (max_coordinate).
   std::uint32_t non_finite_bodies = 0, slowed_bodies = 0, bodies_at_edge = 0;
   StageTimes time;
+  // Of each stage's time, the wall time its parallel regions took (the rest ran on the stepping
+  // thread alone: serial), and the thread-seconds the team spent waiting at those regions' ends
+  // for its slowest thread (imbalance). Zero on one thread. bench_threads reads them.
+  StageTimes parallel_time, idle_time;
 };
 
 }  // namespace tumble
