@@ -108,6 +108,15 @@ struct StepScratch {
   // by body pair; and this step's, contact for contact, with the index of each one's record in
   // `pairs` (kNoRecord: none) and whether its manifold was taken from there.
   std::vector<ContactPairRecord> pairs, next_pairs;
+  static constexpr std::uint8_t kPairTouches = 1, kPairKeptFeature = 2;
+  // The narrow phase's output by broad-phase pair, before the touching ones are copied out to the
+  // world's contacts and next_pairs. Never cut back, so that a step reuses what the last one
+  // constructed (cutting and growing again constructed every pair's contact anew, serially).
+  std::vector<Contact> found_contacts;
+  std::vector<ContactPairRecord> found_records;
+  std::vector<std::uint32_t> found_previous;  // the record of the last step, or kNoRecord
+  std::vector<std::uint8_t> found_flags;      // kPairTouches, kPairKeptFeature
+  std::vector<std::uint32_t> kept_index;      // where a touching pair goes in `contacts`
   std::vector<std::uint32_t> previous_pair;
   std::vector<std::uint8_t> reused;
 };

@@ -659,26 +659,30 @@ void World::find_contacts(double dt) {
   const std::int64_t n = static_cast<std::int64_t>(pairs_.size());
   // Every pair writes its own slot, then the touching ones are packed in pair order: the same
   // result for any thread count.
-  resize_reusing(contacts_, pairs_.size());
-  resize_reusing(s.next_pairs, pairs_.size());
-  resize_reusing(s.previous_pair, pairs_.size());
-  resize_reusing(s.reused, pairs_.size());
+  if (s.found_contacts.size() < pairs_.size()) {
+    resize_reusing(s.found_contacts, pairs_.size());
+    resize_reusing(s.found_records, pairs_.size());
+  }
+  resize_reusing(s.found_previous, pairs_.size());
+  resize_reusing(s.found_flags, pairs_.size());
+  resize_reusing(s.kept_index, pairs_.size());
   const double reuse = dt > 0 ? settings_.solver.manifold_reuse : 0.0;
   const double gravity = settings_.gravity.norm();
-  match_pair_records(pairs_, s.pairs, s.previous_pair);
-  const std::uint32_t flags = or_over_indices(
-      thread_count(settings_.threads), n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
+  const int threads = thread_count(settings_.threads);
+  match_pair_records(pairs_, s.pairs, s.found_previous);
+  const std::uint32_t flags =
+      or_over_indices(threads, n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
         const Body& a = bodies_[pairs_[i].a].body;
         const Body& b = bodies_[pairs_[i].b].body;
-        Contact& contact = contacts_[i];
+        Contact& contact = s.found_contacts[i];
         contact.a = {pairs_[i].a, bodies_[pairs_[i].a].generation};
         contact.b = {pairs_[i].b, bodies_[pairs_[i].b].generation};
-        std::uint32_t previous = s.previous_pair[i];
+        std::uint32_t previous = s.found_previous[i];
         if (previous != kNoRecord &&
             (s.pairs[previous].a != contact.a || s.pairs[previous].b != contact.b))
           previous = kNoRecord;  // the slot now holds another body
-        s.previous_pair[i] = previous;
-        s.reused[i] = 0;
+        s.found_previous[i] = previous;
+        s.found_flags[i] = 0;
         const Pose pose_a = a.pose(), pose_b = b.pose();
         CollisionSettings settings = settings_.collision;
         const bool fast = fast_[pairs_[i].a] || fast_[pairs_[i].b];
@@ -721,30 +725,37 @@ void World::find_contacts(double dt) {
                                 &contact.manifold);
         }
         if (contact.manifold.count > 0) {
-          ContactPairRecord& record = s.next_pairs[i];
+          s.found_flags[i] = StepScratch::kPairTouches;
+          ContactPairRecord& record = s.found_records[i];
           record_manifold(contact.manifold, chosen, contact.a, pose_a, contact.b, pose_b, &record);
           // The motion allowed is counted from where the feature was searched for.
           if (!chosen.searched) {
-            s.reused[i] = 1;
+            s.found_flags[i] |= StepScratch::kPairKeptFeature;
             record.relative_position = s.pairs[previous].relative_position;
             record.relative_orientation = s.pairs[previous].relative_orientation;
           }
         }
         return pair_flags;
       });
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < contacts_.size(); ++i) {
-    if (contacts_[i].manifold.count == 0) continue;
-    contacts_[kept] = contacts_[i];
-    s.next_pairs[kept] = s.next_pairs[i];
-    s.previous_pair[kept] = s.previous_pair[i];
-    s.reused[kept] = s.reused[i];
-    ++kept;
+  // The touching pairs, in pair order: where each goes (a count, on one thread, over a byte per
+  // pair), then the copies spread over the team.
+  std::uint32_t kept = 0;
+  for (std::size_t i = 0; i < pairs_.size(); ++i) {
+    s.kept_index[i] = kept;
+    kept += (s.found_flags[i] & StepScratch::kPairTouches) != 0;
   }
-  contacts_.resize(kept);
-  s.next_pairs.resize(kept);
-  s.previous_pair.resize(kept);
-  s.reused.resize(kept);
+  resize_reusing(contacts_, kept);
+  resize_reusing(s.next_pairs, kept);
+  resize_reusing(s.previous_pair, kept);
+  resize_reusing(s.reused, kept);
+  for_indices(threads, n > 512, n, [&](std::int64_t i) {
+    if ((s.found_flags[i] & StepScratch::kPairTouches) == 0) return;
+    const std::uint32_t k = s.kept_index[i];
+    contacts_[k] = s.found_contacts[i];
+    s.next_pairs[k] = s.found_records[i];
+    s.previous_pair[k] = s.found_previous[i];
+    s.reused[k] = (s.found_flags[i] & StepScratch::kPairKeptFeature) != 0;
+  });
   collision_flags_ = flags;
 }
 
