@@ -28,22 +28,28 @@ void World::prepare_contact_rows() {
   s.touching.resize(manifolds);
   s.kept_colours.resize(manifolds);
   s.colours.resize(manifolds);
-  double deepest = 0;
-  for (std::size_t m = 0; m < manifolds; ++m) {
+  s.manifold_depth.resize(manifolds);
+  const std::int64_t count = static_cast<std::int64_t>(manifolds);
+  // What each manifold says of itself, read over the team (the contacts are large and each is
+  // read once); then the places of the rows, a count on one thread over a word per manifold.
+  for_indices(threads, count > 256, count, [&](std::int64_t m) {
     const Contact& contact = contacts_[m];
-    s.row_begin[m + 1] = s.row_begin[m] + static_cast<std::uint32_t>(contact.manifold.count);
+    s.row_begin[m + 1] = static_cast<std::uint32_t>(contact.manifold.count);
     s.links[m] = {s.solver_of_slot[contact.a.index], s.solver_of_slot[contact.b.index]};
     s.touching[m] = contact.manifold.depth > -settings_.solver.slop;
-    stats_.reused_manifolds += s.reused[m];
-    deepest = std::max(deepest, contact.manifold.depth);
+    s.manifold_depth[m] = contact.manifold.depth;
     const std::uint32_t previous = s.previous_pair[m];
     s.kept_colours[m] = previous == kNoRecord ? kNoColour : s.pairs[previous].colour;
+  });
+  double deepest = 0;
+  for (std::size_t m = 0; m < manifolds; ++m) {
+    s.row_begin[m + 1] += s.row_begin[m];
+    stats_.reused_manifolds += s.reused[m];
+    deepest = std::max(deepest, s.manifold_depth[m]);
   }
   // A pair keeps the colour it was given when it started touching (colouring.h); its record
-  // carries it to the next step.
+  // carries it to the next step (below, with the rows).
   keep_manifold_colours(s.links, s.dynamic, s.kept_colours, &s.colouring_scratch, s.colours);
-  for (std::size_t m = 0; m < manifolds; ++m)
-    s.next_pairs[m].colour = s.colours[m];
   s.rows.resize(s.row_begin[manifolds]);
   s.cold_rows.resize(s.rows.size());
   s.blocks.resize(manifolds);
@@ -53,8 +59,8 @@ void World::prepare_contact_rows() {
     for (std::size_t r = from; r < s.row_ids.size(); ++r)
       s.row_ids[r] = static_cast<std::uint32_t>(r);
   }
-  const std::int64_t count = static_cast<std::int64_t>(manifolds);
   for_indices(threads, count > 64, count, [&](std::int64_t m) {
+    s.next_pairs[m].colour = s.colours[m];
     const Contact& contact = contacts_[m];
     const std::uint32_t previous = s.previous_pair[m];
     prepare_rows(contact.manifold, s.links[m].a, bodies_[contact.a.index].body, s.links[m].b,

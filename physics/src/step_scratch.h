@@ -102,8 +102,8 @@ struct StepScratch {
   std::vector<std::uint32_t> swept_pairs;
   std::vector<ImpactResult> impacts;
   std::vector<double> first_impact;
-  std::vector<std::uint32_t> support_level;  // for tall_stacks.h
-  std::vector<LevelSums> level_sums;
+  std::vector<std::uint32_t> support_level;               // for tall_stacks.h
+  std::vector<std::vector<LevelSums>> thread_level_sums;  // for tall_stacks.h, one per thread
   // The touching pairs as the last step left them, with their impulses (contact_pairs.h), sorted
   // by body pair; and this step's, contact for contact, with the index of each one's record in
   // `pairs` (kNoRecord: none) and whether its manifold was taken from there.
@@ -117,6 +117,7 @@ struct StepScratch {
   std::vector<std::uint32_t> found_previous;  // the record of the last step, or kNoRecord
   std::vector<std::uint8_t> found_flags;      // kPairTouches, kPairKeptFeature
   std::vector<std::uint32_t> kept_index;      // where a touching pair goes in `contacts`
+  std::vector<double> manifold_depth;         // each manifold's depth, for the step's deepest
   std::vector<std::uint32_t> previous_pair;
   std::vector<std::uint8_t> reused;
 };
