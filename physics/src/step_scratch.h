@@ -92,8 +92,9 @@ struct StepScratch {
   struct PackedManifolds {
     std::uint32_t first = 0, count = 0;
   };
-  bool packed = false;                 // this step sweeps packs (packed_sweeps())
-  std::vector<std::uint32_t> grouped;  // a colour's manifolds while they are grouped by size
+  bool packed = false;  // this step sweeps packs (packed_sweeps())
+  // A colour's manifolds while they are grouped by size, one buffer per thread.
+  std::vector<std::vector<std::uint32_t>> thread_grouped;
   std::vector<ContactPack> packs;
   std::vector<PackedManifolds> pack_manifolds;
   std::vector<std::uint32_t> colour_pack_begin;

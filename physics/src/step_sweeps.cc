@@ -1,6 +1,8 @@
 // Stage "sweeps": each island's manifolds laid out for the solver's sweeps: large iterative
 // islands coloured for the whole team, their colours packed four manifolds to a vector, the
 // others one island per thread; and the step's counts in StepStats.
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <span>
@@ -55,12 +57,17 @@ void World::group_for_sweeps() {
   // Each island's manifolds as row-id spans, for sweeping several islands at once.
   s.island_manifolds.clear();
   s.island_manifold_begin.assign(1, 0);
+  // (An island's rows are its manifolds' in link order, so the manifolds' sizes come from
+  // row_begin, without reading the rows themselves.)
   for (std::size_t i = 0; i < islands; ++i) {
-    for (std::uint32_t r = s.island_row_begin[i]; r < s.island_row_begin[i + 1];) {
-      const int count = s.rows[s.island_rows[r]].block_size;
+    std::uint32_t r = s.island_row_begin[i];
+    for (std::uint32_t l = s.islands.link_begin[i]; l < s.islands.link_begin[i + 1]; ++l) {
+      const std::uint32_t manifold = s.islands.links[l];
+      const int count = static_cast<int>(s.row_begin[manifold + 1] - s.row_begin[manifold]);
       s.island_manifolds.push_back({&s.island_rows[r], count});
       r += count;
     }
+    TUMBLE_ASSERT(r == s.island_row_begin[i + 1]);
     s.island_manifold_begin.push_back(static_cast<std::uint32_t>(s.island_manifolds.size()));
   }
 
@@ -84,12 +91,24 @@ void World::group_for_sweeps() {
   s.packed = packed_sweeps();
   s.pack_manifolds.clear();
   s.colour_pack_begin.assign(1, 0);
+  const std::int64_t colours = static_cast<std::int64_t>(s.colouring.colour_count());
+  if (s.packed) {
+    // Colours are grouped independently, over the team (a thread's own scratch).
+    s.thread_grouped.resize(threads);
+    for_indices(
+        threads, colours > 1 && s.colouring.manifolds.size() > 1024, colours,
+        [&](std::int64_t c) {
+          if (s.colouring.serial[c]) return;
+          const std::uint32_t begin = s.colouring.colour_begin[c],
+                              end = s.colouring.colour_begin[c + 1];
+          group_by_points(std::span(s.colouring.manifolds).subspan(begin, end - begin), s.row_begin,
+                          &s.thread_grouped[omp_get_thread_num()]);
+        },
+        1);
+  }
   for (std::size_t c = 0; c < s.colouring.colour_count(); ++c) {
     const std::uint32_t end = s.colouring.colour_begin[c + 1];
     if (s.packed && !s.colouring.serial[c]) {
-      group_by_points(std::span(s.colouring.manifolds)
-                          .subspan(s.colouring.colour_begin[c], end - s.colouring.colour_begin[c]),
-                      s.row_begin, &s.grouped);
       for (std::uint32_t first = s.colouring.colour_begin[c]; first < end; first += kWideLanes)
         s.pack_manifolds.push_back({first, std::min<std::uint32_t>(kWideLanes, end - first)});
     }
