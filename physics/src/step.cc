@@ -289,15 +289,15 @@ std::span<const std::uint32_t> manifold_rows(const StepScratch& s, std::uint32_t
 }
 
 // The largest of the threads' values, returned to every thread.
-double team_max(double local, std::vector<double>& values) {
+double team_max(double local, StepScratch& s) {
   const int threads = omp_get_num_threads();
   if (threads == 1) return local;
-  values[omp_get_thread_num()] = local;
-#pragma omp barrier
+  s.team_values[omp_get_thread_num()] = local;
+  s.barrier.wait();
   double largest = 0;
   for (int t = 0; t < threads; ++t)
-    largest = std::max(largest, values[t]);
-#pragma omp barrier
+    largest = std::max(largest, s.team_values[t]);
+  s.barrier.wait();
   return largest;
 }
 
@@ -320,25 +320,27 @@ double visit_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
   for (std::uint32_t k = first; k < last; ++k) {
     const std::uint32_t c = backward ? first + last - 1 - k : k;
     const std::int64_t begin = colouring.colour_begin[c], end = colouring.colour_begin[c + 1];
+    // Each colour ends at the team's barrier (team_barrier.h), not OpenMP's.
     if (colouring.serial[c]) {
-#pragma omp single
+#pragma omp single nowait
       for (std::int64_t i = begin; i < end; ++i) {
         const std::int64_t at = backward ? begin + end - 1 - i : i;
         local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[at])));
       }
     } else if (!packed) {
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
       for (std::int64_t i = begin; i < end; ++i)
         local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[i])));
     } else {
       const std::int64_t packs_begin = s.colour_pack_begin[c],
                          packs_end = s.colour_pack_begin[c + 1];
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
       for (std::int64_t p = packs_begin; p < packs_end; ++p)
         local = std::max(local, pack_fn(s.packs[p]));
     }
+    s.barrier.wait();
   }
-  return reduce ? team_max(local, s.team_values) : 0.0;
+  return reduce ? team_max(local, s) : 0.0;
 }
 
 // The step's packs where it sweeps them, else the rows.
@@ -361,23 +363,25 @@ double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
 std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
   std::uint32_t hits = 0;
   const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
   for (std::int64_t k = 0; k < n; ++k) {
     const std::uint32_t body = c.bodies[k];
     if (!integrate_velocity(*c.body_of[body], c.scratch.poses[body].orientation, c.settings.gravity,
                             h, &c.scratch.bodies[body]))
       ++hits;
   }
+  c.scratch.barrier.wait();
   return hits;
 }
 
 void team_integrate_positions(const IslandContext& c, double h) {
   const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
   for (std::int64_t k = 0; k < n; ++k) {
     const std::uint32_t body = c.bodies[k];
     integrate_position(h, &c.scratch.bodies[body], &c.scratch.poses[body]);
   }
+  c.scratch.barrier.wait();
 }
 
 // advance_with's parts for a coloured island (soft or pgs) over the whole team: every member
@@ -553,6 +557,8 @@ void World::solve_islands(double dt) {
   // islands share no body and no row, and colours share no moving body, so any thread count gives
   // the same bits.
   run_region(threads, parallel, [&] {
+#pragma omp single
+    s.barrier.reset(omp_get_num_threads());
     for (std::uint32_t i : s.team_islands) {
       const IslandContext context = island_context(s, settings_, i);
       TeamIsland team(context, s.island_colour_begin[i], s.island_colour_begin[i + 1],
@@ -609,6 +615,8 @@ void World::correct_positions() {
   const int threads = team_size(settings_.threads);
   const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
   run_region(threads, true, [&] {
+#pragma omp single
+    s.barrier.reset(omp_get_num_threads());
     for (std::uint32_t i : s.team_islands) {
       if (!needs_correction(i)) continue;
       for (int k = 0; k < solver.position_iterations; ++k)

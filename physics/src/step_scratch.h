@@ -11,6 +11,7 @@
 #include "continuous.h"
 #include "islands.h"
 #include "tall_stacks.h"
+#include "team_barrier.h"
 
 namespace tumble {
 
@@ -99,6 +100,7 @@ struct StepScratch {
   std::vector<PackedManifolds> pack_manifolds;
   std::vector<std::uint32_t> colour_pack_begin;
   std::vector<double> team_values;  // one per thread, for reductions inside a team
+  TeamBarrier barrier;              // the solver regions' barrier (team_barrier.h)
   // Continuous collision: pairs with a fast body, their results, and each slot's first impact.
   std::vector<std::uint32_t> swept_pairs;
   std::vector<ImpactResult> impacts;
