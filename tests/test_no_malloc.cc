@@ -60,10 +60,10 @@ void free(void* p) {
 namespace tumble::testing {
 namespace {
 
-long allocations_in_steps(SceneDef scene, int steps) {
-  scene.world.threads = 1;
+long allocations_in_steps(SceneDef scene, int steps, int threads = 1, int warm_up = 30) {
+  scene.world.threads = threads;
   World world = build(scene);
-  run(world, scene.dt, 30);  // warm up: scratch memory grows to its size
+  run(world, scene.dt, warm_up);  // scratch memory grows to its size
   calls = 0;
   counting = true;
   for (int s = 0; s < steps; ++s)
@@ -95,6 +95,15 @@ TEST(NoMalloc, OneThreadStepsCallNoAllocator) {
   std::uint32_t swept = 0;
   run(world, fast.dt, 130, [&](long) { swept += world.last_step().swept_bodies; });
   EXPECT_GT(swept, 100u);  // the sweep really ran in those steps
+}
+
+// On a team too, once warmed up: the per-thread working memory of the islands' and the colours'
+// stages grows on every thread to what any needed (a step may hand the tallest island to another
+// thread), and the team's region clocks and barrier allocate nothing.
+TEST(NoMalloc, TwoThreadStepsOfALandedPileCallNoAllocator) {
+  SceneDef pile = pile_scene(1000);
+  pile.world.solver.sleeping = false;
+  EXPECT_EQ(allocations_in_steps(pile, 20, 2, 150), 0);
 }
 
 }  // namespace

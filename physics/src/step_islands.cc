@@ -113,6 +113,13 @@ void World::choose_island_solvers(double dt) {
         }
       },
       16);
+  // Every thread's level sums as large as the largest any needed, so that the next step, which
+  // may hand the tallest island to another thread, allocates nothing.
+  std::size_t most_levels = 0;
+  for (const std::vector<LevelSums>& sums : s.thread_level_sums)
+    most_levels = std::max(most_levels, sums.capacity());
+  for (std::vector<LevelSums>& sums : s.thread_level_sums)
+    sums.reserve(most_levels);
 }
 
 }  // namespace tumble

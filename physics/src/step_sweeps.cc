@@ -105,6 +105,12 @@ void World::group_for_sweeps() {
                           &s.thread_grouped[omp_get_thread_num()]);
         },
         1);
+    // As large as the largest colour needed, on every thread: the next step allocates nothing.
+    std::size_t most = 0;
+    for (const std::vector<std::uint32_t>& grouped : s.thread_grouped)
+      most = std::max(most, grouped.capacity());
+    for (std::vector<std::uint32_t>& grouped : s.thread_grouped)
+      grouped.reserve(most);
   }
   for (std::size_t c = 0; c < s.colouring.colour_count(); ++c) {
     const std::uint32_t end = s.colouring.colour_begin[c + 1];
