@@ -3,7 +3,8 @@
 # builds, alternated round by round, mean ms per step over the first 1.5 s (90 steps).
 #
 # Usage: bench/beside_jolt.sh JOLT_PILE N THREADS ROUNDS TUMBLE_RUN [TUMBLE_RUN ...]
-#   JOLT_PILE   Jolt's pile program (built as ../shared/peers/jolt/README.md says, outside the tree)
+#   JOLT_PILE   a program stepping the S1 pile in Jolt, built outside the tree (docs/PERFORMANCE.md,
+#               "Beside Jolt", says what it prints)
 #   TUMBLE_RUN  tumble-run of each build to compare (e.g. build/apps/tumble-run and an older one)
 set -euo pipefail
 if [ $# -lt 5 ]; then

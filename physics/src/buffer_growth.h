@@ -19,11 +19,4 @@ void resize_reusing(std::vector<T>& buffer, std::size_t size) {
   buffer.resize(size);
 }
 
-// The same growth for a buffer about to be filled by push_back up to `size`.
-template <typename T>
-void reserve_reusing(std::vector<T>& buffer, std::size_t size) {
-  if (size > buffer.capacity())
-    buffer.reserve(std::max(size, buffer.capacity() + buffer.capacity() / 2));
-}
-
 }  // namespace tumble

@@ -78,10 +78,10 @@ Status World::step(double dt) {
   update_sleep(dt);
   stats_.time.total = seconds_since(start);
   regions_since(&parallel.total, &idle.total);
-  parallel.total += parallel.broad_phase + parallel.narrow_phase + parallel.prepare +
-                    parallel.solve + parallel.correct_positions + parallel.continuous;
-  idle.total += idle.broad_phase + idle.narrow_phase + idle.prepare + idle.solve +
-                idle.correct_positions + idle.continuous;
+  // The total adds the stages' to what ran after them (store, sleep).
+  for (StageTimes* times : {&parallel, &idle})
+    times->total += times->broad_phase + times->narrow_phase + times->prepare + times->solve +
+                    times->correct_positions + times->continuous;
   return Status::ok();
 }
 
