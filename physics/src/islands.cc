@@ -17,19 +17,25 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
 
 void build_islands(std::span<const std::uint8_t> dynamic, std::span<const IslandLink> links,
                    Islands* out) {
+  build_islands(dynamic, links, {}, out);
+}
+
+void build_islands(std::span<const std::uint8_t> dynamic, std::span<const IslandLink> links,
+                   std::span<const IslandLink> joint_links, Islands* out) {
   const std::uint32_t body_count = static_cast<std::uint32_t>(dynamic.size());
   std::vector<std::uint32_t>& parent = out->parent;
   parent.resize(body_count);
   std::iota(parent.begin(), parent.end(), 0u);
-  for (const IslandLink& link : links) {
-    if (!dynamic[link.a] || !dynamic[link.b]) continue;
-    const std::uint32_t ra = find_root(parent, link.a), rb = find_root(parent, link.b);
-    // The lower index becomes the root, so roots are the islands' lowest bodies.
-    if (ra < rb)
-      parent[rb] = ra;
-    else if (rb < ra)
-      parent[ra] = rb;
-  }
+  for (const std::span<const IslandLink> list : {links, joint_links})
+    for (const IslandLink& link : list) {
+      if (!dynamic[link.a] || !dynamic[link.b]) continue;
+      const std::uint32_t ra = find_root(parent, link.a), rb = find_root(parent, link.b);
+      // The lower index becomes the root, so roots are the islands' lowest bodies.
+      if (ra < rb)
+        parent[rb] = ra;
+      else if (rb < ra)
+        parent[ra] = rb;
+    }
 
   constexpr std::uint32_t kNone = UINT32_MAX;
   std::vector<std::uint32_t>& island_of = out->island_of;
@@ -72,6 +78,18 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
   cursor.assign(out->link_begin.begin(), out->link_begin.end() - 1);
   for (std::uint32_t l = 0; l < links.size(); ++l)
     out->links[cursor[island_of_link(links[l])]++] = l;
+
+  // The joints, the same way (most worlds have none).
+  link_counts.assign(count, 0);
+  for (const IslandLink& link : joint_links)
+    ++link_counts[island_of_link(link)];
+  out->joint_begin.assign(count + 1, 0);
+  for (std::size_t i = 0; i < count; ++i)
+    out->joint_begin[i + 1] = out->joint_begin[i] + link_counts[i];
+  out->joints.resize(out->joint_begin[count]);
+  cursor.assign(out->joint_begin.begin(), out->joint_begin.end() - 1);
+  for (std::uint32_t l = 0; l < joint_links.size(); ++l)
+    out->joints[cursor[island_of_link(joint_links[l])]++] = l;
 }
 
 }  // namespace tumble

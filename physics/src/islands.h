@@ -17,6 +17,9 @@ struct Islands {
   // link_begin[i+1]) (indices into the links given), both in ascending order.
   std::vector<std::uint32_t> bodies, body_begin;
   std::vector<std::uint32_t> links, link_begin;
+  // Island i's joints: joints[joint_begin[i] .. joint_begin[i+1]) (indices into the joint links
+  // given), ascending.
+  std::vector<std::uint32_t> joints, joint_begin;
   std::size_t count() const { return body_begin.empty() ? 0 : body_begin.size() - 1; }
 
   // Working memory of build_islands, kept to be reused.
@@ -28,5 +31,9 @@ struct Islands {
 // beyond the lists' own order.
 void build_islands(std::span<const std::uint8_t> dynamic, std::span<const IslandLink> links,
                    Islands* out);
+// The same, bodies joined by contacts' links and by joints' (a joint to the world links its body
+// to itself).
+void build_islands(std::span<const std::uint8_t> dynamic, std::span<const IslandLink> links,
+                   std::span<const IslandLink> joint_links, Islands* out);
 
 }  // namespace tumble

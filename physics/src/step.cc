@@ -28,6 +28,7 @@ namespace {
 struct IslandContext {
   std::span<const std::uint32_t> bodies;
   std::span<const std::uint32_t> rows;
+  std::span<const std::uint32_t> joints;  // indices into scratch.joint_rows
   StepScratch& scratch;
   const WorldSettings& settings;
   std::span<const Body* const> body_of;  // by solver index
@@ -87,6 +88,11 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
   run.finish(dt, [&] { run.integrate_positions(dt); });
 }
 
+// Nonlinear Gauss-Seidel passes over an island's joints after each move. Each pass takes a
+// joint's error to second order in its size (a substep's drift is ~1e-5 m); a chain passes
+// corrections along one link a pass, which the next moves' passes carry on.
+constexpr int kJointPositionPasses = 3;
+
 // advance_with's parts for one island on one thread (any island: exact, soft, pgs).
 class SerialIsland {
  public:
@@ -98,7 +104,7 @@ class SerialIsland {
         cold_(c.scratch.cold_rows),
         bodies_(c.scratch.bodies) {}
 
-  bool has_rows() const { return !c_.rows.empty(); }
+  bool has_rows() const { return !c_.rows.empty() || !c_.joints.empty(); }
   void integrate_velocities(double h) {
     for (std::uint32_t k : c_.bodies) {
       if (!integrate_velocity(*c_.body_of[k], c_.scratch.poses[k].orientation, c_.settings.gravity,
@@ -106,18 +112,36 @@ class SerialIsland {
         ++report_->gyroscopic_limit_hits;
     }
   }
+  // Each move is followed by the joints' position passes (joint_solver.h).
   void integrate_positions(double h) {
     for (std::uint32_t k : c_.bodies)
       integrate_position(h, &bodies_[k], &c_.scratch.poses[k]);
+    for (int pass = 0; pass < kJointPositionPasses; ++pass)
+      for (std::uint32_t j : c_.joints)
+        correct_joint_position(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
   }
   void refresh_separations() { update_separations(rows_, c_.rows, bodies_); }
   void warm_start(bool keep_last_substep) {
+    for (std::uint32_t j : c_.joints)
+      warm_start_joint(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
     tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep);
   }
+  // Joints first, then contacts (Box2D v3's order: the contacts have the last word on
+  // penetration).
   double sweep(const Softness* soft, double h, bool backward) {
     ++report_->velocity_iterations;
-    return solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver, soft, h,
-                          backward);
+    double change = 0;
+    if (!c_.joints.empty()) {
+      // Before a move: the soft solver's sweeps with bias, and every pgs sweep (its move follows).
+      const bool move_ahead = soft != nullptr || report_->solver == IslandSolver::kPgs;
+      const JointTarget target{move_ahead ? h : 0.0, c_.settings.solver.max_push_velocity};
+      for (std::uint32_t j : c_.joints)
+        change = std::max(change,
+                          solve_joint(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses, target));
+    }
+    if (c_.rows.empty()) return change;
+    return std::max(change, solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_,
+                                           c_.settings.solver, soft, h, backward));
   }
   // True when the LCP's answer was taken; false when it was refused (then pgs solves the island).
   bool solve_exact(double dt) {
@@ -159,7 +183,12 @@ IslandContext island_context(StepScratch& s, const WorldSettings& settings, std:
           .subspan(s.islands.body_begin[i], s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
       std::span(s.island_rows)
           .subspan(s.island_row_begin[i], s.island_row_begin[i + 1] - s.island_row_begin[i]),
-      s, settings, s.body_of};
+      std::span(s.islands.joints)
+          .subspan(s.islands.joint_begin[i],
+                   s.islands.joint_begin[i + 1] - s.islands.joint_begin[i]),
+      s,
+      settings,
+      s.body_of};
 }
 
 // advance_with's parts for up to kWideLanes small islands of the same recipe (soft with the
@@ -495,7 +524,7 @@ void World::solve_islands(double dt) {
   auto lane_kind = [&](std::uint32_t i) -> int {
     const IslandReport& report = s.reports[i];
     if (s.island_row_begin[i + 1] == s.island_row_begin[i]) return -1;
-    if (!s.packed) return -1;
+    if (!s.packed || report.joints > 0) return -1;
     if (report.solver == IslandSolver::kSoft && report.substeps == 0) return 0;
     if (report.solver == IslandSolver::kPgs) return 1;
     return -1;
@@ -581,6 +610,7 @@ void World::solve_islands(double dt) {
       }
     });
   });
+  store_joint_impulses();
   for (const IslandReport& report : s.reports) {
     if (report.solver == IslandSolver::kExact)
       ++stats_.exact_islands;

@@ -37,6 +37,18 @@ void World::number_solver_bodies() {
       s.solver_slot.push_back(slot);
     }
   }
+  // The static bodies that joints hold moving bodies to.
+  if (joint_count_ == 0) return;
+  for (const JointSlot& joint : joints_) {
+    if (!joint.alive || joint.joint.b == kWorldAnchor) continue;
+    const std::uint32_t a = joint.joint.a, b = joint.joint.b;
+    if (!bodies_[a].body.is_moving() && !bodies_[b].body.is_moving()) continue;
+    for (const std::uint32_t slot : {a, b}) {
+      if (s.solver_of_slot[slot] != kNoSolverBody) continue;
+      s.solver_of_slot[slot] = static_cast<std::uint32_t>(s.solver_slot.size());
+      s.solver_slot.push_back(slot);
+    }
+  }
 }
 
 void World::load_solver_bodies() {

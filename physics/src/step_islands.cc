@@ -24,7 +24,8 @@ namespace tumble {
 void World::choose_island_solvers(double dt) {
   StepScratch& s = *scratch_;
   const std::uint32_t solver_bodies = static_cast<std::uint32_t>(s.solver_slot.size());
-  build_islands(s.dynamic, s.links, &s.islands);
+  prepare_joint_rows();
+  build_islands(s.dynamic, s.links, s.joint_links, &s.islands);
   s.support_level.resize(solver_bodies);
 
   const std::size_t islands = s.islands.count();
@@ -96,6 +97,10 @@ void World::choose_island_solvers(double dt) {
             break;
           }
         }
+        // An island with joints is solved on one thread by an iterative solver (the exact
+        // solver's LCP holds contacts alone).
+        s.reports[i].joints = s.islands.joint_begin[i + 1] - s.islands.joint_begin[i];
+        if (s.reports[i].joints > 0 && kind == IslandSolver::kExact) kind = IslandSolver::kSoft;
         s.reports[i].solver = kind;
         if (kind == IslandSolver::kSoft) {
           const IslandStiffness stiffness = island_stiffness(

@@ -27,6 +27,8 @@ Status World::step(double dt) {
   StageTimes& parallel = stats_.parallel_time;
   StageTimes& idle = stats_.idle_time;
 
+  // Sleepers joined to moving bodies move with them (before the bounds, which count them).
+  if (joint_count_ > 0) stats_.woken_bodies += wake_jointed();
   auto stage = std::chrono::steady_clock::now();
   compute_bounds(dt);
   run_broad_phase();
@@ -40,7 +42,7 @@ Status World::step(double dt) {
   // Sleepers touched by moving bodies wake with their islands, and the woken need their own
   // contacts this step. Islands that touch fall asleep together, so one more pass finds them all.
   if (const std::uint32_t woken = wake_touched(); woken > 0) {
-    stats_.woken_bodies = woken;
+    stats_.woken_bodies += woken;
     stage = std::chrono::steady_clock::now();
     compute_bounds(dt);
     run_broad_phase();

@@ -10,6 +10,7 @@
 #include "contact_solver.h"
 #include "continuous.h"
 #include "islands.h"
+#include "joint_solver.h"
 #include "tall_stacks.h"
 #include "team_barrier.h"
 
@@ -32,6 +33,7 @@ struct IslandReport {
   // Pgs islands tall enough to buckle: all their sweeps, this many (0: the settings').
   int pgs_iterations = 0;
   bool stiffness_capped = false;
+  std::uint32_t joints = 0;  // the island's joints: it is solved on one thread, soft or pgs
 };
 
 // An island this large is worth splitting over threads (and is split with one thread too, so the
@@ -60,7 +62,10 @@ struct StepScratch {
   std::vector<NormalBlock> blocks;        // one per manifold
   std::vector<std::uint32_t> row_begin;   // rows of manifold m: [row_begin[m], row_begin[m+1])
   std::vector<IslandLink> links;          // one per manifold
-  std::vector<std::uint8_t> touching;     // per manifold: apart by less than the slop
+  // The joints with a moving body (world_joints.cc), and their links into islands.
+  std::vector<JointRow> joint_rows;
+  std::vector<IslandLink> joint_links;
+  std::vector<std::uint8_t> touching;  // per manifold: apart by less than the slop
   // Per manifold: its pair's colour last step and this step's (colouring.h).
   std::vector<std::uint8_t> kept_colours, colours;
   Islands islands;

@@ -78,7 +78,8 @@ void World::group_for_sweeps() {
   s.single_islands.clear();
   for (std::size_t i = 0; i < islands; ++i) {
     const std::uint32_t links = s.islands.link_begin[i + 1] - s.islands.link_begin[i];
-    if (links >= kColouredIsland && s.reports[i].solver != IslandSolver::kExact) {
+    if (links >= kColouredIsland && s.reports[i].solver != IslandSolver::kExact &&
+        s.reports[i].joints == 0) {
       colour_manifolds(std::span(s.islands.links).subspan(s.islands.link_begin[i], links),
                        s.colours, &s.colouring_scratch, &s.colouring);
       s.team_islands.push_back(static_cast<std::uint32_t>(i));

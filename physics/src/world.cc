@@ -203,6 +203,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
 
 Status World::remove_body(BodyId id) {
   if (!contains(id)) return Status::not_found("body: no body with this id");
+  remove_joints_of(id.index);
   Slot& slot = bodies_[id.index];
   wake_around(slot.body);                                     // whatever rested on it must fall
   if (slot.body.asleep) wake_island(slot.body.sleep_island);  // it leaves its island's set
@@ -579,7 +580,10 @@ void World::compute_bounds(double dt) {
       const Vec3 travel = body.linear_velocity * dt;
       const double motion = travel.norm() + unsure;
       const double swept_beyond = solver.continuous_fraction * body.shape.inner_radius();
-      if (solver.continuous && motion > swept_beyond) {
+      // A jointed body is not swept: stopping it at its first impact after the solve would tear
+      // its joints. Its speculative contacts reach its whole motion instead.
+      const bool jointed = i < joints_of_body_.size() && joints_of_body_[i] > 0;
+      if (solver.continuous && motion > swept_beyond && !jointed) {
         fast_[i] = 1;
       }
       speculative_[i] = fast_[i] ? swept_beyond : motion;
@@ -683,6 +687,8 @@ void World::find_contacts(double dt) {
           previous = kNoRecord;  // the slot now holds another body
         s.found_previous[i] = previous;
         s.found_flags[i] = 0;
+        // Bodies a joint holds together do not collide unless it says so.
+        if (!unjoined_pairs_.empty() && unjoined(pairs_[i].a, pairs_[i].b)) return 0u;
         const Pose pose_a = a.pose(), pose_b = b.pose();
         CollisionSettings settings = settings_.collision;
         const bool fast = fast_[pairs_[i].a] || fast_[pairs_[i].b];

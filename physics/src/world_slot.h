@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "body_state.h"
+#include "joint_state.h"
 #include "physics/world.h"
 
 namespace tumble {

@@ -12,6 +12,7 @@
 #include "physics/body.h"
 #include "physics/body_view.h"
 #include "physics/collision.h"
+#include "physics/joint.h"
 #include "physics/limits.h"
 #include "physics/math.h"
 #include "physics/status.h"
@@ -64,6 +65,7 @@ struct ImpulseAt {
 };
 
 struct StepScratch;
+struct JointSlot;
 
 // What happened to a body since the world's events were last cleared (World::body_events): the
 // bits of BodyEvent::flags.
@@ -117,6 +119,18 @@ class World {
   // those before it on the same body, so the velocities the body ends with are within the limits.
   // The message names the entry ("[3].impulse: ...").
   Status apply_impulses(std::span<const ImpulseAt> impulses);
+
+  // Joints (joint.h) between two bodies of this world, or a body and the world: made from a
+  // definition in world coordinates at the bodies' present poses, or refused naming the field
+  // ("b: no body with this id"). Both bodies wake. Removing a body removes its joints.
+  static constexpr std::size_t kMaxJoints = 1 << 20;
+  Result<JointId> create_joint(const JointDef& def);
+  Status remove_joint(JointId id);
+  bool contains(JointId id) const;
+  std::size_t joint_count() const { return joint_count_; }
+  // How far the joint is from holding at the bodies' present poses: m for its anchors (or its
+  // length), rad for its axes or rotation, whichever is larger.
+  Result<double> joint_error(JointId id) const;
 
   // The whole state (settings apart: settings()) as bytes in the engine's own versioned format
   // (docs/STATE_FORMAT.md): a world made from them steps on exactly as this one would, bit for bit.
@@ -198,6 +212,21 @@ class World {
   friend struct WorldInternals;  // the engine's own state encoding and tests (physics/src)
   static constexpr std::uint32_t kNoSlot = UINT32_MAX;
   struct Slot;  // a body and its slot's generation (physics/src/world_slot.h)
+  // Joints by slot (physics/src/joint_state.h), as bodies are kept.
+  std::vector<JointSlot> joints_;
+  std::vector<std::uint32_t> free_joint_slots_;
+  std::size_t joint_count_ = 0;
+  std::vector<std::uint32_t> joints_of_body_;  // per body slot
+  // The body pairs whose joints keep them from colliding (low slot << 32 | high slot), sorted,
+  // once per joint: the narrow phase skips them.
+  std::vector<std::uint64_t> unjoined_pairs_;
+  void remove_joints_of(std::uint32_t body_slot);
+  bool unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const;
+  // Sleepers joined to moving bodies wake with their islands; returns how many woke.
+  std::uint32_t wake_jointed();
+  // The step's joints: rows for those with a moving body, their links into islands.
+  void prepare_joint_rows();
+  void store_joint_impulses();
   std::uint32_t wake_island(std::uint32_t island);
   // Links the bodies that fall asleep together into their island's set (sleepers_).
   void link_sleeper(std::uint32_t slot, std::uint32_t island);

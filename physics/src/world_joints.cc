@@ -1,0 +1,172 @@
+// The world's joints: made, removed, checked, and handed to the step (joint_solver.h solves them
+// with the contacts of their islands).
+#include <algorithm>
+
+#include "joint_solver.h"
+#include "joint_state.h"
+#include "physics/world.h"
+#include "step_scratch.h"
+#include "world_slot.h"
+
+namespace tumble {
+namespace {
+
+std::uint64_t pair_key(std::uint32_t x, std::uint32_t y) {
+  return (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
+}
+
+}  // namespace
+
+Result<JointId> World::create_joint(const JointDef& def) {
+  if (Status valid = validate(def); !valid) return valid;
+  if (!contains(def.a)) return Status::not_found("a: no body with this id");
+  const bool world_b = !def.b.is_valid();
+  if (!world_b && !contains(def.b)) return Status::not_found("b: no body with this id");
+  const Body& a = bodies_[def.a.index].body;
+  const Body* b = world_b ? nullptr : &bodies_[def.b.index].body;
+  if (a.is_static() && (b == nullptr || b->is_static()))
+    return Status::error("a: a joint needs a dynamic body on one side");
+  if (joint_count_ >= kMaxJoints)
+    return Status::error("joints: the world holds " + std::to_string(kMaxJoints) +
+                         " joints, the most it takes");
+
+  Joint joint;
+  joint.kind = def.kind;
+  joint.a = def.a.index;
+  joint.b = world_b ? kWorldAnchor : def.b.index;
+  joint.collide_connected = def.collide_connected;
+  const Vec3 end_b = def.kind == JointKind::kDistance ? def.anchor_b : def.anchor;
+  const Vec3 axis = def.kind == JointKind::kHinge ? def.axis.normalized() : Vec3::UnitZ();
+  const Quat qa_inverse = a.orientation.conjugate();
+  joint.local_a = qa_inverse * (def.anchor - a.position);
+  joint.axis_a = qa_inverse * axis;
+  if (world_b) {
+    joint.local_b = end_b;
+    joint.axis_b = axis;
+    joint.relative = qa_inverse;
+  } else {
+    const Quat qb_inverse = b->orientation.conjugate();
+    joint.local_b = qb_inverse * (end_b - b->position);
+    joint.axis_b = qb_inverse * axis;
+    joint.relative = qa_inverse * b->orientation;
+  }
+  joint.length = def.length > 0 ? def.length : (def.anchor_b - def.anchor).norm();
+
+  std::uint32_t index;
+  if (!free_joint_slots_.empty()) {
+    index = free_joint_slots_.back();
+    free_joint_slots_.pop_back();
+  } else {
+    index = static_cast<std::uint32_t>(joints_.size());
+    joints_.emplace_back();
+  }
+  JointSlot& slot = joints_[index];
+  slot.joint = joint;
+  slot.alive = true;
+  ++joint_count_;
+  if (joints_of_body_.size() < bodies_.size()) joints_of_body_.resize(bodies_.size(), 0);
+  ++joints_of_body_[joint.a];
+  if (!world_b) ++joints_of_body_[joint.b];
+  if (!world_b && !joint.collide_connected) {
+    const std::uint64_t key = pair_key(joint.a, joint.b);
+    unjoined_pairs_.insert(std::upper_bound(unjoined_pairs_.begin(), unjoined_pairs_.end(), key),
+                           key);
+  }
+  for (std::uint32_t body : {joint.a, joint.b})
+    if (body != kWorldAnchor && bodies_[body].body.asleep)
+      wake_island(bodies_[body].body.sleep_island);
+  return JointId{index, slot.generation};
+}
+
+bool World::contains(JointId id) const {
+  return id.index < joints_.size() && joints_[id.index].alive &&
+         joints_[id.index].generation == id.generation;
+}
+
+Status World::remove_joint(JointId id) {
+  if (!contains(id)) return Status::not_found("joint: no joint with this id");
+  JointSlot& slot = joints_[id.index];
+  const Joint& joint = slot.joint;
+  for (std::uint32_t body : {joint.a, joint.b}) {
+    if (body == kWorldAnchor) continue;
+    --joints_of_body_[body];
+    if (bodies_[body].body.asleep) wake_island(bodies_[body].body.sleep_island);
+  }
+  if (joint.b != kWorldAnchor && !joint.collide_connected) {
+    const auto at = std::lower_bound(unjoined_pairs_.begin(), unjoined_pairs_.end(),
+                                     pair_key(joint.a, joint.b));
+    TUMBLE_ASSERT(at != unjoined_pairs_.end() && *at == pair_key(joint.a, joint.b));
+    unjoined_pairs_.erase(at);
+  }
+  slot.alive = false;
+  ++slot.generation;
+  slot.joint = Joint();
+  free_joint_slots_.push_back(id.index);
+  --joint_count_;
+  return Status::ok();
+}
+
+Result<double> World::joint_error(JointId id) const {
+  if (!contains(id)) return Status::not_found("joint: no joint with this id");
+  const Joint& joint = joints_[id.index].joint;
+  const Pose pose_b = joint.b == kWorldAnchor ? Pose{} : bodies_[joint.b].body.pose();
+  return tumble::joint_error(joint, bodies_[joint.a].body.pose(), pose_b);
+}
+
+void World::remove_joints_of(std::uint32_t body_slot) {
+  if (body_slot >= joints_of_body_.size() || joints_of_body_[body_slot] == 0) return;
+  for (std::uint32_t index = 0; index < joints_.size(); ++index) {
+    const JointSlot& slot = joints_[index];
+    if (slot.alive && (slot.joint.a == body_slot || slot.joint.b == body_slot))
+      remove_joint({index, slot.generation});
+  }
+}
+
+bool World::unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const {
+  return std::binary_search(unjoined_pairs_.begin(), unjoined_pairs_.end(),
+                            pair_key(slot_a, slot_b));
+}
+
+std::uint32_t World::wake_jointed() {
+  if (joint_count_ == 0 || sleeping_count_ == 0) return 0;
+  std::uint32_t woken = 0;
+  for (const JointSlot& slot : joints_) {
+    if (!slot.alive || slot.joint.b == kWorldAnchor) continue;
+    const Body& a = bodies_[slot.joint.a].body;
+    const Body& b = bodies_[slot.joint.b].body;
+    if (a.is_moving() && b.asleep) woken += wake_island(b.sleep_island);
+    if (b.is_moving() && a.asleep) woken += wake_island(a.sleep_island);
+  }
+  return woken;
+}
+
+void World::prepare_joint_rows() {
+  StepScratch& s = *scratch_;
+  s.joint_rows.clear();
+  s.joint_links.clear();
+  if (joint_count_ == 0) return;
+  for (std::uint32_t index = 0; index < joints_.size(); ++index) {
+    const JointSlot& slot = joints_[index];
+    if (!slot.alive) continue;
+    const std::uint32_t a = s.solver_of_slot[slot.joint.a];
+    const std::uint32_t b =
+        slot.joint.b == kWorldAnchor ? kWorldAnchor : s.solver_of_slot[slot.joint.b];
+    const bool moves_a = a != kNoSolverBody && a < s.moving;
+    const bool moves_b = b != kWorldAnchor && b != kNoSolverBody && b < s.moving;
+    if (!moves_a && !moves_b) continue;  // asleep, or both static
+    TUMBLE_ASSERT(a != kNoSolverBody && b != kNoSolverBody);
+    s.joint_rows.push_back({slot.joint, a, b, index});
+    s.joint_links.push_back({a, b == kWorldAnchor ? a : b});
+  }
+}
+
+void World::store_joint_impulses() {
+  for (const JointRow& row : scratch_->joint_rows) {
+    Joint& joint = joints_[row.slot].joint;
+    joint.linear_impulse = row.joint.linear_impulse;
+    joint.angular_impulse = row.joint.angular_impulse;
+    joint.axial_impulse = row.joint.axial_impulse;
+  }
+}
+
+}  // namespace tumble

@@ -1,0 +1,395 @@
+// Joints: each kind holds what it should while the bodies swing, against closed-form answers
+// where there is one (a pendulum's period); definitions refused naming the field; removed with
+// their bodies; jointed bodies kept from colliding; the same bits for any thread count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include "physics/world.h"
+
+namespace tumble {
+namespace {
+
+constexpr double kDt = 1.0 / 60;
+
+BodyId add_sphere(World& world, const Vec3& at, double radius = 0.05, double mass = 1) {
+  BodyDef def;
+  def.shape = SphereDef{radius};
+  def.position = at;
+  def.mass = mass;
+  return world.create_body(def).value();
+}
+
+BodyId add_box(World& world, const Vec3& at, const Vec3& half_extents, double mass = 1) {
+  BodyDef def;
+  def.shape = BoxDef{half_extents};
+  def.position = at;
+  def.mass = mass;
+  return world.create_body(def).value();
+}
+
+// The complete elliptic integral of the first kind, K(k), by the arithmetic-geometric mean.
+double elliptic_k(double k) {
+  double a = 1, b = std::sqrt(1 - k * k);
+  for (int i = 0; i < 60 && std::abs(a - b) > 1e-16 * a; ++i) {
+    const double mean = (a + b) / 2;
+    b = std::sqrt(a * b);
+    a = mean;
+  }
+  return std::numbers::pi / (2 * a);
+}
+
+// A bob on a massless rod of length L from a fixed pivot, released at rest at `degrees` from the
+// bottom: the mean of its measured periods (upward crossings of the bottom, interpolated) over
+// `seconds`.
+double pendulum_period(JointKind kind, double degrees, double length, double seconds) {
+  World world;
+  const double angle = degrees * std::numbers::pi / 180;
+  const Vec3 pivot(0, 0, 10);
+  const Vec3 bob_at = pivot + length * Vec3(std::sin(angle), 0, -std::cos(angle));
+  const BodyId bob = add_sphere(world, bob_at);
+  JointDef def;
+  def.kind = kind;
+  def.a = bob;
+  if (kind == JointKind::kDistance) {
+    def.anchor = bob_at;  // the rod ends at the bob's centre: the bob turns freely
+    def.anchor_b = pivot;
+  } else {
+    def.anchor = pivot;
+  }
+  EXPECT_TRUE(world.create_joint(def));
+  std::vector<double> crossings;
+  double last_x = world.body(bob).position().x();
+  double time = 0;
+  for (int step = 0; step < static_cast<int>(seconds / kDt); ++step) {
+    EXPECT_TRUE(world.step(kDt));
+    time += kDt;
+    const double x = world.body(bob).position().x();
+    if (last_x < 0 && x >= 0) crossings.push_back(time - kDt * x / (x - last_x));
+    last_x = x;
+  }
+  if (crossings.size() < 2) return 0;
+  return (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+}
+
+// The simple pendulum's exact period, 4 sqrt(L/g) K(sin(theta0 / 2)).
+double exact_period(double degrees, double length) {
+  const double k = std::sin(degrees * std::numbers::pi / 360);
+  return 4 * std::sqrt(length / 9.81) * elliptic_k(k);
+}
+
+TEST(Joints, DistanceJointPendulumKeepsTheExactPeriod) {
+  for (double degrees : {10.0, 90.0, 170.0}) {
+    const double exact = exact_period(degrees, 1.0);
+    const double measured = pendulum_period(JointKind::kDistance, degrees, 1.0, 30);
+    SCOPED_TRACE(degrees);
+    // dt 1/60 in four substeps: the symplectic step's error in the period is of order
+    // (omega h)^2 = 2e-4 of it; 1e-3 leaves room for the joint's spring.
+    EXPECT_NEAR(measured / exact, 1, 1e-3) << "measured " << measured << " s, exact " << exact;
+  }
+}
+
+TEST(Joints, BallJointHoldsItsAnchorWhileTheBobSwings) {
+  World world;
+  const Vec3 pivot(0, 0, 10);
+  const BodyId bob = add_box(world, pivot + Vec3(0.7, 0, -0.7), Vec3(0.1, 0.1, 0.1));
+  JointDef def;
+  def.kind = JointKind::kBall;
+  def.a = bob;
+  def.anchor = pivot;
+  const JointId joint = world.create_joint(def).value();
+  double worst = 0;
+  for (int step = 0; step < 600; ++step) {
+    ASSERT_TRUE(world.step(kDt));
+    worst = std::max(worst, world.joint_error(joint).value());
+  }
+  EXPECT_LT(worst, 1e-3);  // m
+  // It swung: the bob is not where it started, and its distance from the pivot is the rod's.
+  EXPECT_NEAR((world.body(bob).position() - pivot).norm(), 0.7 * std::sqrt(2.0), 1e-3);
+}
+
+TEST(Joints, HingeTurnsAboutItsAxisAlone) {
+  WorldSettings settings;
+  settings.gravity = Vec3::Zero();
+  World world(settings);
+  // A door: a slab hinged to the world along z at its edge, spun about x and z at once.
+  const BodyId door = add_box(world, Vec3(0.5, 0, 1), Vec3(0.5, 0.05, 1), 20);
+  JointDef def;
+  def.kind = JointKind::kHinge;
+  def.a = door;
+  def.anchor = Vec3(0, 0, 1);
+  def.axis = Vec3::UnitZ();
+  const JointId hinge = world.create_joint(def).value();
+  BodyMotion motion;
+  motion.angular_velocity = Vec3(2, 0, 1);
+  ASSERT_TRUE(world.set_motion(door, motion));
+  double worst = 0;
+  for (int step = 0; step < 240; ++step) {
+    ASSERT_TRUE(world.step(kDt));
+    worst = std::max(worst, world.joint_error(hinge).value());
+  }
+  EXPECT_LT(worst, 1e-3);
+  const Vec3 w = world.body(door).angular_velocity();
+  EXPECT_LT(std::hypot(w.x(), w.y()), 1e-3);  // the turn about x is gone
+  EXPECT_GT(std::abs(w.z()), 0.2);            // the turn about z is kept
+}
+
+TEST(Joints, FixedJointHoldsABodyInTheAirAndTwoBodiesTogether) {
+  World world;
+  const BodyId shelf = add_box(world, Vec3(1, 0, 2), Vec3(0.5, 0.2, 0.05), 5);
+  const BodyId cup = add_box(world, Vec3(1.3, 0, 2.15), Vec3(0.1, 0.1, 0.1), 1);
+  JointDef wall;
+  wall.kind = JointKind::kFixed;
+  wall.a = shelf;
+  wall.anchor = Vec3(0.5, 0, 2);
+  const JointId to_wall = world.create_joint(wall).value();
+  JointDef glue;
+  glue.kind = JointKind::kFixed;
+  glue.a = shelf;
+  glue.b = cup;
+  glue.anchor = Vec3(1.3, 0, 2.1);
+  const JointId glued = world.create_joint(glue).value();
+  for (int step = 0; step < 300; ++step)
+    ASSERT_TRUE(world.step(kDt));
+  EXPECT_LT(world.joint_error(to_wall).value(), 1e-3);
+  EXPECT_LT(world.joint_error(glued).value(), 1e-3);
+  EXPECT_NEAR(world.body(cup).position().z(), 2.15, 2e-3);
+  EXPECT_LT(world.body(cup).linear_velocity().norm(), 1e-3);
+}
+
+TEST(Joints, AChainOfTenHangsAtItsLength) {
+  World world;
+  std::vector<BodyId> links;
+  std::vector<JointId> joints;
+  const Vec3 top(0, 0, 12);
+  for (int i = 0; i < 10; ++i) {
+    // Links 0.2 m long, laid out sideways so that the chain swings down.
+    links.push_back(add_box(world, top + Vec3(0.2 * i + 0.1, 0, 0), Vec3(0.1, 0.02, 0.02), 0.5));
+    JointDef def;
+    def.kind = JointKind::kBall;
+    def.a = links.back();
+    if (i > 0) def.b = links[i - 1];
+    def.anchor = top + Vec3(0.2 * i, 0, 0);
+    joints.push_back(world.create_joint(def).value());
+  }
+  double worst = 0;
+  for (int step = 0; step < 600; ++step) {
+    ASSERT_TRUE(world.step(kDt));
+    for (JointId joint : joints)
+      worst = std::max(worst, world.joint_error(joint).value());
+  }
+  // The chain whips and folds, its links hitting each other at 8 m/s: its joints hold within
+  // a millimetre.
+  EXPECT_LT(worst, 1e-3);
+  // Every link within the chain's length of the top: no joint came apart.
+  for (BodyId link : links)
+    EXPECT_LT((world.body(link).position() - top).norm(), 2.0);
+}
+
+TEST(Joints, DefinitionsAreRefusedNamingTheField) {
+  World world;
+  const BodyId box = add_box(world, Vec3(0, 0, 1), Vec3::Constant(0.5));
+  BodyDef ground_def;
+  ground_def.type = BodyType::kStatic;
+  ground_def.shape = BoxDef{Vec3(5, 5, 0.5)};
+  const BodyId ground = world.create_body(ground_def).value();
+  auto message = [&](JointDef def) {
+    const Result<JointId> made = world.create_joint(def);
+    EXPECT_FALSE(made);
+    return made ? std::string() : made.status().message();
+  };
+  JointDef def;
+  def.a = box;
+  EXPECT_EQ(message([&] {
+              JointDef d = def;
+              d.a = BodyId{};
+              return d;
+            }()),
+            "a: must name a body");
+  EXPECT_EQ(message([&] {
+              JointDef d = def;
+              d.b = box;
+              return d;
+            }()),
+            "b: must differ from a");
+  EXPECT_EQ(message([&] {
+              JointDef d = def;
+              d.anchor.x() = std::numeric_limits<double>::quiet_NaN();
+              return d;
+            }()),
+            "anchor: must be finite");
+  EXPECT_EQ(message([&] {
+              JointDef d = def;
+              d.kind = JointKind::kHinge;
+              d.axis = Vec3::Zero();
+              return d;
+            }()),
+            "axis: must not be zero");
+  EXPECT_EQ(message([&] {
+              JointDef d = def;
+              d.kind = JointKind::kDistance;
+              return d;
+            }()),
+            "length: the anchors coincide; give a length or separate them");
+  EXPECT_EQ(message([&] {
+              JointDef d = def;
+              d.b = BodyId{77, 0};
+              return d;
+            }()),
+            "b: no body with this id");
+  EXPECT_EQ(message([&] {
+              JointDef d = def;
+              d.a = ground;
+              return d;
+            }()),
+            "a: a joint needs a dynamic body on one side");
+  EXPECT_EQ(world.joint_count(), 0u);
+}
+
+TEST(Joints, RemovingABodyRemovesItsJointsAndStaleIdsFail) {
+  World world;
+  const BodyId a = add_box(world, Vec3(0, 0, 5), Vec3::Constant(0.2));
+  const BodyId b = add_box(world, Vec3(1, 0, 5), Vec3::Constant(0.2));
+  const BodyId c = add_box(world, Vec3(2, 0, 5), Vec3::Constant(0.2));
+  JointDef def;
+  def.kind = JointKind::kBall;
+  def.a = a;
+  def.b = b;
+  def.anchor = Vec3(0.5, 0, 5);
+  const JointId ab = world.create_joint(def).value();
+  def.a = b;
+  def.b = c;
+  def.anchor = Vec3(1.5, 0, 5);
+  const JointId bc = world.create_joint(def).value();
+  EXPECT_EQ(world.joint_count(), 2u);
+  ASSERT_TRUE(world.remove_body(b));
+  EXPECT_EQ(world.joint_count(), 0u);
+  EXPECT_FALSE(world.contains(ab));
+  EXPECT_FALSE(world.contains(bc));
+  EXPECT_FALSE(world.remove_joint(ab));
+  // The slot is reused under a new generation; the old id stays dead.
+  def.a = a;
+  def.b = c;
+  def.anchor = Vec3(1, 0, 5);
+  const JointId ac = world.create_joint(def).value();
+  EXPECT_TRUE(world.contains(ac));
+  EXPECT_FALSE(world.contains(ab.index == ac.index ? ab : bc));
+  ASSERT_TRUE(world.remove_joint(ac));
+  EXPECT_EQ(world.remove_joint(ac).message(), "joint: no joint with this id");
+  for (int step = 0; step < 10; ++step)
+    ASSERT_TRUE(world.step(kDt));
+}
+
+// A pendulum of two links at rest falls asleep as one island; a push on the lower link wakes the
+// upper one too, and a joint made to a sleeper wakes it.
+TEST(Joints, JointedBodiesSleepAndWakeTogether) {
+  struct Pendulum {
+    World world;
+    BodyId upper, lower;
+  };
+  // Asleep after at most two seconds (it starts at rest).
+  auto asleep_pendulum = [] {
+    auto pendulum = std::make_unique<Pendulum>();
+    World& world = pendulum->world;
+    pendulum->upper = add_box(world, Vec3(0, 0, 9.5), Vec3(0.05, 0.05, 0.5));
+    pendulum->lower = add_box(world, Vec3(0, 0, 8.5), Vec3(0.05, 0.05, 0.5));
+    JointDef def;
+    def.kind = JointKind::kBall;
+    def.a = pendulum->upper;
+    def.anchor = Vec3(0, 0, 10);
+    EXPECT_TRUE(world.create_joint(def));
+    def.a = pendulum->lower;
+    def.b = pendulum->upper;
+    def.anchor = Vec3(0, 0, 9);
+    EXPECT_TRUE(world.create_joint(def));
+    for (int step = 0; step < 120 && !world.body(pendulum->upper).asleep(); ++step)
+      EXPECT_TRUE(world.step(kDt));
+    EXPECT_TRUE(world.body(pendulum->upper).asleep());
+    EXPECT_TRUE(world.body(pendulum->lower).asleep());
+    return pendulum;
+  };
+  {
+    auto pendulum = asleep_pendulum();
+    World& world = pendulum->world;
+    ASSERT_TRUE(world.apply_impulse(pendulum->lower, Vec3(0.5, 0, 0), nullptr));
+    EXPECT_FALSE(world.body(pendulum->upper).asleep());
+    ASSERT_TRUE(world.step(kDt));
+    EXPECT_GT(world.body(pendulum->upper).angular_velocity().norm(), 0.01);  // the push reached it
+  }
+  {
+    auto pendulum = asleep_pendulum();
+    World& world = pendulum->world;
+    const BodyId ball = add_sphere(world, Vec3(1, 0, 8));
+    JointDef def;
+    def.kind = JointKind::kBall;
+    def.a = ball;
+    def.b = pendulum->lower;
+    def.anchor = Vec3(0.5, 0, 8);
+    ASSERT_TRUE(world.create_joint(def));
+    EXPECT_FALSE(world.body(pendulum->lower).asleep());
+    EXPECT_FALSE(world.body(pendulum->upper).asleep());
+    ASSERT_TRUE(world.step(kDt));
+    EXPECT_GT(world.body(pendulum->upper).linear_velocity().norm(), 0.0);  // the ball pulls it
+  }
+}
+
+// Two boxes that overlap where a joint holds them: no contact between them, unless the joint
+// says they collide.
+TEST(Joints, JointedBodiesDoNotCollideUnlessTheJointSaysSo) {
+  for (bool collide : {false, true}) {
+    WorldSettings settings;
+    settings.gravity = Vec3::Zero();
+    World world(settings);
+    const BodyId a = add_box(world, Vec3(0, 0, 5), Vec3::Constant(0.5));
+    const BodyId b = add_box(world, Vec3(0.8, 0, 5), Vec3::Constant(0.5));
+    JointDef def;
+    def.kind = JointKind::kFixed;
+    def.a = a;
+    def.b = b;
+    def.anchor = Vec3(0.4, 0, 5);
+    def.collide_connected = collide;
+    ASSERT_TRUE(world.create_joint(def));
+    ASSERT_TRUE(world.step(kDt));
+    EXPECT_EQ(world.contacts().size(), collide ? 1u : 0u) << collide;
+  }
+}
+
+// A chain swinging against a pile of boxes: the same bits on 1, 2 and 4 threads.
+TEST(Joints, SameBitsForAnyThreadCount) {
+  auto run = [](int threads) {
+    WorldSettings settings;
+    settings.threads = threads;
+    World world(settings);
+    BodyDef ground;
+    ground.type = BodyType::kStatic;
+    ground.shape = HalfSpaceDef{};
+    world.create_body(ground).value();
+    for (int i = 0; i < 200; ++i)
+      add_box(world, Vec3(0.3 * (i % 10) - 1.5, 0.3 * ((i / 10) % 4), 0.15 + 0.3 * (i / 40)),
+              Vec3::Constant(0.14));
+    BodyId last;
+    for (int i = 0; i < 12; ++i) {
+      const BodyId link =
+          add_box(world, Vec3(-2 + 0.25 * i + 0.125, 0.5, 3), Vec3(0.125, 0.03, 0.03));
+      JointDef def;
+      def.kind = JointKind::kBall;
+      def.a = link;
+      def.b = last;
+      def.anchor = Vec3(-2 + 0.25 * i, 0.5, 3);
+      world.create_joint(def).value();
+      last = link;
+    }
+    for (int step = 0; step < 120; ++step)
+      EXPECT_TRUE(world.step(kDt));
+    return world.save_state();
+  };
+  const std::string one = run(1);
+  EXPECT_EQ(run(2), one);
+  EXPECT_EQ(run(4), one);
+}
+
+}  // namespace
+}  // namespace tumble
