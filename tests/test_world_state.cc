@@ -326,6 +326,129 @@ TEST(StateFormat, DamagedBytesAreRefusedOrStepSafely) {
   EXPECT_GT(accepted, 0);  // some flips land on values still valid (a velocity's low bits)
 }
 
+// The busy world with a chain of every joint kind hanging from the world beside it, swinging,
+// and one joint removed (a free joint slot to reuse).
+World jointed_world() {
+  World world = busy_world();
+  BodyDef link;
+  link.shape = BoxDef{Vec3(0.2, 0.05, 0.05)};
+  BodyId last;
+  const JointKind kinds[] = {JointKind::kBall, JointKind::kHinge, JointKind::kFixed,
+                             JointKind::kDistance, JointKind::kBall};
+  for (int i = 0; i < 5; ++i) {
+    link.position = Vec3(6 + 0.4 * i + 0.2, 0, 5);
+    const BodyId body = world.create_body(link).value();
+    JointDef def;
+    def.kind = kinds[i];
+    def.a = body;
+    def.b = last;
+    def.anchor = Vec3(6 + 0.4 * i, 0, 5);
+    def.anchor_b = def.anchor - Vec3(0.1, 0, 0);  // a distance joint's rod, 0.1 m
+    def.axis = Vec3(0, 1, 0);
+    EXPECT_TRUE(world.create_joint(def));
+    last = body;
+  }
+  JointDef extra;
+  extra.a = last;
+  extra.anchor = Vec3(8, 0, 5);
+  const JointId removed = world.create_joint(extra).value();
+  EXPECT_TRUE(world.remove_joint(removed));
+  run(world, kDt, 30);
+  return world;
+}
+
+TEST(WorldState, JointsAndTheirImpulsesRoundTripBitForBit) {
+  World original = jointed_world();
+  const std::string saved = original.save_state();
+  const WorldStateData data = data_of(original);
+  ASSERT_EQ(data.joints.size(), 6u);
+  ASSERT_EQ(data.free_joints.size(), 1u);
+  Result<World> restored = World::from_state(original.settings(), saved);
+  ASSERT_TRUE(restored) << restored.error();
+  EXPECT_EQ(restored.value().joint_count(), 5u);
+  EXPECT_EQ(restored.value().save_state(), saved);
+  run(original, kDt, 90);
+  run(restored.value(), kDt, 90);
+  EXPECT_EQ(restored.value().save_state(), original.save_state());
+  // Without the warm start's impulses the run differs: the test above would see them lost.
+  WorldStateData cold = data;
+  for (JointSlot& slot : cold.joints)
+    slot.joint.linear_impulse.setZero();
+  Result<World> without = world_of(original.settings(), cold);
+  ASSERT_TRUE(without) << without.error();
+  run(without.value(), kDt, 90);
+  EXPECT_NE(without.value().save_state(), original.save_state());
+}
+
+TEST(WorldState, BadJointsAreRefusedNamingTheField) {
+  const World original = jointed_world();
+  const WorldStateData good = data_of(original);
+  auto refused = [&](const WorldStateData& state, const std::string& field) {
+    Result<World> world = world_of(original.settings(), state);
+    ASSERT_FALSE(world) << field;
+    EXPECT_NE(world.error().find(field), std::string::npos) << world.error();
+  };
+  WorldStateData s = good;
+  s.joints[0].joint.a = static_cast<std::uint32_t>(s.slots.size());  // no such body
+  refused(s, "joints[0].a");
+  s = good;
+  s.slots.push_back({});  // a dead slot, free
+  s.free_slots.push_back(static_cast<std::uint32_t>(s.slots.size() - 1));
+  s.joints[0].joint.a = static_cast<std::uint32_t>(s.slots.size() - 1);
+  refused(s, "joints[0].a");
+  s = good;
+  s.joints[1].joint.b = 100000;
+  refused(s, "joints[1].b");
+  s = good;
+  s.joints[1].joint.axis_a *= 2;
+  refused(s, "joints[1].axis_a");
+  s = good;
+  s.joints[2].joint.relative.coeffs() *= 3;
+  refused(s, "joints[2].relative");
+  s = good;
+  s.joints[3].joint.length = 0;
+  refused(s, "joints[3].length");
+  s = good;
+  s.joints[4].joint.linear_impulse.x() = std::nan("");
+  refused(s, "joints[4].impulses");
+  s = good;
+  s.free_joints.clear();
+  refused(s, "free_joints");
+  s = good;
+  s.free_joints[0] = 0;  // a live joint
+  refused(s, "free_joints[0]");
+  s = good;
+  s.joints[0].joint.b = s.joints[0].joint.a;
+  refused(s, "joints[0].b");
+}
+
+TEST(StateFormat, DamagedJointBytesAreRefusedOrStepSafely) {
+  const World world = jointed_world();
+  const std::string good = world.save_state();
+  // The joints' section ends the bytes (six slots of at most 207 bytes): damage falls there.
+  const std::size_t joints_from = good.size() - 6 * 180;
+  std::mt19937_64 random(33);
+  int refused = 0, accepted = 0;
+  for (int round = 0; round < 300; ++round) {
+    std::string bytes = good;
+    const int flips = 1 + static_cast<int>(random() % 4);
+    for (int k = 0; k < flips; ++k) {
+      const std::size_t at = joints_from + random() % (bytes.size() - joints_from);
+      bytes[at] = static_cast<char>(random());
+    }
+    Result<World> restored = World::from_state(world.settings(), bytes);
+    if (!restored) {
+      EXPECT_FALSE(restored.error().empty());
+      ++refused;
+      continue;
+    }
+    ++accepted;
+    for (int step = 0; step < 5; ++step)
+      ASSERT_TRUE(restored.value().step(kDt));
+  }
+  EXPECT_GT(refused, 50);
+}
+
 // Issue 31 (8): a restored hull must be the hull its vertices make, not whatever was stored.
 // Each damage is made in the bytes of a world holding one hull, at the place the format puts it.
 TEST(StateFormat, ARestoredHullMustBeTheHullItsVerticesMake) {

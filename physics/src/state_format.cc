@@ -265,9 +265,50 @@ Status take_pair(Reader& r, ContactPairRecord* p) {
   return r.status();
 }
 
+void put_joint(Writer& w, const Joint& j) {
+  w.put(static_cast<std::uint8_t>(j.kind));
+  w.put(j.a);
+  w.put(j.b);
+  w.put(j.local_a);
+  w.put(j.local_b);
+  w.put(j.axis_a);
+  w.put(j.axis_b);
+  w.put(j.relative);
+  w.put(j.length);
+  w.put(static_cast<std::uint8_t>(j.collide_connected));
+  w.put(j.linear_impulse);
+  w.put(j.angular_impulse);
+  w.put(j.axial_impulse);
+}
+
+Status take_joint(Reader& r, Joint* j) {
+  const auto kind = r.take<std::uint8_t>("kind");
+  if (r.ok() && kind > static_cast<std::uint8_t>(JointKind::kDistance))
+    return Status::error("kind: unknown joint kind " + std::to_string(kind));
+  j->kind = static_cast<JointKind>(kind);
+  j->a = r.take<std::uint32_t>("a");
+  j->b = r.take<std::uint32_t>("b");
+  j->local_a = r.vec3("local_a");
+  j->local_b = r.vec3("local_b");
+  j->axis_a = r.vec3("axis_a");
+  j->axis_b = r.vec3("axis_b");
+  j->relative = r.quat("relative");
+  j->length = r.take<double>("length");
+  j->collide_connected = take_flag(r, "collide_connected");
+  j->linear_impulse = r.vec3("linear_impulse");
+  j->angular_impulse = r.vec3("angular_impulse");
+  j->axial_impulse = r.take<double>("axial_impulse");
+  return r.status();  // the values are checked with the whole state (world_from)
+}
+
+// Header flags: a joints section follows the contact pairs.
+constexpr std::uint32_t kStateHasJoints = 1;
+constexpr std::size_t kFlagsOffset = 36;  // magic 8, version 4, header 4, length 8, counts 12
+
 // The least bytes of one entry, so that counts are checked against what is left.
 constexpr std::size_t kLeastSlotBytes = 5;   // generation, alive
 constexpr std::size_t kLeastPairBytes = 83;  // ids, pose, feature, colour, count
+constexpr std::size_t kLeastJointSlotBytes = 5;  // generation, alive
 
 }  // namespace
 
@@ -283,7 +324,7 @@ std::string encode_state(const WorldStateData& state) {
   w.put(static_cast<std::uint32_t>(state.slots.size()));
   w.put(static_cast<std::uint32_t>(state.free_slots.size()));
   w.put(static_cast<std::uint32_t>(state.contact_pairs.size()));
-  w.put(static_cast<std::uint32_t>(0));  // flags: none yet
+  w.put(state.joints.empty() ? std::uint32_t{0} : kStateHasJoints);
   w.put(state.time);
   w.put(state.step);
   for (const BodySlotState& slot : state.slots) {
@@ -295,6 +336,17 @@ std::string encode_state(const WorldStateData& state) {
     w.put(slot);
   for (const ContactPairRecord& pair : state.contact_pairs)
     put_pair(w, pair);
+  if (!state.joints.empty()) {
+    w.put(static_cast<std::uint32_t>(state.joints.size()));
+    w.put(static_cast<std::uint32_t>(state.free_joints.size()));
+    for (const JointSlot& slot : state.joints) {
+      w.put(slot.generation);
+      w.put(static_cast<std::uint8_t>(slot.alive));
+      if (slot.alive) put_joint(w, slot.joint);
+    }
+    for (std::uint32_t slot : state.free_joints)
+      w.put(slot);
+  }
   const std::uint64_t length = out.size();
   std::memcpy(out.data() + length_at, &length, sizeof length);
   return out;
@@ -322,7 +374,8 @@ Result<StateSizes> read_state_header(std::string_view bytes) {
   if (sizes.bytes != bytes.size())
     return Status::error("length: the header says " + std::to_string(sizes.bytes) +
                          " bytes, there are " + std::to_string(bytes.size()));
-  if (flags != 0) return Status::error("flags: unknown flags " + std::to_string(flags));
+  if ((flags & ~kStateHasJoints) != 0)
+    return Status::error("flags: unknown flags " + std::to_string(flags));
   // Every entry takes bytes: counts the length cannot hold are refused before anything is made.
   const std::size_t body = bytes.size() - kStateHeaderBytes;
   if (sizes.slots > body / kLeastSlotBytes || sizes.free_slots > body / 4 ||
@@ -359,6 +412,22 @@ Result<WorldStateData> decode_state(std::string_view bytes) {
   for (std::size_t i = 0; i < state.contact_pairs.size() && r.ok(); ++i)
     if (Status s = take_pair(r, &state.contact_pairs[i]); !s)
       return s.within("contact_pairs[" + std::to_string(i) + "].");
+  std::uint32_t flags = 0;
+  std::memcpy(&flags, bytes.data() + kFlagsOffset, sizeof flags);
+  if ((flags & kStateHasJoints) != 0) {
+    state.joints.resize(r.count("joints", kLeastJointSlotBytes));
+    const std::uint32_t free_count = r.count("free_joints", 4);
+    for (std::size_t i = 0; i < state.joints.size() && r.ok(); ++i) {
+      JointSlot& slot = state.joints[i];
+      slot.generation = r.take<std::uint32_t>("generation");
+      slot.alive = take_flag(r, "alive");
+      Status s = slot.alive ? take_joint(r, &slot.joint) : r.status();
+      if (!s) return s.within("joints[" + std::to_string(i) + "].");
+    }
+    state.free_joints.resize(free_count);  // bounded by the bytes there were (count)
+    for (std::uint32_t& slot : state.free_joints)
+      slot = r.take<std::uint32_t>("free_joints");
+  }
   if (!r.ok()) return r.status();
   if (r.left() != 0)
     return Status::error("length: " + std::to_string(r.left()) + " bytes after the last pair");

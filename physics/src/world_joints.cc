@@ -122,6 +122,21 @@ void World::remove_joints_of(std::uint32_t body_slot) {
   }
 }
 
+void World::restore_joint_indexes() {
+  joint_count_ = 0;
+  joints_of_body_.assign(bodies_.size(), 0);
+  unjoined_pairs_.clear();
+  for (const JointSlot& slot : joints_) {
+    if (!slot.alive) continue;
+    ++joint_count_;
+    ++joints_of_body_[slot.joint.a];
+    if (slot.joint.b == kWorldAnchor) continue;
+    ++joints_of_body_[slot.joint.b];
+    if (!slot.joint.collide_connected) unjoined_pairs_.push_back(pair_key(slot.joint.a, slot.joint.b));
+  }
+  std::sort(unjoined_pairs_.begin(), unjoined_pairs_.end());
+}
+
 bool World::unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const {
   return std::binary_search(unjoined_pairs_.begin(), unjoined_pairs_.end(),
                             pair_key(slot_a, slot_b));

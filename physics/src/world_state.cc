@@ -90,6 +90,35 @@ Status check_contact_pair(const ContactPairRecord& record, std::span<const BodyS
   return Status::ok();
 }
 
+bool unit(const Vec3& v) {
+  return is_finite(v) && std::abs(v.norm() - 1) <= 1e-6;
+}
+
+// A joint names live bodies (b may be the world), one of them dynamic, with finite anchors, unit
+// axes and rotation, a length a distance joint can hold, and finite impulses.
+Status check_joint(const Joint& joint, std::span<const BodySlotState> slots) {
+  auto live = [&](std::uint32_t slot) { return slot < slots.size() && slots[slot].alive; };
+  if (!live(joint.a)) return Status::error("a: not a live body");
+  if (joint.b != kWorldAnchor && (!live(joint.b) || joint.b == joint.a))
+    return Status::error("b: not a live body other than a, nor the world");
+  const bool b_static = joint.b == kWorldAnchor || slots[joint.b].body.is_static();
+  if (slots[joint.a].body.is_static() && b_static)
+    return Status::error("a: a joint needs a dynamic body on one side");
+  if (!is_finite(joint.local_a) || !is_finite(joint.local_b))
+    return Status::error("local_a, local_b: must be finite");
+  if (!unit(joint.axis_a) || !unit(joint.axis_b))
+    return Status::error("axis_a, axis_b: must be unit vectors");
+  if (!(std::abs(joint.relative.norm() - 1) <= 1e-6))
+    return Status::error("relative: must be a unit quaternion");
+  if (!std::isfinite(joint.length) || joint.length < 0 ||
+      (joint.kind == JointKind::kDistance && !(joint.length > 0)))
+    return Status::error("length: must be finite, and > 0 for a distance joint");
+  if (!is_finite(joint.linear_impulse) || !is_finite(joint.angular_impulse) ||
+      !std::isfinite(joint.axial_impulse))
+    return Status::error("impulses: must be finite");
+  return Status::ok();
+}
+
 }  // namespace
 
 WorldStateData WorldInternals::state_of(const World& world) {
@@ -101,6 +130,10 @@ WorldStateData WorldInternals::state_of(const World& world) {
   state.time = world.time_;
   state.step = world.stats_.step;
   state.contact_pairs = world.scratch_->pairs;
+  if (world.joint_count_ > 0 || !world.free_joint_slots_.empty()) {
+    state.joints = world.joints_;
+    state.free_joints = world.free_joint_slots_;
+  }
   return state;
 }
 
@@ -142,6 +175,25 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     }
   }
 
+  if (state.joints.size() > World::kMaxJoints)
+    return Status::error("joints: more than " + std::to_string(World::kMaxJoints));
+  std::size_t live_joints = 0;
+  for (std::size_t i = 0; i < state.joints.size(); ++i) {
+    if (!state.joints[i].alive) continue;
+    ++live_joints;
+    if (Status s = check_joint(state.joints[i].joint, state.slots); !s)
+      return s.within("joints[" + std::to_string(i) + "].");
+  }
+  std::vector<std::uint8_t> joint_listed(state.joints.size(), 0);
+  for (std::size_t k = 0; k < state.free_joints.size(); ++k) {
+    const std::uint32_t i = state.free_joints[k];
+    if (i >= state.joints.size() || state.joints[i].alive || joint_listed[i])
+      return Status::error("free_joints[" + std::to_string(k) + "]: not a dead slot, or repeated");
+    joint_listed[i] = 1;
+  }
+  if (state.free_joints.size() != state.joints.size() - live_joints)
+    return Status::error("free_joints: must list every dead joint slot");
+
   World world(settings);
   world.bodies_.reserve(slot_count);
   for (BodySlotState& slot : state.slots)
@@ -159,6 +211,9 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
   world.time_ = state.time;
   world.stats_.step = state.step;
   world.scratch_->pairs = std::move(state.contact_pairs);
+  world.joints_ = std::move(state.joints);
+  world.free_joint_slots_ = std::move(state.free_joints);
+  world.restore_joint_indexes();
   world.events_complete_ = false;  // every body is new to whoever mirrors this world
   return world;
 }

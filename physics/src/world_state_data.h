@@ -10,6 +10,7 @@
 
 #include "body_state.h"
 #include "contact_record.h"
+#include "joint_state.h"
 #include "physics/world.h"
 
 namespace tumble {
@@ -26,6 +27,8 @@ struct WorldStateData {
   double time = 0;                        // s
   std::uint64_t step = 0;
   std::vector<ContactPairRecord> contact_pairs;  // sorted by (a.index, b.index), each pair once
+  std::vector<JointSlot> joints;                 // by joint slot
+  std::vector<std::uint32_t> free_joints;        // reused last first
 };
 
 // The way in for save_state, from_state and the engine's tests (a friend of World).

@@ -221,6 +221,8 @@ class World {
   // once per joint: the narrow phase skips them.
   std::vector<std::uint64_t> unjoined_pairs_;
   void remove_joints_of(std::uint32_t body_slot);
+  // joint_count_, joints_of_body_ and unjoined_pairs_ from joints_ (a restored state).
+  void restore_joint_indexes();
   bool unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const;
   // Sleepers joined to moving bodies wake with their islands; returns how many woke.
   std::uint32_t wake_jointed();
