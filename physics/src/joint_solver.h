@@ -27,9 +27,12 @@ struct JointRow {
 void warm_start_joint(const JointRow& row, std::span<SolverBody> bodies,
                       std::span<const Pose> poses);
 
-// What a sweep asks of a joint: with a move of h ahead (h > 0), velocities that take the bodies
-// onto the joint at its end (closing the error now and what moving along the velocities would
-// open, at most most_speed m/s or rad/s); with h = 0, velocities the joint allows now, rigidly.
+// What a sweep asks of a joint: with a move of h ahead (h > 0), velocities under which the move
+// opens no error (the turns' curvature included, which the velocities' first order misses; at
+// most most_speed m/s or rad/s for it); with h = 0, velocities the joint allows now, rigidly.
+// The error a joint has is closed by the position passes after each move, never through the
+// velocities: closing it there too overshot in Gauss-Seidel and threw a chain with a 100 times
+// heavier end kilometres.
 // The first is SHAKE's position step, the second RATTLE's velocity projection (Andersen 1983,
 // "Rattle: a velocity version of the Shake algorithm"): together they keep a pendulum's energy.
 struct JointTarget {

@@ -306,8 +306,8 @@ constexpr std::uint32_t kStateHasJoints = 1;
 constexpr std::size_t kFlagsOffset = 36;  // magic 8, version 4, header 4, length 8, counts 12
 
 // The least bytes of one entry, so that counts are checked against what is left.
-constexpr std::size_t kLeastSlotBytes = 5;   // generation, alive
-constexpr std::size_t kLeastPairBytes = 83;  // ids, pose, feature, colour, count
+constexpr std::size_t kLeastSlotBytes = 5;       // generation, alive
+constexpr std::size_t kLeastPairBytes = 83;      // ids, pose, feature, colour, count
 constexpr std::size_t kLeastJointSlotBytes = 5;  // generation, alive
 
 }  // namespace

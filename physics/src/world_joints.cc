@@ -132,7 +132,8 @@ void World::restore_joint_indexes() {
     ++joints_of_body_[slot.joint.a];
     if (slot.joint.b == kWorldAnchor) continue;
     ++joints_of_body_[slot.joint.b];
-    if (!slot.joint.collide_connected) unjoined_pairs_.push_back(pair_key(slot.joint.a, slot.joint.b));
+    if (!slot.joint.collide_connected)
+      unjoined_pairs_.push_back(pair_key(slot.joint.a, slot.joint.b));
   }
   std::sort(unjoined_pairs_.begin(), unjoined_pairs_.end());
 }
@@ -176,7 +177,12 @@ void World::prepare_joint_rows() {
 }
 
 void World::store_joint_impulses() {
-  for (const JointRow& row : scratch_->joint_rows) {
+  const StepScratch& s = *scratch_;
+  stats_.solved_joints = static_cast<std::uint32_t>(s.joint_rows.size());
+  for (const JointRow& row : s.joint_rows) {
+    const Pose pose_b = row.b == kWorldAnchor ? Pose{} : s.poses[row.b];
+    stats_.joint_error =
+        std::max(stats_.joint_error, tumble::joint_error(row.joint, s.poses[row.a], pose_b));
     Joint& joint = joints_[row.slot].joint;
     joint.linear_impulse = row.joint.linear_impulse;
     joint.angular_impulse = row.joint.angular_impulse;

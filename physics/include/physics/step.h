@@ -122,6 +122,11 @@ struct StepStats {
   // iteration bound (they stop at the last safe time).
   std::uint32_t swept_bodies = 0, continuous_impacts = 0, continuous_limit_hits = 0;
   double max_penetration = 0;  // m, the deepest contact point found this step
+  // Joints the step solved (those with a moving body) and the farthest any was from holding at
+  // the solve's end (World::joint_error's measure: m, or rad for axes and rotations). The joint
+  // passes are a fixed few a move; this says when they were not enough.
+  std::uint32_t solved_joints = 0;
+  double joint_error = 0;
   std::uint32_t collision_flags = 0;
   // Bodies whose implicit gyroscopic step hit its Newton iteration bound or spun too fast for
   // kGyroscopicMaxPieces; they kept their body-frame spin for the step.
