@@ -41,6 +41,14 @@ World busy_world() {
 
 constexpr double kDt = 1.0 / 60;
 
+// The state is refused, and the message names `field`.
+void expect_refused(const WorldSettings& settings, const WorldStateData& state,
+                    const std::string& field) {
+  Result<World> world = world_of(settings, state);
+  ASSERT_FALSE(world) << field;
+  EXPECT_NE(world.error().find(field), std::string::npos) << world.error();
+}
+
 TEST(WorldState, RestoredWorldStepsOnBitForBit) {
   World original = busy_world();
   const std::string saved = original.save_state();
@@ -113,9 +121,7 @@ TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   const World original = busy_world();
   const WorldStateData good = data_of(original);
   auto refused = [&](const WorldStateData& state, const std::string& field) {
-    Result<World> world = world_of(original.settings(), state);
-    ASSERT_FALSE(world) << field;
-    EXPECT_NE(world.error().find(field), std::string::npos) << world.error();
+    expect_refused(original.settings(), state, field);
   };
   WorldStateData s = good;
   s.slots[2].body.position.x() = std::nan("");
@@ -384,9 +390,7 @@ TEST(WorldState, BadJointsAreRefusedNamingTheField) {
   const World original = jointed_world();
   const WorldStateData good = data_of(original);
   auto refused = [&](const WorldStateData& state, const std::string& field) {
-    Result<World> world = world_of(original.settings(), state);
-    ASSERT_FALSE(world) << field;
-    EXPECT_NE(world.error().find(field), std::string::npos) << world.error();
+    expect_refused(original.settings(), state, field);
   };
   WorldStateData s = good;
   s.joints[0].joint.a = static_cast<std::uint32_t>(s.slots.size());  // no such body

@@ -123,21 +123,36 @@ double solve_point(JointRow& row, JointBodies& j, const Anchors& anchors, const 
   return (k * impulse).lpNorm<Eigen::Infinity>();
 }
 
-// A hinge's two angular rows: axis a stays perpendicular to two directions perpendicular to
-// axis b (Jolt's HingeRotationConstraintPart has the same rows).
+// A hinge's two angular rows: axis a stays perpendicular to two directions b2, c2 perpendicular
+// to axis b (Jolt's HingeRotationConstraintPart has the same rows). d/dt (axis_a . d) =
+// (w_b - w_a) . (d x axis_a) for d fixed in b, so the rows' directions are g = d x axis_a.
+struct HingeRows {
+  Vec3 axis_a, b2, c2, g1, g2;
+  Eigen::Matrix2d k;  // effective inverse mass of the two rows
+  Eigen::Vector2d error() const { return {axis_a.dot(b2), axis_a.dot(c2)}; }
+};
+
+HingeRows hinge_rows(const Joint& joint, const Quat& qa, const Quat* qb, const Mat3& inertia) {
+  HingeRows rows;
+  rows.axis_a = qa * joint.axis_a;
+  const Vec3 axis_b = qb == nullptr ? joint.axis_b : Vec3(*qb * joint.axis_b);
+  rows.b2 = perpendicular(axis_b);
+  rows.c2 = axis_b.cross(rows.b2);
+  rows.g1 = rows.b2.cross(rows.axis_a);
+  rows.g2 = rows.c2.cross(rows.axis_a);
+  rows.k(0, 0) = rows.g1.dot(inertia * rows.g1);
+  rows.k(0, 1) = rows.k(1, 0) = rows.g1.dot(inertia * rows.g2);
+  rows.k(1, 1) = rows.g2.dot(inertia * rows.g2);
+  return rows;
+}
+
 double solve_hinge_axes(JointRow& row, JointBodies& j, const JointTarget& t) {
   const SolverBody& b = j.body_b();
-  const Vec3 axis_a = j.pose_a.orientation * row.joint.axis_a;
-  const Vec3 axis_b =
-      j.b == nullptr ? row.joint.axis_b : Vec3(j.pose_b.orientation * row.joint.axis_b);
-  const Vec3 b2 = perpendicular(axis_b), c2 = axis_b.cross(b2);
-  // d/dt (axis_a . d) = (w_b - w_a) . (d x axis_a) for d fixed in b.
-  const Vec3 g1 = b2.cross(axis_a), g2 = c2.cross(axis_a);
-  const Mat3 inertia = j.a->inverse_inertia + b.inverse_inertia;
-  Eigen::Matrix2d k;
-  k(0, 0) = g1.dot(inertia * g1);
-  k(0, 1) = k(1, 0) = g1.dot(inertia * g2);
-  k(1, 1) = g2.dot(inertia * g2);
+  const HingeRows rows =
+      hinge_rows(row.joint, j.pose_a.orientation, j.b == nullptr ? nullptr : &j.pose_b.orientation,
+                 j.a->inverse_inertia + b.inverse_inertia);
+  const Vec3 &axis_a = rows.axis_a, &b2 = rows.b2, &c2 = rows.c2, &g1 = rows.g1, &g2 = rows.g2;
+  const Eigen::Matrix2d& k = rows.k;
   const Vec3 relative_w = b.w - j.a->w;
   if (!(k.determinant() > 0)) return 0;
   Eigen::Vector2d velocity(relative_w.dot(g1), relative_w.dot(g2));
@@ -287,20 +302,12 @@ void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
   const SolverBody& b = m.body_b();
   // The rotation first (it moves the anchors), then the point or the length.
   if (joint.kind == JointKind::kHinge) {
-    const Pose pose_b = m.world_pose_b();
-    const Vec3 axis_a = m.pose_a->orientation * joint.axis_a;
-    const Vec3 axis_b = world_b ? joint.axis_b : Vec3(pose_b.orientation * joint.axis_b);
-    const Vec3 b2 = perpendicular(axis_b), c2 = axis_b.cross(b2);
-    const Vec3 g1 = b2.cross(axis_a), g2 = c2.cross(axis_a);
-    const Mat3 inertia = m.a->inverse_inertia + b.inverse_inertia;
-    Eigen::Matrix2d k;
-    k(0, 0) = g1.dot(inertia * g1);
-    k(0, 1) = k(1, 0) = g1.dot(inertia * g2);
-    k(1, 1) = g2.dot(inertia * g2);
-    if (k.determinant() > 0) {
-      const Eigen::Vector2d lambda =
-          -k.ldlt().solve(Eigen::Vector2d(axis_a.dot(b2), axis_a.dot(c2)));
-      displace_angular(m, lambda.x() * g1 + lambda.y() * g2);
+    const HingeRows rows =
+        hinge_rows(joint, m.pose_a->orientation, world_b ? nullptr : &m.pose_b->orientation,
+                   m.a->inverse_inertia + b.inverse_inertia);
+    if (rows.k.determinant() > 0) {
+      const Eigen::Vector2d lambda = -rows.k.ldlt().solve(rows.error());
+      displace_angular(m, lambda.x() * rows.g1 + lambda.y() * rows.g2);
     }
   } else if (joint.kind == JointKind::kFixed) {
     const Mat3 k = m.a->inverse_inertia + b.inverse_inertia;
