@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <optional>
 
 #include "scene_runner.h"
 
@@ -113,6 +114,89 @@ TEST(SceneJson, RoundTripsExactly) {
     EXPECT_EQ(back.value().bodies[i].orientation.coeffs(), scene.bodies[i].orientation.coeffs());
     EXPECT_EQ(back.value().bodies[i].linear_velocity, scene.bodies[i].linear_velocity);
   }
+}
+
+TEST(SceneJson, JointsAreReadCheckedAndWrittenBack) {
+  const Result<SceneDef> scene = parse_scene(R"({
+    "bodies": [
+      {"shape": "plane"},
+      {"shape": "box", "size": [1, 0.1, 2], "mass": 5, "position": [0.5, 0, 1]},
+      {"shape": "sphere", "radius": 0.1, "mass": 1, "position": [3, 0, 2]},
+      {"shape": "sphere", "radius": 0.1, "mass": 1, "position": [4, 0, 2]}
+    ],
+    "joints": [
+      {"kind": "hinge", "a": 1, "anchor": [0, 0, 1], "axis": [0, 0, 1]},
+      {"kind": "distance", "a": 2, "anchor": [3, 0, 2], "anchor_b": [3, 0, 3]},
+      {"kind": "ball", "a": 3, "b": 2, "anchor": [3.5, 0, 2], "collide_connected": true},
+      {"kind": "fixed", "a": 1, "b": 0, "anchor": [0, 0, 0]}
+    ]})");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  ASSERT_EQ(scene.value().joints.size(), 4u);
+  EXPECT_EQ(scene.value().joints[0].def.kind, JointKind::kHinge);
+  EXPECT_FALSE(scene.value().joints[0].b.has_value());
+  EXPECT_EQ(scene.value().joints[2].b, std::optional<std::size_t>(2));
+  EXPECT_TRUE(scene.value().joints[2].def.collide_connected);
+  EXPECT_EQ(scene.value().joints[1].def.anchor_b, Vec3(3, 0, 3));
+  const Result<SceneDef> back = parse_scene(scene_to_json(scene.value()));
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(scene_to_json(back.value()), scene_to_json(scene.value()));
+  // The world: the joints hold while it steps (the door is fixed to the static ground too).
+  Result<World> world = make_world(scene.value());
+  ASSERT_TRUE(world.ok()) << world.error();
+  EXPECT_EQ(world.value().joint_count(), 4u);
+  run(world.value(), 1.0 / 60, 60);
+  EXPECT_LT(world.value().last_step().joint_error, 1e-3);
+
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}], "joints": [{"kind": "rope", "a": 0}]})"),
+            "joints[0].kind: must be ball, hinge, fixed or distance");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}], "joints": [{"kind": "ball", "a": 3}]})"),
+            "joints[0].a: body 3, but the scene has 1 bodies");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}], "joints": [{"kind": "ball"}]})"),
+            "joints[0].a: must name a body");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
+                         "joints": [{"kind": "ball", "a": 0, "b": 0}]})"),
+            "joints[0].b: must differ from a");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
+                         "joints": [{"kind": "hinge", "a": 0, "axis": [0, 0, 0]}]})"),
+            "joints[0].axis: must not be zero");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
+                         "joints": [{"kind": "ball", "a": 0, "anchr": [0, 0, 0]}]})"),
+            "joints[0].anchr: unknown field");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}], "joints": {"kind": "ball"}})"),
+            "joints: must be an array");
+  // A scene for a server that allows 2 bodies holds at most 4 joints.
+  std::string many = R"({"bodies": [{"shape": "sphere"}], "joints": [)";
+  for (int i = 0; i < 5; ++i)
+    many += std::string(i ? "," : "") + R"({"kind": "ball", "a": 0})";
+  many += "]}";
+  EXPECT_TRUE(parse_scene(many, 3));
+  const Result<SceneDef> too_many = parse_scene(many, 2);
+  ASSERT_FALSE(too_many);
+  EXPECT_EQ(too_many.error(), "joints: 5 joints, more than the 2 a body allowed (2 bodies)");
+  // What only the world can say, named with the joint's place.
+  const Result<SceneDef> static_only =
+      parse_scene(R"({"bodies": [{"shape": "plane"}], "joints": [{"kind": "ball", "a": 0}]})");
+  ASSERT_TRUE(static_only.ok()) << static_only.error();
+  EXPECT_EQ(make_world(static_only.value()).error(),
+            "joints[0].a: a joint needs a dynamic body on one side");
+}
+
+TEST(StandardScenes, PendulumAndChainSwingOnTheirJoints) {
+  for (const char* name : {"pendulum", "chain:12"}) {
+    SceneDef scene = standard_scene(name).value();
+    World world = build(scene);
+    EXPECT_EQ(world.joint_count(), scene.joints.size());
+    double worst = 0;
+    for (int step = 0; step < 120; ++step) {
+      ASSERT_TRUE(world.step(scene.dt));
+      worst = std::max(worst, world.last_step().joint_error);
+    }
+    EXPECT_LT(worst, 2e-3) << name;
+    EXPECT_EQ(world.last_step().solved_joints, scene.joints.size());
+  }
+  EXPECT_EQ(standard_scene("chain:12").value().bodies.size(), 13u);
+  EXPECT_FALSE(standard_scene("pendulum:3"));
+  EXPECT_FALSE(standard_scene("chain:5000", 1000));
 }
 
 TEST(SceneJson, DefaultSceneIsBuiltInAndFalls) {

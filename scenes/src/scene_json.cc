@@ -177,6 +177,75 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   return def;
 }
 
+constexpr std::pair<const char*, JointKind> kJointKinds[] = {{"ball", JointKind::kBall},
+                                                             {"hinge", JointKind::kHinge},
+                                                             {"fixed", JointKind::kFixed},
+                                                             {"distance", JointKind::kDistance}};
+
+const char* joint_kind_name(JointKind kind) {
+  for (const auto& [name, value] : kJointKinds)
+    if (value == kind) return name;
+  return "ball";
+}
+
+// A body's place in the scene's list.
+std::size_t body_index(const Json& value, const std::string& path, std::size_t bodies) {
+  if (!value.is_number_unsigned()) fail(path, "must be a body's index in \"bodies\"");
+  const auto index = value.get<unsigned long long>();
+  if (index >= bodies)
+    fail(path, "body " + std::to_string(index) + ", but the scene has " + std::to_string(bodies) +
+                   " bodies");
+  return static_cast<std::size_t>(index);
+}
+
+SceneJoint read_joint(const Json& json, const std::string& path, std::size_t bodies) {
+  ObjectReader r(json, path);
+  SceneJoint joint;
+  const std::string kind = r.string("kind", "");
+  bool known = false;
+  for (const auto& [name, value] : kJointKinds)
+    if (kind == name) {
+      joint.def.kind = value;
+      known = true;
+    }
+  if (!known) fail(r.child("kind"), "must be ball, hinge, fixed or distance");
+  const Json* a = r.find("a");
+  if (a == nullptr) fail(r.child("a"), "must name a body");
+  joint.a = body_index(*a, r.child("a"), bodies);
+  if (const Json* b = r.find("b"); b != nullptr && !b->is_null())
+    joint.b = body_index(*b, r.child("b"), bodies);
+  joint.def.anchor = r.vector("anchor", joint.def.anchor);
+  joint.def.anchor_b = r.vector("anchor_b", joint.def.anchor_b);
+  joint.def.axis = r.vector("axis", joint.def.axis);
+  joint.def.length = r.number("length", joint.def.length);
+  joint.def.collide_connected = r.boolean("collide_connected", joint.def.collide_connected);
+  r.reject_unknown();
+  // The engine's checks of what needs no world, with this path (the ids are filled in later).
+  JointDef check = joint.def;
+  check.a = BodyId{0, 0};
+  check.b = joint.b ? BodyId{1, 0} : BodyId{};
+  if (joint.b && *joint.b == joint.a) fail(r.child("b"), "must differ from a");
+  if (Status s = validate(check); !s) throw FieldError{path + "." + s.message()};
+  return joint;
+}
+
+Json vector_json(const Vec3& v);
+
+Json joint_json(const SceneJoint& joint) {
+  Json out = Json::object();
+  out["kind"] = joint_kind_name(joint.def.kind);
+  out["a"] = joint.a;
+  if (joint.b) out["b"] = *joint.b;
+  out["anchor"] = vector_json(joint.def.anchor);
+  if (joint.def.kind == JointKind::kDistance) {
+    out["anchor_b"] = vector_json(joint.def.anchor_b);
+    out["length"] = joint.def.length;
+  }
+  if (joint.def.kind == JointKind::kHinge) out["axis"] = vector_json(joint.def.axis);
+  out["collide_connected"] = joint.def.collide_connected;
+  return out;
+}
+
 SceneDef read_scene(const Json& json) {
   ObjectReader r(json, "");
   SceneDef scene;
@@ -227,6 +296,14 @@ SceneDef read_scene(const Json& json) {
     for (std::size_t i = 0; i < bodies->size(); ++i)
       scene.bodies.push_back(
           read_body((*bodies)[i], "bodies[" + std::to_string(i) + "]", world.limits));
+  }
+  if (const Json* joints = r.find("joints")) {
+    if (!joints->is_array()) fail("joints", "must be an array");
+    if (joints->size() > World::kMaxJoints)
+      fail("joints", "more than the " + std::to_string(World::kMaxJoints) + " a world holds");
+    for (std::size_t i = 0; i < joints->size(); ++i)
+      scene.joints.push_back(
+          read_joint((*joints)[i], "joints[" + std::to_string(i) + "]", scene.bodies.size()));
   }
   r.reject_unknown();
   return scene;
@@ -354,11 +431,19 @@ Result<SceneDef> parse_scene(std::string_view json_text, std::size_t max_bodies)
   } catch (const Json::parse_error& e) {
     return Status::error(std::string("scene: not valid JSON: ") + e.what());
   }
+  SceneDef scene;
   try {
-    return read_scene(json);
+    scene = read_scene(json);
   } catch (const FieldError& e) {
     return Status::error(e.message);
   }
+  // A world that may hold max_bodies bodies holds at most kJointsPerBody joints a body.
+  if (max_bodies != kNoBodyLimit && scene.joints.size() > kJointsPerBody * max_bodies)
+    return Status::error("joints: " + std::to_string(scene.joints.size()) +
+                             " joints, more than the " + std::to_string(kJointsPerBody) +
+                             " a body allowed (" + std::to_string(max_bodies) + " bodies)",
+                         StatusCode::kResourceExhausted);
+  return scene;
 }
 
 Result<SceneDef> load_scene_file(const std::string& path) {
@@ -404,13 +489,29 @@ std::string scene_to_json(const SceneDef& scene) {
   out["bodies"] = Json::array();
   for (const BodyDef& def : scene.bodies)
     out["bodies"].push_back(body_json(def));
+  if (!scene.joints.empty()) {
+    out["joints"] = Json::array();
+    for (const SceneJoint& joint : scene.joints)
+      out["joints"].push_back(joint_json(joint));
+  }
   return out.dump(1);
 }
 
 Result<World> make_world(const SceneDef& scene) {
   if (Status s = validate(scene.world); !s) return s;
   World world(scene.world);
-  if (auto ids = world.create_bodies(scene.bodies); !ids) return ids.status();
+  Result<std::vector<BodyId>> ids = world.create_bodies(scene.bodies);
+  if (!ids) return ids.status();
+  for (std::size_t i = 0; i < scene.joints.size(); ++i) {
+    const SceneJoint& joint = scene.joints[i];
+    JointDef def = joint.def;
+    if (joint.a >= ids.value().size() || (joint.b && *joint.b >= ids.value().size()))
+      return Status::error("joints[" + std::to_string(i) + "]: names a body the scene lacks");
+    def.a = ids.value()[joint.a];
+    def.b = joint.b ? ids.value()[*joint.b] : BodyId{};
+    if (Result<JointId> made = world.create_joint(def); !made)
+      return made.status().within("joints[" + std::to_string(i) + "].");
+  }
   return world;
 }
 

@@ -142,6 +142,39 @@ Result<SceneDef> standard_scene(std::string_view spec, std::size_t max_bodies) {
   return made;
 }
 
+SceneDef pendulum_scene() {
+  SceneDef scene = base_scene("pendulum", 10);
+  scene.bodies.push_back(ground());
+  BodyDef bob;
+  bob.shape = SphereDef{0.05};
+  bob.mass = 1;
+  bob.position = Vec3(1, 0, 2);
+  scene.bodies.push_back(bob);
+  SceneJoint rod;
+  rod.def.kind = JointKind::kDistance;
+  rod.def.anchor = bob.position;
+  rod.def.anchor_b = Vec3(0, 0, 2);
+  rod.a = 1;
+  scene.joints.push_back(rod);
+  return scene;
+}
+
+SceneDef chain_scene(int links) {
+  SceneDef scene = base_scene("chain-" + std::to_string(links), 10);
+  scene.bodies.push_back(ground());
+  const Vec3 top(0, 0, 0.2 * links + 1);
+  for (int i = 0; i < links; ++i) {
+    scene.bodies.push_back(box(Vec3(0.2, 0.04, 0.04), 0.5, top + Vec3(0.2 * i + 0.1, 0, 0)));
+    SceneJoint joint;
+    joint.def.kind = JointKind::kBall;
+    joint.def.anchor = top + Vec3(0.2 * i, 0, 0);
+    joint.a = scene.bodies.size() - 1;
+    if (i > 0) joint.b = scene.bodies.size() - 2;
+    scene.joints.push_back(joint);
+  }
+  return scene;
+}
+
 namespace {
 
 Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bodies) {
@@ -160,7 +193,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   // Counted, ground included, before anything is built, so a request for a huge scene costs
   // nothing.
-  if (name == "pile" || name == "pyramid" || name == "tower") {
+  if (name == "pile" || name == "pyramid" || name == "tower" || name == "chain") {
     const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(name == "pile" ? 1000 : 20));
     const std::uint64_t bodies = (name == "pyramid" ? n * (n + 1) / 2 : n) + 1;
     if (bodies > max_bodies)
@@ -195,13 +228,18 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     if (Status s = sized("bounce"); !s) return s;
     return bounce_scene();
   }
+  if (name == "chain") return chain_scene(size.value_or(20));
+  if (name == "pendulum") {
+    if (Status s = sized("pendulum"); !s) return s;
+    return pendulum_scene();
+  }
   if (name == "default") {
     if (Status s = sized("default"); !s) return s;
     return parse_scene(default_scene_json());
   }
   return Status::error("scene '" + shown(spec) +
                        "': unknown; the standard scenes are pile, pyramid, tower, mass-ratio, "
-                       "mass-ratio-inv, bullet, slide, spin, bounce, default");
+                       "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, chain, default");
 }
 
 }  // namespace

@@ -39,8 +39,14 @@ SceneDef bounce_scene(double height = 1,
                       double restitution = 0.5);  // dropped from `height`
                                                   // (bottom face above ground), 3 s
 
+// Joints (docs/SCENES.md): a 1 m rod pendulum released level with its pivot, 10 s; a chain of
+// `links` ball-jointed 0.2 m links hung from a fixed point and released level, 10 s.
+SceneDef pendulum_scene();
+SceneDef chain_scene(int links = 20);
+
 // A standard scene by name, with an optional size: "pile", "pile:250", "pyramid:10", "tower:5",
-// "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "default". A size whose
+// "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "pendulum", "chain:20",
+// "default". A size whose
 // scene would have more than `max_bodies` bodies is refused before anything is built.
 Result<SceneDef> standard_scene(std::string_view name, std::size_t max_bodies = 1000000);
 
