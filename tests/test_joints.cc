@@ -356,6 +356,35 @@ TEST(Joints, JointedBodiesSleepAndWakeTogether) {
   }
 }
 
+// A door asleep on its hinge to a static frame wakes when the frame is moved, however far the
+// door is from the frame's bounds.
+TEST(Joints, MovingAStaticBodyWakesWhatItsJointsHold) {
+  World world;
+  BodyDef frame_def;
+  frame_def.type = BodyType::kStatic;
+  frame_def.shape = BoxDef{Vec3(0.05, 0.05, 0.05)};
+  frame_def.position = Vec3(0, 0, 5);
+  const BodyId frame = world.create_body(frame_def).value();
+  const BodyId door = add_box(world, Vec3(0, 0, 3), Vec3(0.05, 0.05, 1));
+  JointDef def;
+  def.kind = JointKind::kHinge;
+  def.a = door;
+  def.b = frame;
+  def.anchor = Vec3(0, 0, 4);
+  def.axis = Vec3::UnitY();
+  ASSERT_TRUE(world.create_joint(def));
+  for (int step = 0; step < 120 && !world.body(door).asleep(); ++step)
+    ASSERT_TRUE(world.step(kDt));
+  ASSERT_TRUE(world.body(door).asleep());
+  BodyMotion motion;
+  motion.position = Vec3(0.5, 0, 5);
+  ASSERT_TRUE(world.set_motion(frame, motion));
+  EXPECT_FALSE(world.body(door).asleep());
+  for (int step = 0; step < 30; ++step)
+    ASSERT_TRUE(world.step(kDt));
+  EXPECT_GT(world.body(door).position().x(), 0.1);  // it followed the frame
+}
+
 // Two boxes that overlap where a joint holds them: no contact between them, unless the joint
 // says they collide.
 TEST(Joints, JointedBodiesDoNotCollideUnlessTheJointSaysSo) {

@@ -294,9 +294,10 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
   }
   body.update_world_inertia();
   if (body.is_static()) resting_changed(id.index);  // (a sleeper wakes below, which counts too)
-  if (body.is_static())
-    wake_around(body);  // and what it now touches
-  else if (body.asleep)
+  if (body.is_static()) {
+    wake_around(body);         // and what it now touches
+    wake_joined_to(id.index);  // and what its joints hold, however far
+  } else if (body.asleep)
     wake_island(body.sleep_island);
   body.sleep_timer = 0;
   note_event(id.index, kBodyMoved);

@@ -156,6 +156,16 @@ std::uint32_t World::wake_jointed() {
   return woken;
 }
 
+void World::wake_joined_to(std::uint32_t body_slot) {
+  if (body_slot >= joints_of_body_.size() || joints_of_body_[body_slot] == 0) return;
+  for (const JointSlot& slot : joints_) {
+    if (!slot.alive || (slot.joint.a != body_slot && slot.joint.b != body_slot)) continue;
+    const std::uint32_t other = slot.joint.a == body_slot ? slot.joint.b : slot.joint.a;
+    if (other != kWorldAnchor && bodies_[other].body.asleep)
+      wake_island(bodies_[other].body.sleep_island);
+  }
+}
+
 void World::prepare_joint_rows() {
   StepScratch& s = *scratch_;
   s.joint_rows.clear();
@@ -164,13 +174,14 @@ void World::prepare_joint_rows() {
   for (std::uint32_t index = 0; index < joints_.size(); ++index) {
     const JointSlot& slot = joints_[index];
     if (!slot.alive) continue;
+    const bool world_b = slot.joint.b == kWorldAnchor;
     const std::uint32_t a = s.solver_of_slot[slot.joint.a];
-    const std::uint32_t b =
-        slot.joint.b == kWorldAnchor ? kWorldAnchor : s.solver_of_slot[slot.joint.b];
+    const std::uint32_t b = world_b ? kWorldAnchor : s.solver_of_slot[slot.joint.b];
     const bool moves_a = a != kNoSolverBody && a < s.moving;
-    const bool moves_b = b != kWorldAnchor && b != kNoSolverBody && b < s.moving;
+    const bool moves_b = !world_b && b != kNoSolverBody && b < s.moving;
     if (!moves_a && !moves_b) continue;  // asleep, or both static
-    TUMBLE_ASSERT(a != kNoSolverBody && b != kNoSolverBody);
+    // number_solver_bodies numbered both bodies of a joint with a moving body.
+    TUMBLE_ASSERT(a != kNoSolverBody && (world_b || b != kNoSolverBody));
     s.joint_rows.push_back({slot.joint, a, b, index});
     s.joint_links.push_back({a, b == kWorldAnchor ? a : b});
   }

@@ -226,6 +226,8 @@ class World {
   bool unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const;
   // Sleepers joined to moving bodies wake with their islands; returns how many woke.
   std::uint32_t wake_jointed();
+  // The sleepers a static body's joints hold wake (it moved).
+  void wake_joined_to(std::uint32_t body_slot);
   // The step's joints: rows for those with a moving body, their links into islands.
   void prepare_joint_rows();
   void store_joint_impulses();
