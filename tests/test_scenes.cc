@@ -128,10 +128,23 @@ TEST(SceneJson, JointsAreReadCheckedAndWrittenBack) {
       {"kind": "hinge", "a": 1, "anchor": [0, 0, 1], "axis": [0, 0, 1]},
       {"kind": "distance", "a": 2, "anchor": [3, 0, 2], "anchor_b": [3, 0, 3]},
       {"kind": "ball", "a": 3, "b": 2, "anchor": [3.5, 0, 2], "collide_connected": true},
-      {"kind": "fixed", "a": 1, "b": 0, "anchor": [0, 0, 0]}
+      {"kind": "fixed", "a": 1, "b": 0, "anchor": [0, 0, 0]},
+      {"kind": "slider", "a": 3, "anchor": [4, 0, 2], "axis": [1, 0, 0], "limit": [-0.5, 0.5],
+       "motor": {"speed": 0.2, "max_force": 50}},
+      {"kind": "hinge", "a": 2, "b": 3, "anchor": [3.5, 0, 2], "axis": [0, 1, 0],
+       "spring": {"target": 0.1, "stiffness": 20, "damping": 1}},
+      {"kind": "ball", "a": 2, "anchor": [3, 0, 2.5], "axis": [0, 0, -1], "max_swing": 0.4,
+       "limit": [-0.1, 0.1]}
     ]})");
   ASSERT_TRUE(scene.ok()) << scene.error();
-  ASSERT_EQ(scene.value().joints.size(), 4u);
+  ASSERT_EQ(scene.value().joints.size(), 7u);
+  const JointDef& slider = scene.value().joints[4].def;
+  EXPECT_EQ(slider.kind, JointKind::kSlider);
+  EXPECT_TRUE(slider.limit.enabled && slider.motor.enabled && !slider.spring.enabled);
+  EXPECT_EQ(slider.limit.lower, -0.5);
+  EXPECT_EQ(slider.motor.max_force, 50);
+  EXPECT_EQ(scene.value().joints[5].def.spring.stiffness, 20);
+  EXPECT_EQ(scene.value().joints[6].def.max_swing, 0.4);
   EXPECT_EQ(scene.value().joints[0].def.kind, JointKind::kHinge);
   EXPECT_FALSE(scene.value().joints[0].b.has_value());
   EXPECT_EQ(scene.value().joints[2].b, std::optional<std::size_t>(2));
@@ -143,12 +156,21 @@ TEST(SceneJson, JointsAreReadCheckedAndWrittenBack) {
   // The world: the joints hold while it steps (the door is fixed to the static ground too).
   Result<World> world = make_world(scene.value());
   ASSERT_TRUE(world.ok()) << world.error();
-  EXPECT_EQ(world.value().joint_count(), 4u);
+  EXPECT_EQ(world.value().joint_count(), 7u);
   run(world.value(), 1.0 / 60, 60);
   EXPECT_LT(world.value().last_step().joint_error, 1e-3);
 
   EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}], "joints": [{"kind": "rope", "a": 0}]})"),
-            "joints[0].kind: must be ball, hinge, fixed or distance");
+            "joints[0].kind: must be ball, hinge, fixed, distance or slider");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
+                         "joints": [{"kind": "hinge", "a": 0, "limit": [1]}]})"),
+            "joints[0].limit: must be [lower, upper]");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
+                         "joints": [{"kind": "hinge", "a": 0, "motor": {"speed": 1, "torque": 2}}]})"),
+            "joints[0].motor.torque: unknown field");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
+                         "joints": [{"kind": "ball", "a": 0, "spring": {"stiffness": 1}}]})"),
+            "joints[0].spring: only hinges, sliders and distance joints have one");
   EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}], "joints": [{"kind": "ball", "a": 3}]})"),
             "joints[0].a: body 3, but the scene has 1 bodies");
   EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}], "joints": [{"kind": "ball"}]})"),

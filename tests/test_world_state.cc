@@ -341,15 +341,15 @@ TEST(StateFormat, DamagedBytesAreRefusedOrStepSafely) {
 }
 
 // The busy world with a chain of every joint kind hanging from the world beside it, swinging,
-// and one joint removed (a free joint slot to reuse).
+// with limits, a motor and springs, and one joint removed (a free joint slot to reuse).
 World jointed_world() {
   World world = busy_world();
   BodyDef link;
   link.shape = BoxDef{Vec3(0.2, 0.05, 0.05)};
   BodyId last;
-  const JointKind kinds[] = {JointKind::kBall, JointKind::kHinge, JointKind::kFixed,
-                             JointKind::kDistance, JointKind::kBall};
-  for (int i = 0; i < 5; ++i) {
+  const JointKind kinds[] = {JointKind::kBall,     JointKind::kHinge, JointKind::kFixed,
+                             JointKind::kDistance, JointKind::kBall,  JointKind::kSlider};
+  for (int i = 0; i < 6; ++i) {
     link.position = Vec3(6 + 0.4 * i + 0.2, 0, 5);
     const BodyId body = world.create_body(link).value();
     JointDef def;
@@ -359,6 +359,20 @@ World jointed_world() {
     def.anchor = Vec3(6 + 0.4 * i, 0, 5);
     def.anchor_b = def.anchor - Vec3(0.1, 0, 0);  // a distance joint's rod, 0.1 m
     def.axis = Vec3(0, 1, 0);
+    if (def.kind == JointKind::kHinge) {
+      def.limit = {true, -0.3, 0.4};
+      def.spring = {true, 0.1, 5, 0.5};
+    } else if (def.kind == JointKind::kDistance) {
+      def.limit = {true, 0.05, 0.12};
+    } else if (def.kind == JointKind::kSlider) {
+      def.axis = Vec3(1, 0, 0);
+      def.limit = {true, -0.05, 0.05};
+      def.motor = {true, 0.2, 3};
+    } else if (i == 4) {
+      def.axis = Vec3(1, 0, 0);
+      def.max_swing = 0.5;
+      def.limit = {true, -0.2, 0.2};
+    }
     EXPECT_TRUE(world.create_joint(def));
     last = body;
   }
@@ -375,19 +389,21 @@ TEST(WorldState, JointsAndTheirImpulsesRoundTripBitForBit) {
   World original = jointed_world();
   const std::string saved = original.save_state();
   const WorldStateData data = data_of(original);
-  ASSERT_EQ(data.joints.size(), 6u);
+  ASSERT_EQ(data.joints.size(), 7u);
   ASSERT_EQ(data.free_joints.size(), 1u);
   Result<World> restored = World::from_state(original.settings(), saved);
   ASSERT_TRUE(restored) << restored.error();
-  EXPECT_EQ(restored.value().joint_count(), 5u);
+  EXPECT_EQ(restored.value().joint_count(), 6u);
   EXPECT_EQ(restored.value().save_state(), saved);
   run(original, kDt, 90);
   run(restored.value(), kDt, 90);
   EXPECT_EQ(restored.value().save_state(), original.save_state());
   // Without the warm start's impulses the run differs: the test above would see them lost.
   WorldStateData cold = data;
-  for (JointSlot& slot : cold.joints)
+  for (JointSlot& slot : cold.joints) {
     slot.joint.linear_impulse.setZero();
+    slot.joint.limit_impulse = slot.joint.motor_impulse = slot.joint.spring_impulse = 0;
+  }
   Result<World> without = world_of(original.settings(), cold);
   ASSERT_TRUE(without) << without.error();
   run(without.value(), kDt, 90);
@@ -432,13 +448,28 @@ TEST(WorldState, BadJointsAreRefusedNamingTheField) {
   s = good;
   s.joints[0].joint.b = s.joints[0].joint.a;
   refused(s, "joints[0].b");
+  s = good;
+  s.joints[1].joint.limit = {true, 1, -1};
+  refused(s, "joints[1].limit");
+  s = good;
+  s.joints[5].joint.reference_a *= 2;
+  refused(s, "joints[5].reference_a");
+  s = good;
+  s.joints[5].joint.motor.max_force = -1;
+  refused(s, "joints[5].motor.max_force");
+  s = good;
+  s.joints[2].joint.spring = {true, 0, 1, 0};  // a fixed joint
+  refused(s, "joints[2].spring");
+  s = good;
+  s.joints[4].joint.swing_impulse = std::nan("");
+  refused(s, "joints[4].impulses");
 }
 
 TEST(StateFormat, DamagedJointBytesAreRefusedOrStepSafely) {
   const World world = jointed_world();
   const std::string good = world.save_state();
-  // The joints' section ends the bytes (six slots of at most 207 bytes): damage falls there.
-  const std::size_t joints_from = good.size() - 6 * 180;
+  // The joints' section ends the bytes (seven slots of 5 to 365 bytes): damage falls there.
+  const std::size_t joints_from = good.size() - 7 * 300;
   std::mt19937_64 random(33);
   int refused = 0;
   for (int round = 0; round < 300; ++round) {

@@ -3,87 +3,16 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
+#include "joint_axial.h"
+#include "joint_geometry.h"
 #include "rotation.h"
 
 namespace tumble {
 namespace {
 
-// The world as body b: no mass, no motion, and its own frame.
-const SolverBody kWorldBody{};
-
-// The two bodies of a row, velocities and poses; the world's are the origin, at rest, and never
-// written.
-struct JointBodies {
-  SolverBody* a;
-  SolverBody* b;  // null for the world
-  const Pose& pose_a;
-  Pose pose_b;
-  const SolverBody& body_b() const { return b != nullptr ? *b : kWorldBody; }
-};
-
-JointBodies bodies_of(const JointRow& row, std::span<SolverBody> bodies,
-                      std::span<const Pose> poses) {
-  if (row.b == kWorldAnchor) return {&bodies[row.a], nullptr, poses[row.a], Pose{}};
-  return {&bodies[row.a], &bodies[row.b], poses[row.a], poses[row.b]};
-}
-
-Mat3 skew(const Vec3& v) {
-  Mat3 m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
-// Any unit vector perpendicular to the unit vector n.
-Vec3 perpendicular(const Vec3& n) {
-  const Vec3 axis = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
-  return n.cross(axis).normalized();
-}
-
-// Impulse p at the anchors (on b; a takes -p), lever arms ra and rb from the centres of mass.
-// A static body (inverse mass 0, zero inertia) is never written: it may be shared with other
-// islands.
-void apply_linear(JointBodies& j, const Vec3& ra, const Vec3& rb, const Vec3& p) {
-  if (j.a->inverse_mass > 0) {
-    j.a->v -= j.a->inverse_mass * p;
-    j.a->w -= j.a->inverse_inertia * ra.cross(p);
-  }
-  if (j.b != nullptr && j.b->inverse_mass > 0) {
-    j.b->v += j.b->inverse_mass * p;
-    j.b->w += j.b->inverse_inertia * rb.cross(p);
-  }
-}
-
-// Angular impulse l on b (a takes -l).
-void apply_angular(JointBodies& j, const Vec3& l) {
-  if (j.a->inverse_mass > 0) j.a->w -= j.a->inverse_inertia * l;
-  if (j.b != nullptr && j.b->inverse_mass > 0) j.b->w += j.b->inverse_inertia * l;
-}
-
-// The anchors' lever arms and world points at the bodies' present poses.
-struct Anchors {
-  Vec3 ra, rb, pa, pb;
-};
-
-Anchors anchors_of(const Joint& joint, const Pose& pose_a, const Pose& pose_b, bool world_b) {
-  Anchors anchors;
-  anchors.ra = pose_a.orientation * joint.local_a;
-  anchors.pa = pose_a.position + anchors.ra;
-  if (world_b) {
-    anchors.pb = joint.local_b;
-    anchors.rb = Vec3::Zero();
-  } else {
-    anchors.rb = pose_b.orientation * joint.local_b;
-    anchors.pb = pose_b.position + anchors.rb;
-  }
-  return anchors;
-}
-
-// The velocity of b's anchor relative to a's.
-Vec3 anchor_velocity(const JointBodies& j, const Anchors& anchors) {
-  const SolverBody& b = j.body_b();
-  return (b.v + b.w.cross(anchors.rb)) - (j.a->v + j.a->w.cross(anchors.ra));
-}
+using namespace joint_detail;
 
 // How far an anchor r (from the centre of mass) moves over a move of h: the body's translation
 // and its exact turn, as the move makes them.
@@ -218,57 +147,99 @@ double solve_distance(JointRow& row, JointBodies& j, const Anchors& anchors, con
   return std::abs(impulse) * k;
 }
 
+// A slider's two rows across its axis: b's anchor stays on the line through a's anchor along
+// a's axis (the rows' lever arm on a reaches b's anchor, as the offset's does).
+struct SliderRows {
+  AxialRow rows[2];
+  Eigen::Matrix2d k;
+  Eigen::Vector2d error;
+};
+
+SliderRows slider_rows(const Joint& joint, const Pose& pose_a, const Pose& pose_b, bool world_b,
+                       const SolverBody& a, const SolverBody& b) {
+  SliderRows s;
+  const Anchors anchors = anchors_of(joint, pose_a, pose_b, world_b);
+  const Vec3 axis = pose_a.orientation * joint.axis_a;
+  const Vec3 d = anchors.pb - anchors.pa;
+  const Vec3 t1 = perpendicular(axis), t2 = axis.cross(t1);
+  const Vec3 across[2] = {t1, t2};
+  for (int i = 0; i < 2; ++i) {
+    s.rows[i] = {across[i], -(anchors.ra + d).cross(across[i]), anchors.rb.cross(across[i])};
+    s.error[i] = d.dot(across[i]);
+  }
+  for (int i = 0; i < 2; ++i)
+    for (int k = 0; k < 2; ++k)
+      s.k(i, k) = (a.inverse_mass + b.inverse_mass) * across[i].dot(across[k]) +
+                  s.rows[i].angular_a.dot(a.inverse_inertia * s.rows[k].angular_a) +
+                  s.rows[i].angular_b.dot(b.inverse_inertia * s.rows[k].angular_b);
+  return s;
+}
+
+double solve_slider_across(JointRow& row, JointBodies& j) {
+  const SliderRows s = slider_rows(row.joint, j.pose_a, j.pose_b, j.world_b(), *j.a, j.body_b());
+  if (!(s.k.determinant() > 0)) return 0;
+  const Eigen::Vector2d rate(row_rate(s.rows[0], *j.a, j.body_b()),
+                             row_rate(s.rows[1], *j.a, j.body_b()));
+  const Eigen::Vector2d lambda = -s.k.ldlt().solve(rate);
+  for (int i = 0; i < 2; ++i)
+    apply_row(j, s.rows[i], lambda[i]);
+  row.joint.linear_impulse += lambda[0] * s.rows[0].linear + lambda[1] * s.rows[1].linear;
+  return (s.k * lambda).lpNorm<Eigen::Infinity>();
+}
+
 }  // namespace
 
 void warm_start_joint(const JointRow& row, std::span<SolverBody> bodies,
                       std::span<const Pose> poses) {
   JointBodies j = bodies_of(row, bodies, poses);
-  const Anchors anchors = anchors_of(row.joint, j.pose_a, j.pose_b, j.b == nullptr);
-  if (row.joint.kind == JointKind::kDistance) {
-    const Vec3 d = anchors.pb - anchors.pa;
-    const double length = d.norm();
-    if (length > 1e-12)
-      apply_linear(j, anchors.ra, anchors.rb, row.joint.axial_impulse / length * d);
-    return;
+  warm_start_axial(row, j);
+  const Anchors anchors = anchors_of(row.joint, j.pose_a, j.pose_b, j.world_b());
+  switch (row.joint.kind) {
+    case JointKind::kDistance: {
+      const Vec3 d = anchors.pb - anchors.pa;
+      const double length = d.norm();
+      if (length > 1e-12 && rigid_distance(row.joint))
+        apply_linear(j, anchors.ra, anchors.rb, row.joint.axial_impulse / length * d);
+      return;
+    }
+    case JointKind::kSlider:
+      // The rows across the axis reach b's anchor from a's centre.
+      apply_linear(j, anchors.pb - j.pose_a.position, anchors.rb, row.joint.linear_impulse);
+      break;
+    default:
+      apply_linear(j, anchors.ra, anchors.rb, row.joint.linear_impulse);
   }
-  apply_linear(j, anchors.ra, anchors.rb, row.joint.linear_impulse);
   apply_angular(j, row.joint.angular_impulse);
 }
 
 double solve_joint(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
                    const JointTarget& target) {
   JointBodies j = bodies_of(row, bodies, poses);
-  // The rotation first, then the point, whose lever arms the rotation changed last (Box2D v3's
+  // Springs, motors and limits first, so that the rows that must hold have the last word; then
+  // the rotation, then the point, whose lever arms the rotation changed last (Box2D v3's
   // revolute joint's order).
-  double change = 0;
+  double change = solve_axial(row, j, target);
   switch (row.joint.kind) {
     case JointKind::kHinge:
-      change = solve_hinge_axes(row, j, target);
+      change = std::max(change, solve_hinge_axes(row, j, target));
       break;
     case JointKind::kFixed:
-      change = solve_fixed_rotation(row, j);
+    case JointKind::kSlider:
+      change = std::max(change, solve_fixed_rotation(row, j));
       break;
     case JointKind::kBall:
     case JointKind::kDistance:
       break;
   }
-  const Anchors anchors = anchors_of(row.joint, j.pose_a, j.pose_b, j.b == nullptr);
+  if (row.joint.kind == JointKind::kSlider) return std::max(change, solve_slider_across(row, j));
+  const Anchors anchors = anchors_of(row.joint, j.pose_a, j.pose_b, j.world_b());
   if (row.joint.kind == JointKind::kDistance)
-    return std::max(change, solve_distance(row, j, anchors, target));
+    return rigid_distance(row.joint) ? std::max(change, solve_distance(row, j, anchors, target))
+                                     : change;
   return std::max(change, solve_point(row, j, anchors, target));
 }
 
 namespace {
-
-// A body moved by a correction: its pose, and its motion since the step start, which the
-// contacts' separations are measured from (current_separation). Statics and the world stay.
-void move_body(SolverBody* body, Pose* pose, const Vec3& dx, const Vec3& dtheta) {
-  if (body == nullptr || body->inverse_mass == 0) return;
-  pose->position += dx;
-  pose->orientation = rotated(pose->orientation, dtheta);
-  body->delta_position += dx;
-  body->delta_angle += dtheta;
-}
 
 struct MovingBodies {
   SolverBody* a;
@@ -300,7 +271,8 @@ void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
                  world_b ? nullptr : &poses[row.b]};
   const Joint& joint = row.joint;
   const SolverBody& b = m.body_b();
-  // The rotation first (it moves the anchors), then the point or the length.
+  // The bounds first, then the rotation (it moves the anchors), then the point or the length.
+  correct_axial(joint, m.a, m.b, m.pose_a, m.pose_b);
   if (joint.kind == JointKind::kHinge) {
     const HingeRows rows =
         hinge_rows(joint, m.pose_a->orientation, world_b ? nullptr : &m.pose_b->orientation,
@@ -309,17 +281,25 @@ void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
       const Eigen::Vector2d lambda = -rows.k.ldlt().solve(rows.error());
       displace_angular(m, lambda.x() * rows.g1 + lambda.y() * rows.g2);
     }
-  } else if (joint.kind == JointKind::kFixed) {
+  } else if (joint.kind == JointKind::kFixed || joint.kind == JointKind::kSlider) {
     const Mat3 k = m.a->inverse_inertia + b.inverse_inertia;
     const Quat qb = world_b ? Quat::Identity() : m.pose_b->orientation;
     const Vec3 error = rotation_error(joint, m.pose_a->orientation, qb);
     if (k.determinant() > 0) displace_angular(m, -k.ldlt().solve(error));
   }
+  if (joint.kind == JointKind::kSlider) {
+    const SliderRows s = slider_rows(joint, *m.pose_a, m.world_pose_b(), world_b, *m.a, b);
+    if (!(s.k.determinant() > 0)) return;
+    const Eigen::Vector2d lambda = -s.k.ldlt().solve(s.error);
+    for (int i = 0; i < 2; ++i)
+      displace_row(s.rows[i], lambda[i], m.a, m.b, m.pose_a, m.pose_b);
+    return;
+  }
   const Anchors anchors = anchors_of(joint, *m.pose_a, m.world_pose_b(), world_b);
   const Vec3 d = anchors.pb - anchors.pa;
   if (joint.kind == JointKind::kDistance) {
     const double length = d.norm();
-    if (!(length > 1e-12)) return;
+    if (!(length > 1e-12) || !rigid_distance(joint)) return;
     const Vec3 n = d / length;
     const Vec3 ra_n = anchors.ra.cross(n), rb_n = anchors.rb.cross(n);
     const double k = m.a->inverse_mass + b.inverse_mass + ra_n.dot(m.a->inverse_inertia * ra_n) +
@@ -333,23 +313,61 @@ void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
   displace_linear(m, anchors.ra, anchors.rb, -k.ldlt().solve(d));
 }
 
+JointReading read_joint(const Joint& joint, const Pose& pose_a, const Pose& pose_b,
+                        const SolverBody& a, const SolverBody& b) {
+  const bool world_b = joint.b == kWorldAnchor;
+  JointReading reading = read_axial(joint, pose_a, pose_b, a, b, world_b);
+  if (!(joint.impulse_time > 0)) return reading;
+  // The free coordinate's rows' share: along the row, as force (sliders, distance) or torque.
+  const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
+  Vec3 linear = joint.linear_impulse, angular = joint.angular_impulse;
+  if (c.exists) {
+    const double along = rigid_distance(joint)
+                             ? joint.axial_impulse
+                             : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse;
+    linear += along * c.row.linear;
+    if (c.row.linear.isZero()) angular += along * c.row.angular_b;
+  }
+  if (joint.swing_impulse != 0) {
+    const Swing swing = swing_of(joint, pose_a.orientation, pose_b.orientation);
+    if (swing.exists) angular -= joint.swing_impulse * swing.row.angular_b;
+  }
+  reading.force = linear / joint.impulse_time;
+  reading.torque = angular / joint.impulse_time;
+  return reading;
+}
+
 double joint_error(const Joint& joint, const Pose& pose_a, const Pose& pose_b) {
   const bool world_b = joint.b == kWorldAnchor;
+  const Quat qb = world_b ? Quat::Identity() : pose_b.orientation;
   const Anchors anchors = anchors_of(joint, pose_a, pose_b, world_b);
   const Vec3 d = anchors.pb - anchors.pa;
+  double bounds = 0;
+  if (joint.limit.enabled) {
+    const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
+    if (c.exists) bounds = limit_violation(joint, c.position);
+  }
+  if (joint.kind == JointKind::kBall && joint.max_swing < std::numbers::pi) {
+    const Swing swing = swing_of(joint, pose_a.orientation, qb);
+    if (swing.exists) bounds = std::max(bounds, swing.angle - joint.max_swing);
+  }
   switch (joint.kind) {
     case JointKind::kBall:
-      return d.norm();
+      return std::max(bounds, d.norm());
     case JointKind::kDistance:
-      return std::abs(d.norm() - joint.length);
+      return rigid_distance(joint) ? std::abs(d.norm() - joint.length) : bounds;
     case JointKind::kHinge: {
       const Vec3 axis_a = pose_a.orientation * joint.axis_a;
       const Vec3 axis_b = world_b ? joint.axis_b : Vec3(pose_b.orientation * joint.axis_b);
-      return std::max(d.norm(), axis_a.cross(axis_b).norm());
+      return std::max({bounds, d.norm(), axis_a.cross(axis_b).norm()});
     }
-    case JointKind::kFixed: {
-      const Quat qb = world_b ? Quat::Identity() : pose_b.orientation;
+    case JointKind::kFixed:
       return std::max(d.norm(), rotation_error(joint, pose_a.orientation, qb).norm());
+    case JointKind::kSlider: {
+      const Vec3 axis = pose_a.orientation * joint.axis_a;
+      const Vec3 across = d - d.dot(axis) * axis;
+      return std::max(
+          {bounds, across.norm(), rotation_error(joint, pose_a.orientation, qb).norm()});
     }
   }
   return 0;

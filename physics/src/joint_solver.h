@@ -35,9 +35,12 @@ void warm_start_joint(const JointRow& row, std::span<SolverBody> bodies,
 // heavier end kilometres.
 // The first is SHAKE's position step, the second RATTLE's velocity projection (Andersen 1983,
 // "Rattle: a velocity version of the Shake algorithm"): together they keep a pendulum's energy.
+// `substep` is the time the coming move takes, before the move or after it: the limits'
+// speculative margins and the springs and motors use it.
 struct JointTarget {
   double h = 0;
   double most_speed = 0;
+  double substep = 0;
 };
 
 // One Gauss-Seidel visit of the joint's rows. Returns the largest velocity change it gave (m/s).
@@ -51,8 +54,14 @@ double solve_joint(JointRow& row, std::span<SolverBody> bodies, std::span<const 
 void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
                             std::span<Pose> poses);
 
+// The joint's reading (joint.h) at the given poses and velocities (b: the world's, at rest, when
+// the joint holds to the world), from the impulses it stored.
+JointReading read_joint(const Joint& joint, const Pose& pose_a, const Pose& pose_b,
+                        const SolverBody& a, const SolverBody& b);
+
 // How far the joint is from holding, at the given poses: m for the anchors (or the length), rad
-// for the axes or rotation. For tests and reports.
+// for the axes or rotation, whichever is larger; a limit's or cone's overrun counts. For tests
+// and reports.
 double joint_error(const Joint& joint, const Pose& pose_a, const Pose& pose_b);
 
 }  // namespace tumble

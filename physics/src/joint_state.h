@@ -22,12 +22,24 @@ struct Joint {
   Vec3 axis_a = Vec3::UnitZ(), axis_b = Vec3::UnitZ();
   // A fixed joint's rotation of b relative to a when made: q_a^-1 q_b.
   Quat relative = Quat::Identity();
+  // A direction perpendicular to the axis in each body's axes (world for the world), the same
+  // direction when made: a hinge's angle and a ball's twist are measured between them.
+  Vec3 reference_a = Vec3::UnitX(), reference_b = Vec3::UnitX();
   double length = 0;  // a distance joint's
   bool collide_connected = false;
+  JointLimit limit;
+  JointMotor motor;
+  JointSpring spring;
+  double max_swing = 3.141592653589793;
   // Warm start, world: the impulse at the anchors (N s, on b; a takes the opposite), the angular
   // impulse (N m s, on b), and a distance joint's along its rod.
   Vec3 linear_impulse = Vec3::Zero(), angular_impulse = Vec3::Zero();
   double axial_impulse = 0;
+  // Along the free coordinate (N s or N m s): the limit's, the motor's and the spring's; a ball's
+  // swing cone's about the lean.
+  double limit_impulse = 0, motor_impulse = 0, spring_impulse = 0, swing_impulse = 0;
+  // What the last step's impulses were spread over (s): a substep, or the step (pgs).
+  double impulse_time = 0;
 };
 
 struct JointSlot {

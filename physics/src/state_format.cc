@@ -1,4 +1,6 @@
 #include "state_format.h"
+
+#include "joint_geometry.h"
 #include "shape_state.h"
 
 #include <bit>
@@ -281,9 +283,53 @@ void put_joint(Writer& w, const Joint& j) {
   w.put(j.axial_impulse);
 }
 
+// The drives section of a joint (flag kStateJointDrives): what joints carry beyond rigid rows.
+void put_joint_drives(Writer& w, const Joint& j) {
+  w.put(j.reference_a);
+  w.put(j.reference_b);
+  w.put(static_cast<std::uint8_t>(j.limit.enabled));
+  w.put(j.limit.lower);
+  w.put(j.limit.upper);
+  w.put(static_cast<std::uint8_t>(j.motor.enabled));
+  w.put(j.motor.speed);
+  w.put(j.motor.max_force);
+  w.put(static_cast<std::uint8_t>(j.spring.enabled));
+  w.put(j.spring.target);
+  w.put(j.spring.stiffness);
+  w.put(j.spring.damping);
+  w.put(j.max_swing);
+  w.put(j.limit_impulse);
+  w.put(j.motor_impulse);
+  w.put(j.spring_impulse);
+  w.put(j.swing_impulse);
+  w.put(j.impulse_time);
+}
+
+Status take_joint_drives(Reader& r, Joint* j) {
+  j->reference_a = r.vec3("reference_a");
+  j->reference_b = r.vec3("reference_b");
+  j->limit.enabled = take_flag(r, "limit.enabled");
+  j->limit.lower = r.take<double>("limit.lower");
+  j->limit.upper = r.take<double>("limit.upper");
+  j->motor.enabled = take_flag(r, "motor.enabled");
+  j->motor.speed = r.take<double>("motor.speed");
+  j->motor.max_force = r.take<double>("motor.max_force");
+  j->spring.enabled = take_flag(r, "spring.enabled");
+  j->spring.target = r.take<double>("spring.target");
+  j->spring.stiffness = r.take<double>("spring.stiffness");
+  j->spring.damping = r.take<double>("spring.damping");
+  j->max_swing = r.take<double>("max_swing");
+  j->limit_impulse = r.take<double>("limit_impulse");
+  j->motor_impulse = r.take<double>("motor_impulse");
+  j->spring_impulse = r.take<double>("spring_impulse");
+  j->swing_impulse = r.take<double>("swing_impulse");
+  j->impulse_time = r.take<double>("impulse_time");
+  return r.status();
+}
+
 Status take_joint(Reader& r, Joint* j) {
   const auto kind = r.take<std::uint8_t>("kind");
-  if (r.ok() && kind > static_cast<std::uint8_t>(JointKind::kDistance))
+  if (r.ok() && kind > static_cast<std::uint8_t>(JointKind::kSlider))
     return Status::error("kind: unknown joint kind " + std::to_string(kind));
   j->kind = static_cast<JointKind>(kind);
   j->a = r.take<std::uint32_t>("a");
@@ -301,8 +347,11 @@ Status take_joint(Reader& r, Joint* j) {
   return r.status();  // the values are checked with the whole state (world_from)
 }
 
-// Header flags: a joints section follows the contact pairs.
+// Header flags: a joints section follows the contact pairs; each joint carries its drives
+// (limits, motor, spring, their impulses). States written before drives existed have flag 1
+// alone: their joints read with none.
 constexpr std::uint32_t kStateHasJoints = 1;
+constexpr std::uint32_t kStateJointDrives = 2;
 constexpr std::size_t kFlagsOffset = 36;  // magic 8, version 4, header 4, length 8, counts 12
 
 // The least bytes of one entry, so that counts are checked against what is left.
@@ -324,7 +373,7 @@ std::string encode_state(const WorldStateData& state) {
   w.put(static_cast<std::uint32_t>(state.slots.size()));
   w.put(static_cast<std::uint32_t>(state.free_slots.size()));
   w.put(static_cast<std::uint32_t>(state.contact_pairs.size()));
-  w.put(state.joints.empty() ? std::uint32_t{0} : kStateHasJoints);
+  w.put(state.joints.empty() ? std::uint32_t{0} : kStateHasJoints | kStateJointDrives);
   w.put(state.time);
   w.put(state.step);
   for (const BodySlotState& slot : state.slots) {
@@ -342,7 +391,9 @@ std::string encode_state(const WorldStateData& state) {
     for (const JointSlot& slot : state.joints) {
       w.put(slot.generation);
       w.put(static_cast<std::uint8_t>(slot.alive));
-      if (slot.alive) put_joint(w, slot.joint);
+      if (!slot.alive) continue;
+      put_joint(w, slot.joint);
+      put_joint_drives(w, slot.joint);
     }
     for (std::uint32_t slot : state.free_joints)
       w.put(slot);
@@ -374,7 +425,8 @@ Result<StateSizes> read_state_header(std::string_view bytes) {
   if (sizes.bytes != bytes.size())
     return Status::error("length: the header says " + std::to_string(sizes.bytes) +
                          " bytes, there are " + std::to_string(bytes.size()));
-  if ((flags & ~kStateHasJoints) != 0)
+  if ((flags & ~(kStateHasJoints | kStateJointDrives)) != 0 ||
+      (flags & (kStateHasJoints | kStateJointDrives)) == kStateJointDrives)
     return Status::error("flags: unknown flags " + std::to_string(flags));
   // Every entry takes bytes: counts the length cannot hold are refused before anything is made.
   const std::size_t body = bytes.size() - kStateHeaderBytes;
@@ -422,6 +474,14 @@ Result<WorldStateData> decode_state(std::string_view bytes) {
       slot.generation = r.take<std::uint32_t>("generation");
       slot.alive = take_flag(r, "alive");
       Status s = slot.alive ? take_joint(r, &slot.joint) : r.status();
+      if (s && slot.alive && (flags & kStateJointDrives) != 0) {
+        s = take_joint_drives(r, &slot.joint);
+      } else if (s && slot.alive) {
+        // No drives: the angles count from how the joint was made, as they would have.
+        Joint& joint = slot.joint;
+        joint.reference_a = joint_detail::perpendicular(joint.axis_a.normalized());
+        joint.reference_b = joint.relative.conjugate() * joint.reference_a;
+      }
       if (!s) return s.within("joints[" + std::to_string(i) + "].");
     }
     state.free_joints.resize(free_count);  // bounded by the bytes there were (count)

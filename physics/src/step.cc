@@ -134,10 +134,12 @@ class SerialIsland {
     if (!c_.joints.empty()) {
       // Before a move: the soft solver's sweeps with bias, and every pgs sweep (its move follows).
       const bool move_ahead = soft != nullptr || report_->solver == IslandSolver::kPgs;
-      const JointTarget target{move_ahead ? h : 0.0, c_.settings.solver.max_push_velocity};
-      for (std::uint32_t j : c_.joints)
-        change = std::max(change,
-                          solve_joint(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses, target));
+      const JointTarget target{move_ahead ? h : 0.0, c_.settings.solver.max_push_velocity, h};
+      for (std::uint32_t j : c_.joints) {
+        JointRow& row = c_.scratch.joint_rows[j];
+        row.joint.impulse_time = h;
+        change = std::max(change, solve_joint(row, bodies_, c_.scratch.poses, target));
+      }
     }
     if (c_.rows.empty()) return change;
     return std::max(change, solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_,

@@ -2,6 +2,7 @@
 // with the contacts of their islands).
 #include <algorithm>
 
+#include "joint_geometry.h"
 #include "joint_solver.h"
 #include "joint_state.h"
 #include "physics/world.h"
@@ -36,21 +37,37 @@ Result<JointId> World::create_joint(const JointDef& def) {
   joint.b = world_b ? kWorldAnchor : def.b.index;
   joint.collide_connected = def.collide_connected;
   const Vec3 end_b = def.kind == JointKind::kDistance ? def.anchor_b : def.anchor;
-  const Vec3 axis = def.kind == JointKind::kHinge ? def.axis.normalized() : Vec3::UnitZ();
+  const bool has_axis = def.kind == JointKind::kHinge || def.kind == JointKind::kSlider ||
+                        def.kind == JointKind::kBall;
+  const Vec3 axis = has_axis ? def.axis.normalized() : Vec3::UnitZ();
+  const Vec3 reference = joint_detail::perpendicular(axis);
   const Quat qa_inverse = a.orientation.conjugate();
   joint.local_a = qa_inverse * (def.anchor - a.position);
   joint.axis_a = qa_inverse * axis;
+  joint.reference_a = qa_inverse * reference;
   if (world_b) {
     joint.local_b = end_b;
     joint.axis_b = axis;
+    joint.reference_b = reference;
     joint.relative = qa_inverse;
   } else {
     const Quat qb_inverse = b->orientation.conjugate();
     joint.local_b = qb_inverse * (end_b - b->position);
     joint.axis_b = qb_inverse * axis;
+    joint.reference_b = qb_inverse * reference;
     joint.relative = qa_inverse * b->orientation;
   }
   joint.length = def.length > 0 ? def.length : (def.anchor_b - def.anchor).norm();
+  joint.limit = def.limit;
+  joint.motor = def.motor;
+  joint.spring = def.spring;
+  joint.max_swing = def.max_swing;
+  if (def.kind == JointKind::kDistance && def.limit.enabled && def.limit.lower == def.limit.upper) {
+    // A range of one length is a rod of that length.
+    joint.length = def.limit.lower;
+    joint.limit = JointLimit{};
+    if (!(joint.length > 0)) return Status::error("limit: a distance joint's length must be > 0");
+  }
 
   std::uint32_t index;
   if (!free_joint_slots_.empty()) {
@@ -72,9 +89,7 @@ Result<JointId> World::create_joint(const JointDef& def) {
     unjoined_pairs_.insert(std::upper_bound(unjoined_pairs_.begin(), unjoined_pairs_.end(), key),
                            key);
   }
-  for (std::uint32_t body : {joint.a, joint.b})
-    if (body != kWorldAnchor && bodies_[body].body.asleep)
-      wake_island(bodies_[body].body.sleep_island);
+  wake_joint(joint);
   return JointId{index, slot.generation};
 }
 
@@ -111,6 +126,47 @@ Result<double> World::joint_error(JointId id) const {
   const Joint& joint = joints_[id.index].joint;
   const Pose pose_b = joint.b == kWorldAnchor ? Pose{} : bodies_[joint.b].body.pose();
   return tumble::joint_error(joint, bodies_[joint.a].body.pose(), pose_b);
+}
+
+Status World::set_joint_motor(JointId id, const JointMotor& motor) {
+  if (!contains(id)) return Status::not_found("joint: no joint with this id");
+  Joint& joint = joints_[id.index].joint;
+  if (Status s = validate(joint.kind, motor); !s) return s;
+  joint.motor = motor;
+  if (!motor.enabled) joint.motor_impulse = 0;
+  wake_joint(joint);
+  return Status::ok();
+}
+
+Status World::set_joint_spring(JointId id, const JointSpring& spring) {
+  if (!contains(id)) return Status::not_found("joint: no joint with this id");
+  Joint& joint = joints_[id.index].joint;
+  if (Status s = validate(joint.kind, spring); !s) return s;
+  joint.spring = spring;
+  if (!spring.enabled) joint.spring_impulse = 0;
+  wake_joint(joint);
+  return Status::ok();
+}
+
+void World::wake_joint(const Joint& joint) {
+  for (std::uint32_t body : {joint.a, joint.b})
+    if (body != kWorldAnchor && bodies_[body].body.asleep)
+      wake_island(bodies_[body].body.sleep_island);
+}
+
+Result<JointReading> World::joint_reading(JointId id) const {
+  if (!contains(id)) return Status::not_found("joint: no joint with this id");
+  const Joint& joint = joints_[id.index].joint;
+  auto motion = [](const Body& body) {
+    SolverBody s;
+    s.v = body.linear_velocity;
+    s.w = body.angular_velocity;
+    return s;
+  };
+  const Body& a = bodies_[joint.a].body;
+  if (joint.b == kWorldAnchor) return read_joint(joint, a.pose(), Pose{}, motion(a), SolverBody{});
+  const Body& b = bodies_[joint.b].body;
+  return read_joint(joint, a.pose(), b.pose(), motion(a), motion(b));
 }
 
 void World::remove_joints_of(std::uint32_t body_slot) {
@@ -198,6 +254,11 @@ void World::store_joint_impulses() {
     joint.linear_impulse = row.joint.linear_impulse;
     joint.angular_impulse = row.joint.angular_impulse;
     joint.axial_impulse = row.joint.axial_impulse;
+    joint.limit_impulse = row.joint.limit_impulse;
+    joint.motor_impulse = row.joint.motor_impulse;
+    joint.spring_impulse = row.joint.spring_impulse;
+    joint.swing_impulse = row.joint.swing_impulse;
+    joint.impulse_time = row.joint.impulse_time;
   }
 }
 

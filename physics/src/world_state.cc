@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <span>
 #include <string>
 
@@ -114,9 +115,20 @@ Status check_joint(const Joint& joint, std::span<const BodySlotState> slots) {
       (joint.kind == JointKind::kDistance && !(joint.length > 0)))
     return Status::error("length: must be finite, and > 0 for a distance joint");
   if (!is_finite(joint.linear_impulse) || !is_finite(joint.angular_impulse) ||
-      !std::isfinite(joint.axial_impulse))
+      !std::isfinite(joint.axial_impulse) || !std::isfinite(joint.limit_impulse) ||
+      !std::isfinite(joint.motor_impulse) || !std::isfinite(joint.spring_impulse) ||
+      !std::isfinite(joint.swing_impulse))
     return Status::error("impulses: must be finite");
-  return Status::ok();
+  if (!(std::isfinite(joint.impulse_time) && joint.impulse_time >= 0))
+    return Status::error("impulse_time: must be finite and >= 0");
+  if (!unit(joint.reference_a) || !unit(joint.reference_b))
+    return Status::error("reference_a, reference_b: must be unit vectors");
+  if (!(joint.max_swing > 0 && joint.max_swing <= std::numbers::pi) ||
+      (joint.kind != JointKind::kBall && joint.max_swing < std::numbers::pi))
+    return Status::error("max_swing: must be in (0, pi], below pi for a ball joint alone");
+  if (Status s = validate(joint.kind, joint.limit); !s) return s;
+  if (Status s = validate(joint.kind, joint.motor); !s) return s;
+  return validate(joint.kind, joint.spring);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // misspelt key never silently falls back to a default.
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -180,7 +181,8 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
 constexpr std::pair<const char*, JointKind> kJointKinds[] = {{"ball", JointKind::kBall},
                                                              {"hinge", JointKind::kHinge},
                                                              {"fixed", JointKind::kFixed},
-                                                             {"distance", JointKind::kDistance}};
+                                                             {"distance", JointKind::kDistance},
+                                                             {"slider", JointKind::kSlider}};
 
 const char* joint_kind_name(JointKind kind) {
   for (const auto& [name, value] : kJointKinds)
@@ -208,7 +210,7 @@ SceneJoint read_joint(const Json& json, const std::string& path, std::size_t bod
       joint.def.kind = value;
       known = true;
     }
-  if (!known) fail(r.child("kind"), "must be ball, hinge, fixed or distance");
+  if (!known) fail(r.child("kind"), "must be ball, hinge, fixed, distance or slider");
   const Json* a = r.find("a");
   if (a == nullptr) fail(r.child("a"), "must name a body");
   joint.a = body_index(*a, r.child("a"), bodies);
@@ -219,6 +221,23 @@ SceneJoint read_joint(const Json& json, const std::string& path, std::size_t bod
   joint.def.axis = r.vector("axis", joint.def.axis);
   joint.def.length = r.number("length", joint.def.length);
   joint.def.collide_connected = r.boolean("collide_connected", joint.def.collide_connected);
+  if (const Json* limit = r.find("limit"); limit != nullptr) {
+    if (!limit->is_array() || limit->size() != 2) fail(r.child("limit"), "must be [lower, upper]");
+    joint.def.limit = {true, ObjectReader::read_number((*limit)[0], r.child("limit") + "[0]"),
+                       ObjectReader::read_number((*limit)[1], r.child("limit") + "[1]")};
+  }
+  if (const Json* motor = r.find("motor"); motor != nullptr) {
+    ObjectReader m(*motor, r.child("motor"));
+    joint.def.motor = {true, m.number("speed", 0), m.number("max_force", 0)};
+    m.reject_unknown();
+  }
+  if (const Json* spring = r.find("spring"); spring != nullptr) {
+    ObjectReader m(*spring, r.child("spring"));
+    joint.def.spring = {true, m.number("target", 0), m.number("stiffness", 0),
+                        m.number("damping", 0)};
+    m.reject_unknown();
+  }
+  joint.def.max_swing = r.number("max_swing", joint.def.max_swing);
   r.reject_unknown();
   // The engine's checks of what needs no world, with this path (the ids are filled in later).
   JointDef check = joint.def;
@@ -241,8 +260,18 @@ Json joint_json(const SceneJoint& joint) {
     out["anchor_b"] = vector_json(joint.def.anchor_b);
     out["length"] = joint.def.length;
   }
-  if (joint.def.kind == JointKind::kHinge) out["axis"] = vector_json(joint.def.axis);
+  if (joint.def.kind == JointKind::kHinge || joint.def.kind == JointKind::kSlider ||
+      (joint.def.kind == JointKind::kBall && joint.def.max_swing < std::numbers::pi))
+    out["axis"] = vector_json(joint.def.axis);
   out["collide_connected"] = joint.def.collide_connected;
+  if (joint.def.limit.enabled) out["limit"] = {joint.def.limit.lower, joint.def.limit.upper};
+  if (joint.def.motor.enabled)
+    out["motor"] = {{"speed", joint.def.motor.speed}, {"max_force", joint.def.motor.max_force}};
+  if (joint.def.spring.enabled)
+    out["spring"] = {{"target", joint.def.spring.target},
+                     {"stiffness", joint.def.spring.stiffness},
+                     {"damping", joint.def.spring.damping}};
+  if (joint.def.max_swing < std::numbers::pi) out["max_swing"] = joint.def.max_swing;
   return out;
 }
 

@@ -26,7 +26,37 @@ enum class JointKind : std::uint8_t {
   kBall,      // the anchor points coincide; any rotation (spherical joint)
   kHinge,     // the anchor points coincide; rotation about `axis` alone (revolute joint)
   kFixed,     // the anchor points coincide and the relative rotation stays as made (weld)
-  kDistance,  // the two anchor points stay `length` apart (a rigid rod with ball ends)
+  kDistance,  // the two anchor points stay `length` apart (a rod with ball ends), or in `limit`
+  kSlider,    // no rotation; the anchors slide along `axis` alone (prismatic joint)
+};
+
+// A joint's free coordinate: a hinge's angle (rad, b's turn about the axis from how it was made,
+// in (-pi, pi]), a slider's offset (m, b's anchor from a's along the axis), a distance joint's
+// length (m), a ball's twist (rad, about its axis). Fixed joints have none.
+
+// Bounds on the free coordinate: hinge and ball twist within [-pi, pi], distance within [0, inf).
+// lower == upper locks it.
+struct JointLimit {
+  bool enabled = false;
+  double lower = 0, upper = 0;
+};
+
+// Drives the free coordinate's speed (rad/s or m/s) with at most max_force (N m or N): hinges
+// and sliders.
+struct JointMotor {
+  bool enabled = false;
+  double speed = 0;
+  double max_force = 0;
+};
+
+// Pulls the free coordinate toward `target` with the stiffness (N m/rad or N/m) and damping
+// (N m s/rad or N s/m) given, implicitly (a stiff spring does not blow up): hinges, sliders, and
+// distance joints, whose spring rests at `length` (target unused, 0).
+struct JointSpring {
+  bool enabled = false;
+  double target = 0;
+  double stiffness = 0;
+  double damping = 0;
 };
 
 struct JointDef {
@@ -37,16 +67,40 @@ struct JointDef {
   Vec3 anchor = Vec3::Zero();
   // m, world: a distance joint's end on body b (or a point fixed in the world).
   Vec3 anchor_b = Vec3::Zero();
-  // A hinge's axis, world; any length above 1e-9 (it is normalised).
+  // A hinge's or slider's axis, a ball's twist axis (for max_swing and limit), world; any length
+  // above 1e-9 (it is normalised).
   Vec3 axis = Vec3::UnitZ();
   // A distance joint's length (m); 0 takes the anchors' distance when the joint is made.
   double length = 0;
   // Whether the two bodies still collide with each other (most joints want them not to).
   bool collide_connected = false;
+  JointLimit limit;
+  JointMotor motor;
+  JointSpring spring;
+  // A ball's swing cone: the most b's axis may lean from a's (rad, in (0, pi]; pi: free).
+  double max_swing = 3.141592653589793;
+};
+
+// What a joint does at the bodies' present poses: its free coordinate (JointLimit's comment;
+// 0 for fixed joints) and that coordinate's rate, and the reaction the joint gave over the last
+// step, on body b (a took the opposite): force (N) and torque about b's anchor (N m), world.
+// `effort` is the part along the free coordinate (N m or N), positive where it pushes the
+// coordinate up: motor, spring and limit together (a distance joint's: its ends pushed apart, so
+// a hanging rod reads negative).
+struct JointReading {
+  double position = 0;
+  double speed = 0;
+  double effort = 0;
+  Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();
 };
 
 // Checks what can be checked without a world (finite values, an axis, the length); the message
 // names the field ("axis: must not be zero").
 Status validate(const JointDef& def);
+// The parts checked for a kind (a running joint's motor and spring may change).
+Status validate(JointKind kind, const JointLimit& limit);
+Status validate(JointKind kind, const JointMotor& motor);
+Status validate(JointKind kind, const JointSpring& spring);
 
 }  // namespace tumble

@@ -65,6 +65,7 @@ struct ImpulseAt {
 };
 
 struct StepScratch;
+struct Joint;
 struct JointSlot;
 
 // What happened to a body since the world's events were last cleared (World::body_events): the
@@ -131,6 +132,12 @@ class World {
   // How far the joint is from holding at the bodies' present poses: m for its anchors (or its
   // length), rad for its axes or rotation, whichever is larger.
   Result<double> joint_error(JointId id) const;
+  // A running joint's motor or spring (joint.h), changed for the coming steps (its bodies wake),
+  // or refused naming the field ("motor: only hinges and sliders have one").
+  Status set_joint_motor(JointId id, const JointMotor& motor);
+  Status set_joint_spring(JointId id, const JointSpring& spring);
+  // The joint's coordinate, its rate and the reaction it gave over the last step (joint.h).
+  Result<JointReading> joint_reading(JointId id) const;
 
   // The whole state (settings apart: settings()) as bytes in the engine's own versioned format
   // (docs/STATE_FORMAT.md): a world made from them steps on exactly as this one would, bit for bit.
@@ -221,6 +228,7 @@ class World {
   // once per joint: the narrow phase skips them.
   std::vector<std::uint64_t> unjoined_pairs_;
   void remove_joints_of(std::uint32_t body_slot);
+  void wake_joint(const Joint& joint);  // its sleeping bodies
   // joint_count_, joints_of_body_ and unjoined_pairs_ from joints_ (a restored state).
   void restore_joint_indexes();
   bool unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const;

@@ -1,0 +1,169 @@
+#include "joint_axial.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace tumble {
+namespace {
+
+using namespace joint_detail;
+
+constexpr double kPi = std::numbers::pi;
+
+// An angle's difference taken the short way round, in (-pi, pi].
+double wrapped(double angle) {
+  angle = std::remainder(angle, 2 * kPi);
+  return angle == -kPi ? kPi : angle;
+}
+
+bool is_angle(JointKind kind) {
+  return kind == JointKind::kHinge || kind == JointKind::kBall;
+}
+
+// The spring's stretch: the coordinate's distance from where the spring rests.
+double stretch(const Joint& joint, double position) {
+  if (joint.kind == JointKind::kDistance) return position - joint.length;
+  const double d = position - joint.spring.target;
+  return is_angle(joint.kind) ? wrapped(d) : d;
+}
+
+bool has_cone(const Joint& joint) {
+  return joint.kind == JointKind::kBall && joint.max_swing < kPi;
+}
+
+AxialRow negated(const AxialRow& row) {
+  return {-row.linear, -row.angular_a, -row.angular_b};
+}
+
+// A one-sided row: gap >= 0 is what must hold (its rate is the row's), the impulse accumulated in
+// *impulse stays >= 0. The gap may close over the coming move (the speculative margin), no more.
+double solve_bound(JointBodies& j, const AxialRow& row, double mass, double gap, double h,
+                   double* impulse) {
+  const double rate = row_rate(row, *j.a, j.body_b());
+  const double step = -(rate + std::max(gap, 0.0) / h) / mass;
+  const double total = std::max(*impulse + step, 0.0);
+  const double applied = total - *impulse;
+  *impulse = total;
+  apply_row(j, row, applied);
+  return std::abs(applied) * mass;
+}
+
+}  // namespace
+
+void warm_start_axial(const JointRow& row, JointBodies& j) {
+  const Joint& joint = row.joint;
+  if (has_cone(joint) && joint.swing_impulse != 0) {
+    const Swing swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
+    if (swing.exists) apply_row(j, negated(swing.row), joint.swing_impulse);
+  }
+  const double along = joint.limit_impulse + joint.motor_impulse + joint.spring_impulse;
+  if (along == 0) return;
+  const FreeCoordinate c = free_coordinate(joint, j.pose_a, j.pose_b, j.world_b());
+  if (c.exists) apply_row(j, c.row, along);
+}
+
+double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
+  Joint& joint = row.joint;
+  const SolverBody& b = j.body_b();
+  const double h = target.substep;
+  double change = 0;
+  const bool drives = joint.spring.enabled || joint.motor.enabled || joint.limit.enabled;
+  const FreeCoordinate c =
+      drives ? free_coordinate(joint, j.pose_a, j.pose_b, j.world_b()) : FreeCoordinate{};
+  const double mass = c.exists ? row_mass(c.row, *j.a, b) : 0;
+  if (mass > 0) {
+    // The spring acts over the coming move, once: in the sweeps before it (a relaxation sweep's
+    // visit would damp it twice over).
+    if (joint.spring.enabled && target.h > 0) {
+      // Implicit Euler on the spring-damper: the impulse that makes the rate at the move's end
+      // what the spring and damper ask of it, the impulse itself included (gamma).
+      const double softness = joint.spring.damping + h * joint.spring.stiffness;
+      const double gamma = 1 / (h * softness);
+      const double bias = joint.spring.stiffness * stretch(joint, c.position) / softness;
+      const double rate = row_rate(c.row, *j.a, b);
+      const double impulse = -(rate + bias + gamma * joint.spring_impulse) / (mass + gamma);
+      joint.spring_impulse += impulse;
+      apply_row(j, c.row, impulse);
+      change = std::max(change, std::abs(impulse) * mass);
+    }
+    if (joint.motor.enabled) {
+      const double most = joint.motor.max_force * h;
+      const double rate = row_rate(c.row, *j.a, b);
+      const double total =
+          std::clamp(joint.motor_impulse - (rate - joint.motor.speed) / mass, -most, most);
+      const double applied = total - joint.motor_impulse;
+      joint.motor_impulse = total;
+      apply_row(j, c.row, applied);
+      change = std::max(change, std::abs(applied) * mass);
+    }
+    if (joint.limit.enabled) {
+      if (joint.limit.lower == joint.limit.upper) {
+        // Locked: an equality, its error closed by the position passes.
+        const double impulse = -row_rate(c.row, *j.a, b) / mass;
+        joint.limit_impulse += impulse;
+        apply_row(j, c.row, impulse);
+        change = std::max(change, std::abs(impulse) * mass);
+      } else if (c.position - joint.limit.lower < joint.limit.upper - c.position) {
+        // Nearer the lower bound: the impulse pushes the coordinate up (>= 0).
+        change = std::max(change, solve_bound(j, c.row, mass, c.position - joint.limit.lower, h,
+                                              &joint.limit_impulse));
+      } else {
+        double down = -joint.limit_impulse;
+        change = std::max(
+            change, solve_bound(j, negated(c.row), mass, joint.limit.upper - c.position, h, &down));
+        joint.limit_impulse = -down;
+      }
+    }
+  }
+  if (has_cone(joint)) {
+    const Swing swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
+    const double cone_mass = swing.exists ? row_mass(swing.row, *j.a, b) : 0;
+    if (cone_mass > 0)
+      change =
+          std::max(change, solve_bound(j, negated(swing.row), cone_mass,
+                                       joint.max_swing - swing.angle, h, &joint.swing_impulse));
+  }
+  return change;
+}
+
+void correct_axial(const Joint& joint, SolverBody* a, SolverBody* b, Pose* pose_a, Pose* pose_b) {
+  const bool world_b = b == nullptr;
+  const SolverBody& body_b = world_b ? kWorldBody : *b;
+  Pose world;
+  Pose* pb = world_b ? &world : pose_b;
+  if (has_cone(joint)) {
+    const Swing swing = swing_of(joint, pose_a->orientation, pb->orientation);
+    const double mass = swing.exists ? row_mass(swing.row, *a, body_b) : 0;
+    const double over = swing.angle - joint.max_swing;
+    if (mass > 0 && over > 0) displace_row(swing.row, -over / mass, a, b, pose_a, pose_b);
+  }
+  if (!joint.limit.enabled) return;
+  const FreeCoordinate c = free_coordinate(joint, *pose_a, *pb, world_b);
+  const double mass = c.exists ? row_mass(c.row, *a, body_b) : 0;
+  if (!(mass > 0)) return;
+  double error = 0;  // the coordinate's distance past its bound, signed as the coordinate
+  if (c.position < joint.limit.lower || joint.limit.lower == joint.limit.upper)
+    error = c.position - joint.limit.lower;
+  else if (c.position > joint.limit.upper)
+    error = c.position - joint.limit.upper;
+  if (error != 0) displace_row(c.row, -error / mass, a, b, pose_a, pose_b);
+}
+
+JointReading read_axial(const Joint& joint, const Pose& pose_a, const Pose& pose_b,
+                        const SolverBody& a, const SolverBody& b, bool world_b) {
+  JointReading reading;
+  const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
+  if (!c.exists) return reading;
+  reading.position = c.position;
+  reading.speed = row_rate(c.row, a, b);
+  if (joint.impulse_time > 0) {
+    const double along = rigid_distance(joint)
+                             ? joint.axial_impulse
+                             : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse;
+    reading.effort = along / joint.impulse_time;
+  }
+  return reading;
+}
+
+}  // namespace tumble

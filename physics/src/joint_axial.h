@@ -1,0 +1,29 @@
+// The rows along a joint's free coordinate (joint.h): springs, motors and limits on a hinge's
+// angle, a slider's offset, a distance joint's length and a ball's twist, and a ball's swing cone.
+// Limits are one-sided rows with a speculative margin (the coordinate may close the gap to its
+// bound over the coming move, no more: Box2D v3's joint limits); a spring is the implicit
+// spring-damper row (Catto, "Soft constraints", GDC 2011), stable however stiff; a motor's impulse
+// is bounded by its force over the time it acts. Their errors are closed by the position passes,
+// as the joints' own (joint_solver.h).
+#pragma once
+
+#include "joint_geometry.h"
+
+namespace tumble {
+
+// Applies the free coordinate's rows' impulses from the last step: the warm start.
+void warm_start_axial(const JointRow& row, joint_detail::JointBodies& j);
+
+// One Gauss-Seidel visit of the rows (spring, motor, limit, cone, in that order: the limit has the
+// last word). Returns the largest velocity change it gave.
+double solve_axial(JointRow& row, joint_detail::JointBodies& j, const JointTarget& target);
+
+// One position pass over the limits and the cone: a coordinate beyond its bound is put back on it
+// through the inverse masses (velocities untouched).
+void correct_axial(const Joint& joint, SolverBody* a, SolverBody* b, Pose* pose_a, Pose* pose_b);
+
+// The reading (joint.h) from poses and velocities; the effort from the impulses stored.
+JointReading read_axial(const Joint& joint, const Pose& pose_a, const Pose& pose_b,
+                        const SolverBody& a, const SolverBody& b, bool world_b);
+
+}  // namespace tumble
