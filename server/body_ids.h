@@ -1,7 +1,7 @@
-// The ids clients see. world.proto promises that an id never names another body, across every
-// removal, reset, scene load and restore; the engine's BodyId (slot and generation) starts over
-// with each new World, so the server hands out its own: a counter that never goes back, mapped
-// to the engine's ids both ways.
+// The ids clients see. world.proto promises that an id never names another body (or joint),
+// across every removal, reset, scene load and restore; the engine's ids (slot and generation)
+// start over with each new World, so the server hands out its own: a counter that never goes
+// back, mapped to the engine's ids both ways. Bodies and joints each have their own counter.
 #pragma once
 
 #include <cstdint>
@@ -13,34 +13,57 @@
 
 namespace tumble::server {
 
-class BodyIds {
+// How a world lists the things of one kind by slot.
+struct BodySlots {
+  using Id = BodyId;
+  static std::uint32_t count(const World& world) { return world.slot_count(); }
+  static BodyId at(const World& world, std::uint32_t slot) { return world.id_at(slot); }
+};
+struct JointSlots {
+  using Id = JointId;
+  static std::uint32_t count(const World& world) { return world.joint_slot_count(); }
+  static JointId at(const World& world, std::uint32_t slot) { return world.joint_at(slot); }
+};
+
+template <class Slots>
+class SlotIds {
  public:
-  // Follows the world after a change: a body new to its slot gets the next id, a body gone
-  // loses its id for good.
+  using Id = typename Slots::Id;
+  // Follows the world after a change: a thing new to its slot gets the next id, one gone loses
+  // its id for good.
   void sync(const World& world);
-  // Forgets every body (the world was replaced); the counter goes on.
+  // Forgets everything (the world was replaced); the counter goes on.
   void clear();
-  // Gives the bodies of a restored world the ids they had (by slot; 0 where there is no body),
-  // and moves the counter past them and past `next`; bodies without one get new ids.
+  // Gives the things of a restored world the ids they had (by slot; 0 where there is none),
+  // and moves the counter past them and past `next`; things without one get new ids.
   void adopt(const World& world, std::span<const std::uint64_t> ids, std::uint64_t next);
 
-  // The body's id (0 for a body not synced yet).
-  std::uint64_t wire(BodyId id) const {
+  // The thing's id (0 for one not synced yet).
+  std::uint64_t wire(Id id) const {
     return id.index < by_slot_.size() && generation_[id.index] == id.generation ? by_slot_[id.index]
                                                                                 : 0;
   }
-  // The body an id names now, or an invalid BodyId when it names none.
-  BodyId find(std::uint64_t wire) const;
+  // What an id names now, or an invalid id when it names nothing.
+  Id find(std::uint64_t wire) const {
+    const auto found = by_wire_.find(wire);
+    return found == by_wire_.end() ? Id{} : found->second;
+  }
   std::uint64_t next() const { return next_; }
-  // Ids by slot (0 for slots without a body), as snapshots store them.
+  // Ids by slot (0 for empty slots), as snapshots store them.
   const std::vector<std::uint64_t>& by_slot() const { return by_slot_; }
 
  private:
   void forget_slot(std::uint32_t slot);
   std::vector<std::uint64_t> by_slot_;
-  std::vector<std::uint32_t> generation_;  // of the body each slot's id was issued to
-  std::unordered_map<std::uint64_t, BodyId> by_wire_;
+  std::vector<std::uint32_t> generation_;  // of what each slot's id was issued to
+  std::unordered_map<std::uint64_t, Id> by_wire_;
   std::uint64_t next_ = 1;  // ids start at 1; 0 names nothing
 };
+
+using BodyIds = SlotIds<BodySlots>;
+using JointIds = SlotIds<JointSlots>;
+
+extern template class SlotIds<BodySlots>;
+extern template class SlotIds<JointSlots>;
 
 }  // namespace tumble::server

@@ -185,6 +185,8 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
   out->set_gyroscopic_limit_hits(s.gyroscopic_limit_hits);
   out->set_pair_limit_hits(s.pair_limit_hits);
   out->set_resting_contact_points(s.resting_contact_points);
+  out->set_solved_joints(s.solved_joints);
+  out->set_joint_error(s.joint_error);
   out->set_broad_phase_seconds(s.time.broad_phase);
   out->set_narrow_phase_seconds(s.time.narrow_phase);
   out->set_prepare_seconds(s.time.prepare);

@@ -24,6 +24,9 @@ struct HostedWorld {
   // id, a removed one loses its id for good); a command that needs a new body's id at once
   // calls ids.sync(world) itself.
   BodyIds ids;
+  // The joints' ids, as the bodies' (a joint removed with its body loses its id at the next
+  // sync). A restored world's joints get new ids.
+  JointIds joint_ids;
   // Chosen at random when the server starts, and written into snapshots: a snapshot made here
   // gives its bodies back their ids; one from elsewhere gets new ones, which cannot collide with
   // ids this server has handed out.
@@ -49,6 +52,8 @@ struct HostedWorld {
     colours = std::move(new_colours);
     ids.clear();
     ids.sync(world);
+    joint_ids.clear();
+    joint_ids.sync(world);
     ++epoch;
   }
   // A restored world whose bodies keep the ids they had (by slot; see BodyIds::adopt).
@@ -58,6 +63,8 @@ struct HostedWorld {
     dt = new_dt;
     colours = std::move(new_colours);
     ids.adopt(world, wire_ids, next_id);
+    joint_ids.clear();
+    joint_ids.sync(world);
     ++epoch;
   }
   void set_colour(BodyId id, std::uint32_t colour) {

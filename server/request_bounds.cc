@@ -23,6 +23,9 @@ constexpr std::size_t kKiB = 1024, kMiB = 1024 * 1024;
 // hull points aside; a scene body in JSON about twice that.
 constexpr std::size_t kIdBytes = 11, kUpdateBytes = 192, kImpulseBytes = 96, kSpecBytes = 512,
                       kSceneBodyBytes = 1024;
+// A joint spec with every field set: two ids, three vectors, ten doubles and their tags (about
+// 230); a drive update: an id, a motor and a spring, two flags (about 70).
+constexpr std::size_t kJointSpecBytes = 320, kDriveBytes = 96;
 // Room beyond the per-entry bytes: a few hulls of the most points a hull may have (1024 points
 // of three doubles, 24 KiB each) in a batch, the fields of a request that are not entries.
 constexpr std::size_t kSlack = kMiB;
@@ -171,6 +174,12 @@ MethodBounds RequestBounds::of(std::string_view method) const {
     return {capped(kIdBytes * n + kKiB), n};
   if (method == "SetBodyState") return {capped(kUpdateBytes * n + kKiB), n};
   if (method == "ApplyImpulse") return {capped(kImpulseBytes * n + kKiB), n};
+  // A world holds at most two joints a body (scenes/scene.h, kJointsPerBody).
+  const std::size_t joints = 2 * n;
+  if (method == "CreateJoints") return {capped(kJointSpecBytes * joints + kKiB), joints};
+  if (method == "RemoveJoints" || method == "GetJoints")
+    return {capped(kIdBytes * joints + kKiB), joints};
+  if (method == "SetJointDrives") return {capped(kDriveBytes * joints + kKiB), joints};
   if (method == "LoadScene") return {capped(kSceneBodyBytes * n + kSlack), 0};
   if (method == "Restore") return {max_message_bytes, 0};
   if (method == "Control") return {4 * kKiB, 0};
@@ -179,8 +188,9 @@ MethodBounds RequestBounds::of(std::string_view method) const {
 
 std::size_t RequestBounds::largest() const {
   std::size_t largest = 0;
-  for (const char* method : {"SpawnBodies", "GetBodies", "SetBodyState", "ApplyImpulse",
-                             "LoadScene", "Restore", "Control"})
+  for (const char* method :
+       {"SpawnBodies", "GetBodies", "SetBodyState", "ApplyImpulse", "CreateJoints", "RemoveJoints",
+        "SetJointDrives", "GetJoints", "LoadScene", "Restore", "Control"})
     largest = std::max(largest, of(method).bytes);
   return largest;
 }

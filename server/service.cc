@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "convert.h"
+#include "joint_commands.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
 #include "snapshot.h"
@@ -75,6 +76,10 @@ CallGate WorldService::make_gate() {
       {"SetBodyState", unary(&WorldService::set_body_state)},
       {"ApplyImpulse", unary(&WorldService::apply_impulse)},
       {"GetBodies", unary(&WorldService::get_bodies)},
+      {"CreateJoints", unary(&WorldService::create_joints)},
+      {"RemoveJoints", unary(&WorldService::remove_joints)},
+      {"SetJointDrives", unary(&WorldService::set_joint_drives)},
+      {"GetJoints", unary(&WorldService::get_joints)},
       {"LoadScene", unary(&WorldService::load_scene)},
       {"Control", unary(&WorldService::control)},
       {"GetInfo", unary(&WorldService::get_info)},
@@ -178,6 +183,39 @@ grpc::Status WorldService::get_bodies(const v1::GetBodiesRequest& request,
   return to_grpc(read);
 }
 
+grpc::Status WorldService::create_joints(const v1::CreateJointsRequest& request,
+                                         v1::CreateJointsResponse* response) {
+  std::vector<std::uint64_t> ids;
+  const std::size_t max_joints = kJointsPerBody * limits_.max_bodies;
+  const Status applied = host_.apply([&](HostedWorld& hosted) {
+    return server::create_joints(hosted, request, max_joints, &ids);
+  });
+  if (!applied) return to_grpc(applied);
+  for (std::uint64_t id : ids)
+    response->add_ids(id);
+  return grpc::Status::OK;
+}
+
+grpc::Status WorldService::remove_joints(const v1::RemoveJointsRequest& request,
+                                         v1::RemoveJointsResponse*) {
+  return to_grpc(
+      host_.apply([&](HostedWorld& hosted) { return server::remove_joints(hosted, request); }));
+}
+
+grpc::Status WorldService::set_joint_drives(const v1::SetJointDrivesRequest& request,
+                                            v1::SetJointDrivesResponse*) {
+  return to_grpc(
+      host_.apply([&](HostedWorld& hosted) { return server::set_joint_drives(hosted, request); }));
+}
+
+grpc::Status WorldService::get_joints(const v1::GetJointsRequest& request,
+                                      v1::GetJointsResponse* response) {
+  Status read = Status::ok();
+  host_.inspect(
+      [&](const HostedWorld& hosted) { read = server::get_joints(hosted, request, response); });
+  return to_grpc(read);
+}
+
 grpc::Status WorldService::set_body_state(const v1::SetBodyStateRequest& request,
                                           v1::SetBodyStateResponse*) {
   return to_grpc(
@@ -258,6 +296,7 @@ grpc::Status WorldService::get_info(const v1::GetInfoRequest&, v1::GetInfoRespon
   response->set_step(status.step);
   response->set_time(status.time);
   response->set_body_count(static_cast<std::uint32_t>(status.bodies));
+  response->set_joint_count(static_cast<std::uint32_t>(status.joints));
   response->set_running(status.running);
   // From the host's status, not the world: GetInfo answers while a long step runs.
   run_settings_to_proto(status.dt, status.real_time_factor, status.settings,

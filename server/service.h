@@ -34,13 +34,17 @@ struct ServiceLimits {
 // Every method is generic: the CallGate (call_gate.h) receives the calls, checks the token before
 // reading a request, bounds and scans it, and hands it to the methods below. The typed service
 // is registered too, for its name (reflection lists it).
-using GatedWorldService =
-    v1::World::WithGenericMethod_SpawnBodies<v1::World::WithGenericMethod_RemoveBodies<
-        v1::World::WithGenericMethod_SetBodyState<v1::World::WithGenericMethod_ApplyImpulse<
-            v1::World::WithGenericMethod_GetBodies<v1::World::WithGenericMethod_LoadScene<
-                v1::World::WithGenericMethod_Control<v1::World::WithGenericMethod_GetInfo<
-                    v1::World::WithGenericMethod_StreamFrames<v1::World::WithGenericMethod_Snapshot<
-                        v1::World::WithGenericMethod_Restore<v1::World::Service>>>>>>>>>>>;
+using GatedWorldService = v1::World::WithGenericMethod_SpawnBodies<
+    v1::World::WithGenericMethod_RemoveBodies<v1::World::WithGenericMethod_SetBodyState<
+        v1::World::WithGenericMethod_ApplyImpulse<v1::World::WithGenericMethod_GetBodies<
+            v1::World::WithGenericMethod_CreateJoints<v1::World::WithGenericMethod_RemoveJoints<
+                v1::World::WithGenericMethod_SetJointDrives<
+                    v1::World::WithGenericMethod_GetJoints<v1::World::WithGenericMethod_LoadScene<
+                        v1::World::WithGenericMethod_Control<v1::World::WithGenericMethod_GetInfo<
+                            v1::World::WithGenericMethod_StreamFrames<
+                                v1::World::WithGenericMethod_Snapshot<
+                                    v1::World::WithGenericMethod_Restore<
+                                        v1::World::Service>>>>>>>>>>>>>>>;
 
 class WorldService final : public GatedWorldService {
  public:
@@ -60,6 +64,10 @@ class WorldService final : public GatedWorldService {
   grpc::Status spawn_bodies(const v1::SpawnBodiesRequest&, v1::SpawnBodiesResponse*);
   grpc::Status remove_bodies(const v1::RemoveBodiesRequest&, v1::RemoveBodiesResponse*);
   grpc::Status get_bodies(const v1::GetBodiesRequest&, v1::GetBodiesResponse*);
+  grpc::Status create_joints(const v1::CreateJointsRequest&, v1::CreateJointsResponse*);
+  grpc::Status remove_joints(const v1::RemoveJointsRequest&, v1::RemoveJointsResponse*);
+  grpc::Status set_joint_drives(const v1::SetJointDrivesRequest&, v1::SetJointDrivesResponse*);
+  grpc::Status get_joints(const v1::GetJointsRequest&, v1::GetJointsResponse*);
   grpc::Status set_body_state(const v1::SetBodyStateRequest&, v1::SetBodyStateResponse*);
   grpc::Status apply_impulse(const v1::ApplyImpulseRequest&, v1::ApplyImpulseResponse*);
   grpc::Status load_scene(const v1::LoadSceneRequest&, v1::LoadSceneResponse*);

@@ -19,6 +19,7 @@ WorldHost::WorldHost(World world, double dt, double real_time_factor)
     hosted_.server_instance = static_cast<std::uint64_t>(entropy()) << 32 | entropy();
   refresh_catalogue();
   status_.bodies = hosted_.world.body_count();
+  status_.joints = hosted_.world.joint_count();
   status_.dt = dt;
   status_.real_time_factor = real_time_factor_;
   status_.settings = hosted_.world.settings();
@@ -172,6 +173,7 @@ void WorldHost::apply_pending() {
       refresh_catalogue();
     }
     status_.bodies = hosted_.world.body_count();
+    status_.joints = hosted_.world.joint_count();
     status_.step = hosted_.world.step_count();  // a command may have replaced the world
     status_.time = hosted_.world.time();
     status_.settings = hosted_.world.settings();

@@ -31,6 +31,7 @@ struct HostStatus {
   std::uint64_t step = 0;
   double time = 0;
   std::size_t bodies = 0;
+  std::size_t joints = 0;
   bool running = false;
   double dt = 0, real_time_factor = 0;
   StepStats last_step;

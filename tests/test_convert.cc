@@ -137,6 +137,8 @@ TEST(Convert, StepStatsCarryEveryCounter) {
   set("velocity_iterations", s.velocity_iterations);
   set("residual", s.residual);
   set("sleeping_bodies", s.sleeping_bodies);
+  set("solved_joints", s.solved_joints);
+  set("joint_error", s.joint_error);
   set("woken_bodies", s.woken_bodies);
   set("solver_bodies", s.solver_bodies);
   set("swept_bodies", s.swept_bodies);

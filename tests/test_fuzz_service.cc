@@ -49,7 +49,7 @@ class FuzzService {
     refresh_ids();
     for (int i = 0; i < count; ++i) {
       bool read_only = false;
-      const int rpc = h.integer(0, 9);
+      const int rpc = h.integer(0, 13);
       const grpc::Status status = send(h, rpc, &read_only);
       ++tally.tried;
       (status.ok() ? tally.accepted : tally.refused)++;
@@ -101,6 +101,43 @@ class FuzzService {
     known_.clear();
     for (const auto& state : bodies.states())
       known_.push_back(state.id());
+    grpc::ClientContext joints_context;
+    v1::GetJointsResponse joints;
+    EXPECT_TRUE(stub_->GetJoints(&joints_context, {}, &joints).ok());
+    known_joints_.assign(joints.ids().begin(), joints.ids().end());
+  }
+  // A live joint's id most of the time; else one that names nothing.
+  std::uint64_t joint_id(Hostile& h) {
+    if (!known_joints_.empty() && h.chance(0.8))
+      return known_joints_[static_cast<std::size_t>(h.rng().uniform() * known_joints_.size())];
+    const std::uint64_t odd[] = {0, 1, 999999, UINT64_MAX};
+    return odd[h.integer(0, 3)];
+  }
+  v1::JointSpec joint(Hostile& h) {
+    v1::JointSpec spec;
+    spec.set_kind(static_cast<v1::JointKind>(h.chance(0.95) ? h.integer(0, 4) : h.integer(5, 9)));
+    spec.set_a(id(h));
+    if (h.chance(0.6)) spec.set_b(id(h));
+    set(h.vector(-5, 5), spec.mutable_anchor());
+    if (h.chance(0.5)) set(h.vector(-5, 5), spec.mutable_anchor_b());
+    if (h.chance(0.7)) set(h.vector(-1, 1), spec.mutable_axis());
+    if (h.chance(0.3)) spec.set_length(h.number(-1, 3));
+    spec.set_collide_connected(h.chance(0.2));
+    if (h.chance(0.3)) {
+      spec.mutable_limit()->set_lower(h.number(-4, 2));
+      spec.mutable_limit()->set_upper(h.number(-2, 4));
+    }
+    if (h.chance(0.3)) {
+      spec.mutable_motor()->set_speed(h.number(-1e4, 1e4));
+      spec.mutable_motor()->set_max_force(h.number(-10, 1e6));
+    }
+    if (h.chance(0.3)) {
+      spec.mutable_spring()->set_target(h.number(-3, 3));
+      spec.mutable_spring()->set_stiffness(h.number(-1, 1e12));
+      spec.mutable_spring()->set_damping(h.number(-1, 1e3));
+    }
+    if (h.chance(0.2)) spec.set_max_swing(h.number(-1, 4));
+    return spec;
   }
   // A live id most of the time; else one that names nothing (0, stale, huge).
   std::uint64_t id(Hostile& h) {
@@ -247,9 +284,9 @@ class FuzzService {
       case 5: {
         v1::LoadSceneRequest request;
         if (h.chance(0.5)) {
-          const char* builtins[] = {"pile:6",  "pyramid:3", "tower:4",          "pyramid:100000",
-                                    "pile:0",  "pile:-3",   "pile:99999999999", "tower:x",
-                                    "",        "bogus",     "spin:3",           "default",
+          const char* builtins[] = {"pile:6",   "pyramid:3", "tower:4",          "pyramid:100000",
+                                    "pile:0",   "pile:-3",   "pile:99999999999", "tower:x",
+                                    "",         "bogus",     "spin:3",           "default",
                                     "pile:300", "pile"};
           request.set_builtin(builtins[h.integer(0, 13)]);
           if (h.chance(0.05)) request.set_builtin(std::string(100000, 'p'));  // echoed? clipped
@@ -294,6 +331,42 @@ class FuzzService {
         v1::RestoreResponse response;
         return stub_->Restore(&context, request, &response);
       }
+      case 10: {
+        v1::CreateJointsRequest request;
+        const int sizes[] = {0, 1, 1, 2, 3, 10, 700};
+        for (int n = sizes[h.integer(0, 6)]; n > 0; --n)
+          *request.add_joints() = joint(h);
+        v1::CreateJointsResponse response;
+        return stub_->CreateJoints(&context, request, &response);
+      }
+      case 11: {
+        v1::RemoveJointsRequest request;
+        for (int n = h.integer(0, 3); n > 0; --n)
+          request.add_ids(joint_id(h));
+        v1::RemoveJointsResponse response;
+        return stub_->RemoveJoints(&context, request, &response);
+      }
+      case 12: {
+        v1::SetJointDrivesRequest request;
+        for (int n = h.integer(0, 3); n > 0; --n) {
+          v1::JointDriveUpdate* u = request.add_updates();
+          u->set_id(joint_id(h));
+          if (h.chance(0.5)) *u->mutable_motor() = joint(h).motor();
+          if (h.chance(0.5)) *u->mutable_spring() = joint(h).spring();
+          u->set_motor_off(h.chance(0.1));
+          u->set_spring_off(h.chance(0.1));
+        }
+        v1::SetJointDrivesResponse response;
+        return stub_->SetJointDrives(&context, request, &response);
+      }
+      case 13: {
+        *read_only = true;
+        v1::GetJointsRequest request;
+        for (int n = h.integer(0, 3); n > 0; --n)
+          request.add_ids(joint_id(h));
+        v1::GetJointsResponse response;
+        return stub_->GetJoints(&context, request, &response);
+      }
       default: {
         *read_only = true;
         v1::StreamFramesRequest request;
@@ -326,7 +399,7 @@ class FuzzService {
   WorldService service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<v1::World::Stub> stub_;
-  std::vector<std::uint64_t> known_;
+  std::vector<std::uint64_t> known_, known_joints_;
 };
 
 TEST(FuzzService, EveryRpcSurvivesHostileRequestsAndRefusalsChangeNothing) {

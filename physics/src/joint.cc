@@ -36,8 +36,8 @@ Status validate(JointKind kind, const JointMotor& motor) {
   if (kind != JointKind::kHinge && kind != JointKind::kSlider)
     return Status::error("motor: only hinges and sliders have one");
   if (!std::isfinite(motor.speed)) return Status::error("motor.speed: must be finite");
-  if (!(std::isfinite(motor.max_force) && motor.max_force >= 0))
-    return Status::error("motor.max_force: must be finite and >= 0");
+  if (!(motor.max_force >= 0 && motor.max_force <= kMaxJointForce))
+    return Status::error("motor.max_force: must be in [0, 1e20]");
   return Status::ok();
 }
 
@@ -48,10 +48,10 @@ Status validate(JointKind kind, const JointSpring& spring) {
   if (!std::isfinite(spring.target)) return Status::error("spring.target: must be finite");
   if (kind == JointKind::kDistance && spring.target != 0)
     return Status::error("spring.target: a distance joint's spring rests at its length; leave 0");
-  if (!(std::isfinite(spring.stiffness) && spring.stiffness >= 0))
-    return Status::error("spring.stiffness: must be finite and >= 0");
-  if (!(std::isfinite(spring.damping) && spring.damping >= 0))
-    return Status::error("spring.damping: must be finite and >= 0");
+  if (!(spring.stiffness >= 0 && spring.stiffness <= kMaxJointForce))
+    return Status::error("spring.stiffness: must be in [0, 1e20]");
+  if (!(spring.damping >= 0 && spring.damping <= kMaxJointForce))
+    return Status::error("spring.damping: must be in [0, 1e20]");
   if (!(spring.stiffness + spring.damping > 0))
     return Status::error("spring: stiffness or damping must be above 0");
   return Status::ok();
@@ -74,7 +74,7 @@ Status validate(const JointDef& def) {
   if (!finite(def.anchor_b)) return Status::error("anchor_b: must be finite");
   if (has_axis(def.kind)) {
     if (!finite(def.axis)) return Status::error("axis: must be finite");
-    if (!(def.axis.norm() > 1e-9)) return Status::error("axis: must not be zero");
+    if (!(def.axis.stableNorm() > 1e-9)) return Status::error("axis: must not be zero");
   }
   if (def.kind == JointKind::kDistance) {
     if (!(std::isfinite(def.length) && def.length >= 0))

@@ -1,6 +1,7 @@
 // The world's joints: made, removed, checked, and handed to the step (joint_solver.h solves them
 // with the contacts of their islands).
 #include <algorithm>
+#include <cmath>
 
 #include "joint_geometry.h"
 #include "joint_solver.h"
@@ -18,18 +19,45 @@ std::uint64_t pair_key(std::uint32_t x, std::uint32_t y) {
 
 }  // namespace
 
-Result<JointId> World::create_joint(const JointDef& def) {
+Status World::check_joint(const JointDef& def) const {
   if (Status valid = validate(def); !valid) return valid;
   if (!contains(def.a)) return Status::not_found("a: no body with this id");
   const bool world_b = !def.b.is_valid();
   if (!world_b && !contains(def.b)) return Status::not_found("b: no body with this id");
   const Body& a = bodies_[def.a.index].body;
-  const Body* b = world_b ? nullptr : &bodies_[def.b.index].body;
-  if (a.is_static() && (b == nullptr || b->is_static()))
+  if (a.is_static() && (world_b || bodies_[def.b.index].body.is_static()))
     return Status::error("a: a joint needs a dynamic body on one side");
+  const WorldLimits& limits = settings_.limits;
+  auto within = [&](const Vec3& p) { return p.cwiseAbs().maxCoeff() <= limits.max_coordinate; };
+  if (!within(def.anchor)) return Status::error("anchor: beyond the world's max_coordinate");
+  if (!within(def.anchor_b)) return Status::error("anchor_b: beyond the world's max_coordinate");
+  const double reach = 2 * limits.max_coordinate;
+  if (def.length > reach) return Status::error("length: beyond twice the world's max_coordinate");
+  if (def.limit.enabled && (std::abs(def.limit.lower) > reach || std::abs(def.limit.upper) > reach))
+    return Status::error("limit: beyond twice the world's max_coordinate");
+  if (def.motor.enabled) {
+    const double most =
+        def.kind == JointKind::kHinge ? limits.max_angular_speed : limits.max_linear_speed;
+    if (std::abs(def.motor.speed) > most)
+      return Status::error("motor.speed: beyond the world's speed limit " + std::to_string(most));
+  }
+  if (def.spring.enabled && std::abs(def.spring.target) > reach)
+    return Status::error("spring.target: beyond twice the world's max_coordinate");
+  if (def.kind == JointKind::kDistance && def.limit.enabled && def.limit.lower == def.limit.upper &&
+      !(def.limit.lower > 0))
+    return Status::error("limit: a distance joint's length must be > 0");
   if (joint_count_ >= kMaxJoints)
-    return Status::error("joints: the world holds " + std::to_string(kMaxJoints) +
-                         " joints, the most it takes");
+    return Status::error(
+        "joints: the world holds " + std::to_string(kMaxJoints) + " joints, the most it takes",
+        StatusCode::kResourceExhausted);
+  return Status::ok();
+}
+
+Result<JointId> World::create_joint(const JointDef& def) {
+  if (Status checked = check_joint(def); !checked) return checked;
+  const bool world_b = !def.b.is_valid();
+  const Body& a = bodies_[def.a.index].body;
+  const Body* b = world_b ? nullptr : &bodies_[def.b.index].body;
 
   Joint joint;
   joint.kind = def.kind;
@@ -39,7 +67,7 @@ Result<JointId> World::create_joint(const JointDef& def) {
   const Vec3 end_b = def.kind == JointKind::kDistance ? def.anchor_b : def.anchor;
   const bool has_axis = def.kind == JointKind::kHinge || def.kind == JointKind::kSlider ||
                         def.kind == JointKind::kBall;
-  const Vec3 axis = has_axis ? def.axis.normalized() : Vec3::UnitZ();
+  const Vec3 axis = has_axis ? def.axis.stableNormalized() : Vec3::UnitZ();
   const Vec3 reference = joint_detail::perpendicular(axis);
   const Quat qa_inverse = a.orientation.conjugate();
   joint.local_a = qa_inverse * (def.anchor - a.position);
@@ -62,11 +90,26 @@ Result<JointId> World::create_joint(const JointDef& def) {
   joint.motor = def.motor;
   joint.spring = def.spring;
   joint.max_swing = def.max_swing;
+  const WorldLimits& limits = settings_.limits;
+  auto within = [&](const Vec3& p) { return p.cwiseAbs().maxCoeff() <= limits.max_coordinate; };
+  if (!within(def.anchor)) return Status::error("anchor: beyond the world's max_coordinate");
+  if (!within(def.anchor_b)) return Status::error("anchor_b: beyond the world's max_coordinate");
+  const double reach = 2 * limits.max_coordinate;
+  if (def.length > reach) return Status::error("length: beyond twice the world's max_coordinate");
+  if (def.limit.enabled && (std::abs(def.limit.lower) > reach || std::abs(def.limit.upper) > reach))
+    return Status::error("limit: beyond twice the world's max_coordinate");
+  if (def.motor.enabled) {
+    const double most =
+        def.kind == JointKind::kHinge ? limits.max_angular_speed : limits.max_linear_speed;
+    if (std::abs(def.motor.speed) > most)
+      return Status::error("motor.speed: beyond the world's speed limit " + std::to_string(most));
+  }
+  if (def.spring.enabled && std::abs(def.spring.target) > reach)
+    return Status::error("spring.target: beyond twice the world's max_coordinate");
   if (def.kind == JointKind::kDistance && def.limit.enabled && def.limit.lower == def.limit.upper) {
     // A range of one length is a rod of that length.
     joint.length = def.limit.lower;
     joint.limit = JointLimit{};
-    if (!(joint.length > 0)) return Status::error("limit: a distance joint's length must be > 0");
   }
 
   std::uint32_t index;
@@ -132,6 +175,10 @@ Status World::set_joint_motor(JointId id, const JointMotor& motor) {
   if (!contains(id)) return Status::not_found("joint: no joint with this id");
   Joint& joint = joints_[id.index].joint;
   if (Status s = validate(joint.kind, motor); !s) return s;
+  const double most = joint.kind == JointKind::kHinge ? settings_.limits.max_angular_speed
+                                                      : settings_.limits.max_linear_speed;
+  if (motor.enabled && std::abs(motor.speed) > most)
+    return Status::error("motor.speed: beyond the world's speed limit " + std::to_string(most));
   joint.motor = motor;
   if (!motor.enabled) joint.motor_impulse = 0;
   wake_joint(joint);
@@ -142,6 +189,8 @@ Status World::set_joint_spring(JointId id, const JointSpring& spring) {
   if (!contains(id)) return Status::not_found("joint: no joint with this id");
   Joint& joint = joints_[id.index].joint;
   if (Status s = validate(joint.kind, spring); !s) return s;
+  if (spring.enabled && std::abs(spring.target) > 2 * settings_.limits.max_coordinate)
+    return Status::error("spring.target: beyond twice the world's max_coordinate");
   joint.spring = spring;
   if (!spring.enabled) joint.spring_impulse = 0;
   wake_joint(joint);
@@ -167,6 +216,40 @@ Result<JointReading> World::joint_reading(JointId id) const {
   if (joint.b == kWorldAnchor) return read_joint(joint, a.pose(), Pose{}, motion(a), SolverBody{});
   const Body& b = bodies_[joint.b].body;
   return read_joint(joint, a.pose(), b.pose(), motion(a), motion(b));
+}
+
+Result<JointDef> World::joint_def(JointId id) const {
+  if (!contains(id)) return Status::not_found("joint: no joint with this id");
+  const Joint& joint = joints_[id.index].joint;
+  const Body& a = bodies_[joint.a].body;
+  JointDef def;
+  def.kind = joint.kind;
+  def.a = id_at(joint.a);
+  def.anchor = a.pose().transform(joint.local_a);
+  def.axis = a.orientation * joint.axis_a;
+  if (joint.b == kWorldAnchor) {
+    def.anchor_b = joint.local_b;
+  } else {
+    def.b = id_at(joint.b);
+    def.anchor_b = bodies_[joint.b].body.pose().transform(joint.local_b);
+  }
+  if (joint.kind != JointKind::kDistance) def.anchor_b = Vec3::Zero();
+  def.length = joint.kind == JointKind::kDistance ? joint.length : 0;
+  def.collide_connected = joint.collide_connected;
+  def.limit = joint.limit;
+  def.motor = joint.motor;
+  def.spring = joint.spring;
+  def.max_swing = joint.max_swing;
+  return def;
+}
+
+std::uint32_t World::joint_slot_count() const {
+  return static_cast<std::uint32_t>(joints_.size());
+}
+
+JointId World::joint_at(std::uint32_t slot) const {
+  if (slot >= joints_.size() || !joints_[slot].alive) return {};
+  return {slot, joints_[slot].generation};
 }
 
 void World::remove_joints_of(std::uint32_t body_slot) {

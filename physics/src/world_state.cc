@@ -97,7 +97,8 @@ bool unit(const Vec3& v) {
 
 // A joint names live bodies (b may be the world), one of them dynamic, with finite anchors, unit
 // axes and rotation, a length a distance joint can hold, and finite impulses.
-Status check_joint(const Joint& joint, std::span<const BodySlotState> slots) {
+Status check_joint(const Joint& joint, std::span<const BodySlotState> slots,
+                   const WorldLimits& limits) {
   auto live = [&](std::uint32_t slot) { return slot < slots.size() && slots[slot].alive; };
   if (!live(joint.a)) return Status::error("a: not a live body");
   if (joint.b != kWorldAnchor && (!live(joint.b) || joint.b == joint.a))
@@ -105,13 +106,15 @@ Status check_joint(const Joint& joint, std::span<const BodySlotState> slots) {
   const bool b_static = joint.b == kWorldAnchor || slots[joint.b].body.is_static();
   if (slots[joint.a].body.is_static() && b_static)
     return Status::error("a: a joint needs a dynamic body on one side");
-  if (!is_finite(joint.local_a) || !is_finite(joint.local_b))
-    return Status::error("local_a, local_b: must be finite");
+  const double reach = 2 * limits.max_coordinate;
+  if (!is_finite(joint.local_a) || !is_finite(joint.local_b) ||
+      joint.local_a.cwiseAbs().maxCoeff() > reach || joint.local_b.cwiseAbs().maxCoeff() > reach)
+    return Status::error("local_a, local_b: must be finite, within twice max_coordinate");
   if (!unit(joint.axis_a) || !unit(joint.axis_b))
     return Status::error("axis_a, axis_b: must be unit vectors");
   if (!(std::abs(joint.relative.norm() - 1) <= 1e-6))
     return Status::error("relative: must be a unit quaternion");
-  if (!std::isfinite(joint.length) || joint.length < 0 ||
+  if (!std::isfinite(joint.length) || joint.length < 0 || joint.length > reach ||
       (joint.kind == JointKind::kDistance && !(joint.length > 0)))
     return Status::error("length: must be finite, and > 0 for a distance joint");
   if (!is_finite(joint.linear_impulse) || !is_finite(joint.angular_impulse) ||
@@ -128,7 +131,15 @@ Status check_joint(const Joint& joint, std::span<const BodySlotState> slots) {
     return Status::error("max_swing: must be in (0, pi], below pi for a ball joint alone");
   if (Status s = validate(joint.kind, joint.limit); !s) return s;
   if (Status s = validate(joint.kind, joint.motor); !s) return s;
-  return validate(joint.kind, joint.spring);
+  if (Status s = validate(joint.kind, joint.spring); !s) return s;
+  const double speed =
+      joint.kind == JointKind::kHinge ? limits.max_angular_speed : limits.max_linear_speed;
+  if ((joint.limit.enabled &&
+       (std::abs(joint.limit.lower) > reach || std::abs(joint.limit.upper) > reach)) ||
+      (joint.motor.enabled && std::abs(joint.motor.speed) > speed) ||
+      (joint.spring.enabled && std::abs(joint.spring.target) > reach))
+    return Status::error("limit, motor, spring: beyond the world's limits");
+  return Status::ok();
 }
 
 }  // namespace
@@ -193,7 +204,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
   for (std::size_t i = 0; i < state.joints.size(); ++i) {
     if (!state.joints[i].alive) continue;
     ++live_joints;
-    if (Status s = check_joint(state.joints[i].joint, state.slots); !s)
+    if (Status s = check_joint(state.joints[i].joint, state.slots, settings.limits); !s)
       return s.within("joints[" + std::to_string(i) + "].");
   }
   std::vector<std::uint8_t> joint_listed(state.joints.size(), 0);

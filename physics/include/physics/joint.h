@@ -98,6 +98,12 @@ struct JointReading {
 // Checks what can be checked without a world (finite values, an axis, the length); the message
 // names the field ("axis: must not be zero").
 Status validate(const JointDef& def);
+// Values no joint needs, beyond which doubles would overflow in the solver's products: forces,
+// stiffnesses and dampings up to 1e20 (SI), lengths and offsets within twice `max_coordinate`.
+// World::check_joint also bounds anchors by the world's max_coordinate and motor speeds by its
+// speed limits.
+inline constexpr double kMaxJointForce = 1e20;
+
 // The parts checked for a kind (a running joint's motor and spring may change).
 Status validate(JointKind kind, const JointLimit& limit);
 Status validate(JointKind kind, const JointMotor& motor);

@@ -126,6 +126,8 @@ class World {
   // ("b: no body with this id"). Both bodies wake. Removing a body removes its joints.
   static constexpr std::size_t kMaxJoints = 1 << 20;
   Result<JointId> create_joint(const JointDef& def);
+  // What create_joint would answer, without making the joint.
+  Status check_joint(const JointDef& def) const;
   Status remove_joint(JointId id);
   bool contains(JointId id) const;
   std::size_t joint_count() const { return joint_count_; }
@@ -138,6 +140,12 @@ class World {
   Status set_joint_spring(JointId id, const JointSpring& spring);
   // The joint's coordinate, its rate and the reaction it gave over the last step (joint.h).
   Result<JointReading> joint_reading(JointId id) const;
+  // The joint's definition as it stands: anchors and axis where the bodies now carry them (a
+  // distance joint's anchor_b, a world anchor, where made), its limit, motor and spring now.
+  Result<JointDef> joint_def(JointId id) const;
+  // Joints by slot, as bodies are (slot_count, id_at): the id at a slot, invalid if none.
+  std::uint32_t joint_slot_count() const;
+  JointId joint_at(std::uint32_t slot) const;
 
   // The whole state (settings apart: settings()) as bytes in the engine's own versioned format
   // (docs/STATE_FORMAT.md): a world made from them steps on exactly as this one would, bit for bit.
