@@ -2,6 +2,7 @@
 
 #include <random>
 
+#include "joint_commands.h"
 #include "world_commands.h"
 
 namespace tumble::python {
@@ -66,6 +67,24 @@ Result<std::string> LocalWorld::call(std::string_view method, std::string_view b
   } else if (method == "ApplyImpulse") {
     answer = served<v1::ApplyImpulseRequest, v1::ApplyImpulseResponse>(
         bytes, [&](auto& r, auto*) { return apply_impulses(hosted_, r); });
+  } else if (method == "CreateJoints") {
+    answer =
+        served<v1::CreateJointsRequest, v1::CreateJointsResponse>(bytes, [&](auto& r, auto* a) {
+          std::vector<std::uint64_t> ids;
+          if (Status s = create_joints(hosted_, r, kJointsPerBody * limits_.max_bodies, &ids); !s)
+            return s;
+          a->mutable_ids()->Add(ids.begin(), ids.end());
+          return Status::ok();
+        });
+  } else if (method == "RemoveJoints") {
+    answer = served<v1::RemoveJointsRequest, v1::RemoveJointsResponse>(
+        bytes, [&](auto& r, auto*) { return remove_joints(hosted_, r); });
+  } else if (method == "SetJointDrives") {
+    answer = served<v1::SetJointDrivesRequest, v1::SetJointDrivesResponse>(
+        bytes, [&](auto& r, auto*) { return set_joint_drives(hosted_, r); });
+  } else if (method == "GetJoints") {
+    answer = served<v1::GetJointsRequest, v1::GetJointsResponse>(
+        bytes, [&](auto& r, auto* a) { return get_joints(hosted_, r, a); });
   } else if (method == "LoadScene") {
     answer = served<v1::LoadSceneRequest, v1::LoadSceneResponse>(bytes, [&](auto& r, auto* a) {
       Result<SceneDef> scene = scene_of(r, limits_.max_bodies);

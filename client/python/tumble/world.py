@@ -220,6 +220,75 @@ class WorldCalls:
     def body(self, body_id):
         return self.bodies([body_id])[0]
 
+    # --- joints -------------------------------------------------------------------------------
+
+    def joint(self, kind, a, b=0, anchor=(0.0, 0.0, 0.0), *, anchor_b=None, axis=None,
+              length=0.0, limits=None, motor=None, spring=None, max_swing=None,
+              collide_connected=False):
+        """Joins body `a` to body `b` (0: the world) with a joint of `kind` ("ball", "hinge",
+        "fixed", "distance" or "slider") at `anchor` (m, world); returns its id. limits:
+        (lower, upper) of the free coordinate (rad or m); motor: (speed, max_force); spring:
+        (target, stiffness, damping); max_swing: a ball's cone (rad)."""
+        kinds = {"ball": pb.JOINT_KIND_BALL, "hinge": pb.JOINT_KIND_HINGE,
+                 "fixed": pb.JOINT_KIND_FIXED, "distance": pb.JOINT_KIND_DISTANCE,
+                 "slider": pb.JOINT_KIND_SLIDER}
+        if kind not in kinds:
+            raise ArgumentError(f"kind: must be one of {', '.join(kinds)}, got {kind!r}", "joint")
+        spec = pb.JointSpec(kind=kinds[kind], a=convert.ids(a, "a")[0],
+                            b=convert.ids(b, "b")[0] if b else 0, length=float(length),
+                            collide_connected=bool(collide_connected))
+        convert.set_vec3(spec.anchor, anchor, "anchor")
+        if anchor_b is not None:
+            convert.set_vec3(spec.anchor_b, anchor_b, "anchor_b")
+        if axis is not None:
+            convert.set_vec3(spec.axis, axis, "axis")
+        if limits is not None:
+            lower, upper = convert.array(limits, 2, "limits")
+            spec.limit.lower, spec.limit.upper = float(lower), float(upper)
+        if motor is not None:
+            speed, force = convert.array(motor, 2, "motor")
+            spec.motor.speed, spec.motor.max_force = float(speed), float(force)
+        if spring is not None:
+            target, stiffness, damping = convert.array(spring, 3, "spring")
+            spec.spring.target, spec.spring.stiffness = float(target), float(stiffness)
+            spec.spring.damping = float(damping)
+        if max_swing is not None:
+            spec.max_swing = float(max_swing)
+        return list(self._rpc("CreateJoints", pb.CreateJointsRequest(joints=[spec])).ids)[0]
+
+    def hinge(self, a, b=0, anchor=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), **options):
+        """A hinge about `axis` through `anchor`; options as joint()'s (limits, motor, spring)."""
+        return self.joint("hinge", a, b, anchor, axis=axis, **options)
+
+    def drive(self, joint_id, motor=None, spring=None, *, motor_off=False, spring_off=False):
+        """Changes a running joint's motor (speed, max_force) or spring (target, stiffness,
+        damping), or turns them off."""
+        update = pb.JointDriveUpdate(id=convert.ids(joint_id, "id")[0], motor_off=motor_off,
+                                     spring_off=spring_off)
+        if motor is not None:
+            update.motor.speed, update.motor.max_force = (
+                float(v) for v in convert.array(motor, 2, "motor"))
+        if spring is not None:
+            target, stiffness, damping = convert.array(spring, 3, "spring")
+            update.spring.target, update.spring.stiffness = float(target), float(stiffness)
+            update.spring.damping = float(damping)
+        self._rpc("SetJointDrives", pb.SetJointDrivesRequest(updates=[update]))
+
+    def remove_joints(self, ids):
+        """Removes a joint or a list of them, all or nothing."""
+        self._rpc("RemoveJoints", pb.RemoveJointsRequest(ids=convert.ids(ids)))
+
+    def joints(self, ids=()):
+        """Every joint (or those of `ids`): a dict of id, kind, a, b, position, speed, effort,
+        force, torque and error at the current step."""
+        response = self._rpc("GetJoints", pb.GetJointsRequest(ids=convert.ids(ids)))
+        names = {v: k for k, v in pb.JointKind.items()}
+        return [{"id": i, "kind": names[spec.kind].removeprefix("JOINT_KIND_").lower(),
+                 "a": spec.a, "b": spec.b, "position": state.position, "speed": state.speed,
+                 "effort": state.effort, "force": convert.vec3(state.force),
+                 "torque": convert.vec3(state.torque), "error": state.error}
+                for i, spec, state in zip(response.ids, response.specs, response.states)]
+
     # --- the run ------------------------------------------------------------------------------
 
     def play(self):
