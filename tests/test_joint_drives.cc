@@ -72,6 +72,9 @@ TEST(JointDrives, HingeMotorAcceleratesAtItsTorqueBoundThenHoldsItsSpeed) {
     ASSERT_TRUE(world.step(kDt));
   EXPECT_NEAR(speed(world, id), 7.0, 7.0 * 1e-3);
   EXPECT_FALSE(world.set_joint_motor(id, {true, 1.0, -1.0}));
+  // Beyond the world's angular speed limit (1e6 rad/s): refused, the motor as it was.
+  EXPECT_EQ(world.set_joint_motor(id, {true, 2e6, 1.0}).message().rfind("motor.speed:", 0), 0u);
+  EXPECT_EQ(world.joint_def(id).value().motor.speed, -10.0);
   EXPECT_LT(std::abs(world.joint_error(id).value()), 1e-6);
 }
 

@@ -17,6 +17,21 @@ std::uint64_t pair_key(std::uint32_t x, std::uint32_t y) {
   return (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
 }
 
+// A motor's speed within the world's speed limits, a spring's target within its reach.
+Status check_motor(JointKind kind, const JointMotor& motor, const WorldLimits& limits) {
+  const double most =
+      kind == JointKind::kHinge ? limits.max_angular_speed : limits.max_linear_speed;
+  if (motor.enabled && std::abs(motor.speed) > most)
+    return Status::error("motor.speed: beyond the world's speed limit " + std::to_string(most));
+  return Status::ok();
+}
+
+Status check_spring(const JointSpring& spring, const WorldLimits& limits) {
+  if (spring.enabled && std::abs(spring.target) > 2 * limits.max_coordinate)
+    return Status::error("spring.target: beyond twice the world's max_coordinate");
+  return Status::ok();
+}
+
 }  // namespace
 
 Status World::check_joint(const JointDef& def) const {
@@ -35,14 +50,8 @@ Status World::check_joint(const JointDef& def) const {
   if (def.length > reach) return Status::error("length: beyond twice the world's max_coordinate");
   if (def.limit.enabled && (std::abs(def.limit.lower) > reach || std::abs(def.limit.upper) > reach))
     return Status::error("limit: beyond twice the world's max_coordinate");
-  if (def.motor.enabled) {
-    const double most =
-        def.kind == JointKind::kHinge ? limits.max_angular_speed : limits.max_linear_speed;
-    if (std::abs(def.motor.speed) > most)
-      return Status::error("motor.speed: beyond the world's speed limit " + std::to_string(most));
-  }
-  if (def.spring.enabled && std::abs(def.spring.target) > reach)
-    return Status::error("spring.target: beyond twice the world's max_coordinate");
+  if (Status s = check_motor(def.kind, def.motor, limits); !s) return s;
+  if (Status s = check_spring(def.spring, limits); !s) return s;
   if (def.kind == JointKind::kDistance && def.limit.enabled && def.limit.lower == def.limit.upper &&
       !(def.limit.lower > 0))
     return Status::error("limit: a distance joint's length must be > 0");
@@ -90,22 +99,6 @@ Result<JointId> World::create_joint(const JointDef& def) {
   joint.motor = def.motor;
   joint.spring = def.spring;
   joint.max_swing = def.max_swing;
-  const WorldLimits& limits = settings_.limits;
-  auto within = [&](const Vec3& p) { return p.cwiseAbs().maxCoeff() <= limits.max_coordinate; };
-  if (!within(def.anchor)) return Status::error("anchor: beyond the world's max_coordinate");
-  if (!within(def.anchor_b)) return Status::error("anchor_b: beyond the world's max_coordinate");
-  const double reach = 2 * limits.max_coordinate;
-  if (def.length > reach) return Status::error("length: beyond twice the world's max_coordinate");
-  if (def.limit.enabled && (std::abs(def.limit.lower) > reach || std::abs(def.limit.upper) > reach))
-    return Status::error("limit: beyond twice the world's max_coordinate");
-  if (def.motor.enabled) {
-    const double most =
-        def.kind == JointKind::kHinge ? limits.max_angular_speed : limits.max_linear_speed;
-    if (std::abs(def.motor.speed) > most)
-      return Status::error("motor.speed: beyond the world's speed limit " + std::to_string(most));
-  }
-  if (def.spring.enabled && std::abs(def.spring.target) > reach)
-    return Status::error("spring.target: beyond twice the world's max_coordinate");
   if (def.kind == JointKind::kDistance && def.limit.enabled && def.limit.lower == def.limit.upper) {
     // A range of one length is a rod of that length.
     joint.length = def.limit.lower;
@@ -175,10 +168,7 @@ Status World::set_joint_motor(JointId id, const JointMotor& motor) {
   if (!contains(id)) return Status::not_found("joint: no joint with this id");
   Joint& joint = joints_[id.index].joint;
   if (Status s = validate(joint.kind, motor); !s) return s;
-  const double most = joint.kind == JointKind::kHinge ? settings_.limits.max_angular_speed
-                                                      : settings_.limits.max_linear_speed;
-  if (motor.enabled && std::abs(motor.speed) > most)
-    return Status::error("motor.speed: beyond the world's speed limit " + std::to_string(most));
+  if (Status s = check_motor(joint.kind, motor, settings_.limits); !s) return s;
   joint.motor = motor;
   if (!motor.enabled) joint.motor_impulse = 0;
   wake_joint(joint);
@@ -189,8 +179,7 @@ Status World::set_joint_spring(JointId id, const JointSpring& spring) {
   if (!contains(id)) return Status::not_found("joint: no joint with this id");
   Joint& joint = joints_[id.index].joint;
   if (Status s = validate(joint.kind, spring); !s) return s;
-  if (spring.enabled && std::abs(spring.target) > 2 * settings_.limits.max_coordinate)
-    return Status::error("spring.target: beyond twice the world's max_coordinate");
+  if (Status s = check_spring(spring, settings_.limits); !s) return s;
   joint.spring = spring;
   if (!spring.enabled) joint.spring_impulse = 0;
   wake_joint(joint);
