@@ -373,4 +373,161 @@ double joint_error(const Joint& joint, const Pose& pose_a, const Pose& pose_b) {
   return 0;
 }
 
+namespace {
+
+using Row6 = Eigen::Matrix<double, 1, 6>;
+
+// A row whose rate is linear . (v_b - v_a) + angular_a . w_a + angular_b . w_b.
+void set_row(JointEquations& e, int i, const AxialRow& row) {
+  e.on_a.row(i) << -row.linear.transpose(), row.angular_a.transpose();
+  e.on_b.row(i) << row.linear.transpose(), row.angular_b.transpose();
+}
+
+// Three rows at once: the point (rate: b's anchor's velocity less a's), or the rotation
+// (w_b - w_a).
+void set_point_rows(JointEquations& e, int first, const Anchors& anchors) {
+  e.on_a.block<3, 3>(first, 0) = -Mat3::Identity();
+  e.on_a.block<3, 3>(first, 3) = skew(anchors.ra);
+  e.on_b.block<3, 3>(first, 0) = Mat3::Identity();
+  e.on_b.block<3, 3>(first, 3) = -skew(anchors.rb);
+}
+void set_rotation_rows(JointEquations& e, int first) {
+  e.on_a.block<3, 3>(first, 3) = -Mat3::Identity();
+  e.on_b.block<3, 3>(first, 3) = Mat3::Identity();
+}
+
+// Both: the rows at the present poses; `velocities` asks for the targets of a sweep (else the
+// targets are minus the errors).
+JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bodies,
+                            std::span<const Pose> poses, const JointTarget* velocities) {
+  JointEquations e;
+  const Joint& joint = row.joint;
+  const bool world_b = row.b == kWorldAnchor;
+  const SolverBody& a = bodies[row.a];
+  const SolverBody& b = world_b ? kWorldBody : bodies[row.b];
+  const Pose& pose_a = poses[row.a];
+  const Pose pose_b = world_b ? Pose{} : poses[row.b];
+  const Anchors anchors = anchors_of(joint, pose_a, pose_b, world_b);
+  const double h = velocities != nullptr ? velocities->h : 0;
+  const double most = velocities != nullptr ? velocities->most_speed : 0;
+  const Vec3 rate = (b.v + b.w.cross(anchors.rb)) - (a.v + a.w.cross(anchors.ra));
+  auto point_target = [&] {
+    if (velocities == nullptr) return Vec3(anchors.pa - anchors.pb);
+    if (!(h > 0)) return Vec3(Vec3::Zero());
+    const Vec3 drift = anchor_move(b, anchors.rb, h) - anchor_move(a, anchors.ra, h) - h * rate;
+    return Vec3(-drift_velocity(drift, h, most));
+  };
+  switch (joint.kind) {
+    case JointKind::kBall:
+      e.rows = 3;
+      set_point_rows(e, 0, anchors);
+      e.target.head<3>() = point_target();
+      break;
+    case JointKind::kFixed: {
+      e.rows = 6;
+      set_point_rows(e, 0, anchors);
+      e.target.head<3>() = point_target();
+      set_rotation_rows(e, 3);
+      if (velocities == nullptr)
+        e.target.tail<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
+      break;
+    }
+    case JointKind::kHinge: {
+      e.rows = 5;
+      set_point_rows(e, 0, anchors);
+      e.target.head<3>() = point_target();
+      const HingeRows hinge = hinge_rows(joint, pose_a.orientation,
+                                         world_b ? nullptr : &pose_b.orientation, Mat3::Zero());
+      set_row(e, 3, {Vec3::Zero(), -hinge.g1, hinge.g1});
+      set_row(e, 4, {Vec3::Zero(), -hinge.g2, hinge.g2});
+      if (velocities == nullptr) {
+        e.target.segment<2>(3) = -hinge.error();
+      } else if (h > 0) {
+        // The turns' curvature over the move beyond the velocities' first order.
+        const Vec3 relative_w = b.w - a.w;
+        const Quat turn_a = rotation_quaternion(h * a.w), turn_b = rotation_quaternion(h * b.w);
+        const Vec3 a_next = turn_a * hinge.axis_a;
+        const Vec3 drift(a_next.dot(turn_b * hinge.b2) - hinge.axis_a.dot(hinge.b2) -
+                             h * relative_w.dot(hinge.g1),
+                         a_next.dot(turn_b * hinge.c2) - hinge.axis_a.dot(hinge.c2) -
+                             h * relative_w.dot(hinge.g2),
+                         0);
+        e.target.segment<2>(3) = -drift_velocity(drift, h, most).head<2>();
+      }
+      break;
+    }
+    case JointKind::kSlider: {
+      e.rows = 5;
+      set_rotation_rows(e, 0);
+      const SliderRows across = slider_rows(joint, pose_a, pose_b, world_b, a, b);
+      set_row(e, 3, across.rows[0]);
+      set_row(e, 4, across.rows[1]);
+      if (velocities == nullptr) {
+        e.target.head<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
+        e.target.segment<2>(3) = -across.error;
+      }
+      break;
+    }
+    case JointKind::kDistance: {
+      if (!rigid_distance(joint)) break;
+      const Vec3 d = anchors.pb - anchors.pa;
+      const double length = d.norm();
+      if (!(length > 1e-12)) break;
+      const Vec3 n = d / length;
+      e.rows = 1;
+      set_row(e, 0, {n, -anchors.ra.cross(n), anchors.rb.cross(n)});
+      if (velocities == nullptr) {
+        e.target[0] = joint.length - length;
+      } else if (h > 0) {
+        const Vec3 d_next = d + anchor_move(b, anchors.rb, h) - anchor_move(a, anchors.ra, h);
+        e.target[0] = -drift_velocity(d_next.norm() - length - h * n.dot(rate), h, most);
+      }
+      break;
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
+                                  std::span<const Pose> poses, const JointTarget& target) {
+  return equations_of(row, bodies, poses, &target);
+}
+
+JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
+                                  std::span<const Pose> poses) {
+  return equations_of(row, bodies, poses, nullptr);
+}
+
+void add_equation_impulses(JointRow& row, const JointEquations& equations,
+                           const Eigen::Matrix<double, 6, 1>& impulses) {
+  Joint& joint = row.joint;
+  if (joint.kind == JointKind::kDistance) {
+    if (equations.rows == 1) joint.axial_impulse += impulses[0];
+    return;
+  }
+  // A row that pushes a's centre is a force at the anchors; one that only turns is a torque.
+  for (int i = 0; i < equations.rows; ++i) {
+    const Vec3 linear = -equations.on_a.block<1, 3>(i, 0).transpose();
+    if (!linear.isZero())
+      joint.linear_impulse += impulses[i] * linear;
+    else
+      joint.angular_impulse += impulses[i] * -equations.on_a.block<1, 3>(i, 3).transpose();
+  }
+}
+
+double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
+                          const JointTarget& target) {
+  JointBodies j = bodies_of(row, bodies, poses);
+  return solve_axial(row, j, target);
+}
+
+void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies,
+                          std::span<Pose> poses) {
+  const bool world_b = row.b == kWorldAnchor;
+  correct_axial(row.joint, &bodies[row.a], world_b ? nullptr : &bodies[row.b], &poses[row.a],
+                world_b ? nullptr : &poses[row.b]);
+}
+
 }  // namespace tumble

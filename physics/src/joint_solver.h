@@ -6,6 +6,7 @@
 // contacts' spring) damped a pendulum: at 170 degrees its period came out 0.6-15% short.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <span>
 
@@ -42,6 +43,35 @@ struct JointTarget {
   double most_speed = 0;
   double substep = 0;
 };
+
+// The rows a joint must hold exactly (its point, axes, rotation, a rod's length, a slider's line;
+// not its limits, motor or spring), linearised at the present poses: `rows` rows of a Jacobian on
+// each body (6 columns: linear, then angular; world) and what each row's rate must be (`target`),
+// or, for positions, minus each row's error. Rows beyond `rows` are zero. For the direct solve of
+// joint trees (joint_tree.h).
+struct JointEquations {
+  int rows = 0;
+  Eigen::Matrix<double, 6, 6> on_a = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> on_b = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> target = Eigen::Matrix<double, 6, 1>::Zero();
+};
+// For velocities, with the sweep's target (a move ahead: the rates that end it on the joint).
+JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
+                                  std::span<const Pose> poses, const JointTarget& target);
+// For positions: target = minus the error.
+JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
+                                  std::span<const Pose> poses);
+// Adds the equations' impulses (one per row, on b; a takes the opposite) to the joint's warm
+// start, in the same terms as the Gauss-Seidel rows keep them.
+void add_equation_impulses(JointRow& row, const JointEquations& equations,
+                           const Eigen::Matrix<double, 6, 1>& impulses);
+
+// The joint's springs, motors and limits alone (joint_axial.h): what a sweep does besides the
+// direct solve of the joint's own rows.
+double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
+                          const JointTarget& target);
+// The position pass of the joint's limits and cone alone.
+void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies, std::span<Pose> poses);
 
 // One Gauss-Seidel visit of the joint's rows. Returns the largest velocity change it gave (m/s).
 double solve_joint(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,

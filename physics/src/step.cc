@@ -102,7 +102,16 @@ class SerialIsland {
         report_(report),
         rows_(c.scratch.rows),
         cold_(c.scratch.cold_rows),
-        bodies_(c.scratch.bodies) {}
+        bodies_(c.scratch.bodies) {
+    if (report->joint_tree && !c.joints.empty()) {
+      tree_ = &c.scratch.joint_trees[omp_get_thread_num()];
+      if (!tree_->build(c.joints, c.scratch.joint_rows, bodies_, bodies_.size())) {
+        tree_ = nullptr;
+        report->joint_tree = false;
+        report->joint_loop = true;
+      }
+    }
+  }
 
   bool has_rows() const { return !c_.rows.empty() || !c_.joints.empty(); }
   void integrate_velocities(double h) {
@@ -116,9 +125,16 @@ class SerialIsland {
   void integrate_positions(double h) {
     for (std::uint32_t k : c_.bodies)
       integrate_position(h, &bodies_[k], &c_.scratch.poses[k]);
-    for (int pass = 0; pass < kJointPositionPasses; ++pass)
+    for (int pass = 0; pass < kJointPositionPasses; ++pass) {
+      if (tree_ != nullptr) {
+        for (std::uint32_t j : c_.joints)
+          correct_joint_bounds(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
+        tree_->solve_positions(c_.scratch.joint_rows, bodies_, c_.scratch.poses);
+        continue;
+      }
       for (std::uint32_t j : c_.joints)
         correct_joint_position(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
+    }
   }
   void refresh_separations() { update_separations(rows_, c_.rows, bodies_); }
   void warm_start(bool keep_last_substep) {
@@ -135,11 +151,18 @@ class SerialIsland {
       // Before a move: the soft solver's sweeps with bias, and every pgs sweep (its move follows).
       const bool move_ahead = soft != nullptr || report_->solver == IslandSolver::kPgs;
       const JointTarget target{move_ahead ? h : 0.0, c_.settings.solver.max_push_velocity, h};
+      // With a tree (joint_tree.h), every joint's own rows at once, exactly, after the drives.
+      const bool direct = tree_ != nullptr;
       for (std::uint32_t j : c_.joints) {
         JointRow& row = c_.scratch.joint_rows[j];
         row.joint.impulse_time = h;
-        change = std::max(change, solve_joint(row, bodies_, c_.scratch.poses, target));
+        change =
+            std::max(change, direct ? solve_joint_drives(row, bodies_, c_.scratch.poses, target)
+                                    : solve_joint(row, bodies_, c_.scratch.poses, target));
       }
+      if (direct)
+        change = std::max(change, tree_->solve_velocities(c_.scratch.joint_rows, bodies_,
+                                                          c_.scratch.poses, target));
     }
     if (c_.rows.empty()) return change;
     return std::max(change, solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_,
@@ -177,6 +200,7 @@ class SerialIsland {
   std::span<ContactRow> rows_;
   std::span<ContactRowCold> cold_;
   std::span<SolverBody> bodies_;
+  JointTree* tree_ = nullptr;  // the island's joints solved directly (joint_tree.h), if so
 };
 
 IslandContext island_context(StepScratch& s, const WorldSettings& settings, std::size_t i) {
@@ -584,6 +608,7 @@ void World::solve_islands(double dt) {
   for (const StepScratch::PackedManifolds& pack : s.pack_manifolds)
     stats_.packed_manifolds += pack.count;
   const bool parallel = threads > 1 && (work > 1 || !s.team_islands.empty());
+  if (s.joint_trees.size() < static_cast<std::size_t>(threads)) s.joint_trees.resize(threads);
   // Large islands one after the other with the whole team, then the rest one island per thread:
   // islands share no body and no row, and colours share no moving body, so any thread count gives
   // the same bits.
@@ -620,6 +645,8 @@ void World::solve_islands(double dt) {
       ++stats_.iterative_islands;
     stats_.exact_fallbacks += report.exact_failed ? 1 : 0;
     stats_.exact_oversized += report.exact_oversized ? 1 : 0;
+    stats_.joint_tree_islands += report.joint_tree ? 1 : 0;
+    stats_.joint_loop_islands += report.joint_loop ? 1 : 0;
     stats_.stiffened_islands += report.substeps > 0 || report.pgs_iterations > 0 ? 1 : 0;
     stats_.stiffness_capped += report.stiffness_capped ? 1 : 0;
     stats_.lemke_pivots += report.lemke_pivots;

@@ -100,6 +100,14 @@ void World::choose_island_solvers(double dt) {
         // An island with joints is solved on one thread by an iterative solver (the exact
         // solver's LCP holds contacts alone).
         s.reports[i].joints = s.islands.joint_begin[i + 1] - s.islands.joint_begin[i];
+        // Exact and auto solve its joints' rows directly (joint_tree.h), its contacts soft.
+        s.reports[i].joint_tree = false;
+        s.reports[i].joint_loop = false;
+        if (s.reports[i].joints > 0 &&
+            (solver.kind == SolverKind::kExact || solver.kind == SolverKind::kAuto)) {
+          s.reports[i].joint_tree = true;
+          kind = IslandSolver::kSoft;
+        }
         if (s.reports[i].joints > 0 && kind == IslandSolver::kExact) kind = IslandSolver::kSoft;
         s.reports[i].solver = kind;
         if (kind == IslandSolver::kSoft) {

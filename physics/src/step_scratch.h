@@ -11,6 +11,7 @@
 #include "continuous.h"
 #include "islands.h"
 #include "joint_solver.h"
+#include "joint_tree.h"
 #include "tall_stacks.h"
 #include "team_barrier.h"
 
@@ -34,6 +35,10 @@ struct IslandReport {
   int pgs_iterations = 0;
   bool stiffness_capped = false;
   std::uint32_t joints = 0;  // the island's joints: it is solved on one thread, soft or pgs
+  // Its joints' rows solved directly (joint_tree.h: exact and auto), or asked to be and found
+  // to close a loop (then Gauss-Seidel).
+  bool joint_tree = false;
+  bool joint_loop = false;
 };
 
 // An island this large is worth splitting over threads (and is split with one thread too, so the
@@ -112,6 +117,7 @@ struct StepScratch {
   std::vector<double> first_impact;
   std::vector<std::uint32_t> support_level;               // for tall_stacks.h
   std::vector<std::vector<LevelSums>> thread_level_sums;  // for tall_stacks.h, one per thread
+  std::vector<JointTree> joint_trees;                     // for joint_tree.h, one per thread
   // The touching pairs as the last step left them, with their impulses (contact_pairs.h), sorted
   // by body pair; and this step's, contact for contact, with the index of each one's record in
   // `pairs` (kNoRecord: none) and whether its manifold was taken from there.

@@ -126,6 +126,10 @@ struct StepStats {
   // the solve's end (World::joint_error's measure: m, or rad for axes and rotations). The joint
   // passes are a fixed few a move; this says when they were not enough.
   std::uint32_t solved_joints = 0;
+  // Islands whose joints were solved directly (exact and auto, joint_tree.h), and islands that
+  // asked for it but whose joints close a loop (solved by Gauss-Seidel sweeps instead).
+  std::uint32_t joint_tree_islands = 0;
+  std::uint32_t joint_loop_islands = 0;
   double joint_error = 0;
   std::uint32_t collision_flags = 0;
   // Bodies whose implicit gyroscopic step hit its Newton iteration bound or spun too fast for

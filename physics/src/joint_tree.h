@@ -1,0 +1,77 @@
+// The direct solve of an island's joints when they form no loop: the rows every joint must hold
+// (joint_solver.h, JointEquations) solved together and exactly, in time linear in the joints
+// (Baraff 1996, "Linear-time dynamics using Lagrange multipliers", SIGGRAPH). Gauss-Seidel passes
+// a chain's load one link a sweep, so a chain with a heavy end stretches (1:1000 by centimetres);
+// solved directly it holds whatever the masses.
+//
+// The system is the block matrix [M J^T; J 0] over the jointed moving bodies and the joints, a
+// tree (a forest) when the joints close no loop: each body and each joint a node, a joint joined
+// to its moving bodies. Eliminating every node after its children fills nothing in. Statics and
+// the world are no nodes: their velocity is fixed. Limits, motors and springs stay Gauss-Seidel
+// rows swept before it.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "contact_solver.h"
+#include "joint_solver.h"
+
+namespace tumble {
+
+class JointTree {
+ public:
+  // The forest of the island's joints (indices into `rows`); false when the joints close a loop
+  // (the island keeps Gauss-Seidel). `body_count`: the step's solver bodies. Keeps its memory
+  // from one island to the next.
+  bool build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
+             std::span<const SolverBody> bodies, std::size_t body_count);
+
+  // Velocities that hold every joint's rows at the sweep's targets (JointTarget); the impulses
+  // are added to the joints' warm start. Returns the largest velocity change it made.
+  double solve_velocities(std::span<JointRow> rows, std::span<SolverBody> bodies,
+                          std::span<const Pose> poses, const JointTarget& target);
+  // Moves the bodies onto every joint's rows, to first order (one Newton step; velocities
+  // untouched): a position pass.
+  void solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
+                       std::span<Pose> poses);
+
+ private:
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+
+  // A body (its solver index) or a joint (its index into the rows).
+  struct Node {
+    bool is_joint = false;
+    std::uint32_t index = 0;
+    std::uint32_t parent = kNone;  // a node
+    // The block of this node's rows and the parent's columns (a joint's Jacobian on its parent
+    // body, or a body's Jacobian columns of its parent joint, transposed).
+    Mat6 to_parent = Mat6::Zero();
+    Mat6 pivot = Mat6::Zero();  // the node's diagonal block once its children are eliminated
+    Vec6 rhs = Vec6::Zero();
+  };
+
+  // Fills the joints' rows and targets (a body's right side: M v for velocities, else 0),
+  // factors, solves; the solution per node in rhs.
+  template <class Equations>
+  void factor_and_solve(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
+                        bool velocities, Equations equations);
+
+  std::vector<Node> nodes_;                  // children before their parents
+  std::vector<std::uint32_t> node_of_body_;  // by solver index: kNone if none
+  std::vector<std::uint32_t> bodies_used_;   // solver indices whose node_of_body_ is set
+  std::vector<JointEquations> equations_;    // by node, for joints
+  // A substep's targets for its sweeps before the move (solve_velocities).
+  std::vector<Eigen::Matrix<double, 6, 1>> kept_targets_;
+  int target_refreshes_ = 0;  // since the last move
+  static constexpr int kTargetRefreshes = 1;
+  // For building: each node's neighbours and the visit.
+  std::vector<std::uint32_t> first_edge_, next_edge_, edge_to_, pending_, parent_of_, order_;
+  std::vector<std::uint8_t> visited_;
+};
+
+}  // namespace tumble
