@@ -221,6 +221,65 @@ TEST(StandardScenes, PendulumAndChainSwingOnTheirJoints) {
   EXPECT_FALSE(standard_scene("chain:5000", 1000));
 }
 
+// The joint scenes of docs/SCENES.md run and do what they are for: the cradle never gains energy
+// and passes its swing to the far ball; the double pendulum (chaotic) stays within 0.5% of its
+// energy (solved directly it rose at most 0.26% over 20 s; soft, 4%: not yet the "never grows"
+// the issue asks); the door stops at its quarter turn and closes again; the rope bridge's loop
+// of joints is named in the statistics.
+TEST(StandardScenes, JointScenesDoWhatTheyAreFor) {
+  for (const char* name : {"double-pendulum", "cradle"}) {
+    SceneDef scene = standard_scene(name).value();
+    World world = build(scene);
+    const double start = total_energy(world);
+    double highest = start, worst = 0;
+    for (int step = 0; step < 240; ++step) {
+      ASSERT_TRUE(world.step(scene.dt));
+      highest = std::max(highest, total_energy(world));
+      worst = std::max(worst, world.last_step().joint_error);
+    }
+    const double allowed = std::string(name) == "cradle" ? 1e-6 : 5e-3;
+    EXPECT_LE(highest, start + allowed * std::abs(start)) << name;
+    EXPECT_LT(worst, 1e-3) << name;
+    if (std::string(name) == "cradle") {
+      // Somewhere in the first seconds the far ball rises well above its rest (the swing passed
+      // through the row).
+      double highest_far = 0;
+      SceneDef again = standard_scene(name).value();
+      World cradle = build(again);
+      const double rest = cradle.body(cradle.id_at(5)).position().z();
+      for (int step = 0; step < 120; ++step) {
+        ASSERT_TRUE(cradle.step(again.dt));
+        highest_far = std::max(highest_far, cradle.body(cradle.id_at(5)).position().z() - rest);
+      }
+      EXPECT_GT(highest_far, 0.05);  // 0.079 m of the first ball's 0.29 m (soft contacts)
+    }
+  }
+  {
+    SceneDef scene = standard_scene("door").value();
+    World world = build(scene);
+    const BodyId door = world.id_at(1);
+    double widest = 0;
+    for (int step = 0; step < 600; ++step) {
+      ASSERT_TRUE(world.step(scene.dt));
+      const Vec3 face = world.body(door).orientation() * Vec3::UnitX();
+      widest = std::max(widest, std::atan2(face.y(), face.x()));
+    }
+    EXPECT_LT(widest, std::numbers::pi / 2 + 2e-3);  // the stop
+    EXPECT_GT(widest, 1.0);                          // it did swing open
+    const Vec3 face = world.body(door).orientation() * Vec3::UnitX();
+    EXPECT_LT(std::abs(std::atan2(face.y(), face.x())), 0.05);  // closed again by its spring
+  }
+  {
+    SceneDef scene = standard_scene("rope-bridge:8").value();
+    World world = build(scene);
+    EXPECT_EQ(world.joint_count(), 9u);
+    for (int step = 0; step < 120; ++step)
+      ASSERT_TRUE(world.step(scene.dt));
+    EXPECT_EQ(world.last_step().joint_loop_islands, 1u);
+    EXPECT_LT(world.last_step().joint_error, 1e-2);
+  }
+}
+
 TEST(SceneJson, DefaultSceneIsBuiltInAndFalls) {
   const Result<SceneDef> scene = parse_scene(default_scene_json());
   ASSERT_TRUE(scene.ok()) << scene.error();

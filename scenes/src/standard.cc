@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace tumble {
@@ -175,6 +176,96 @@ SceneDef chain_scene(int links) {
   return scene;
 }
 
+SceneDef double_pendulum_scene() {
+  SceneDef scene = base_scene("double-pendulum", 20);
+  scene.bodies.push_back(ground());
+  for (int i = 0; i < 2; ++i) {
+    BodyDef bob;
+    bob.shape = SphereDef{0.05};
+    bob.mass = 1;
+    bob.position = Vec3(i + 1.0, 0, 3);
+    scene.bodies.push_back(bob);
+    SceneJoint rod;
+    rod.def.kind = JointKind::kDistance;
+    rod.def.anchor = bob.position;
+    rod.def.anchor_b = Vec3(i, 0, 3);
+    rod.a = scene.bodies.size() - 1;
+    if (i > 0) rod.b = scene.bodies.size() - 2;
+    scene.joints.push_back(rod);
+  }
+  return scene;
+}
+
+SceneDef cradle_scene() {
+  SceneDef scene = base_scene("cradle", 10);
+  scene.bodies.push_back(ground());
+  const double radius = 0.05, length = 1, top = 1.5;
+  for (int i = 0; i < 5; ++i) {
+    const Vec3 pivot(2 * radius * i, 0, top);
+    BodyDef ball;
+    ball.shape = SphereDef{radius};
+    ball.mass = 1;
+    ball.restitution = 1;
+    ball.friction = 0;
+    // The first ball is pulled out 45 degrees; the others hang touching.
+    const double angle = i == 0 ? -std::numbers::pi / 4 : 0;
+    ball.position = pivot + length * Vec3(std::sin(angle), 0, -std::cos(angle));
+    scene.bodies.push_back(ball);
+    SceneJoint rod;
+    rod.def.kind = JointKind::kDistance;
+    rod.def.anchor = ball.position;
+    rod.def.anchor_b = pivot;
+    rod.a = scene.bodies.size() - 1;
+    scene.joints.push_back(rod);
+  }
+  return scene;
+}
+
+SceneDef door_scene() {
+  SceneDef scene = base_scene("door", 10);
+  scene.bodies.push_back(ground());
+  // A 1 m x 2 m door of 20 kg hinged along its edge at x = 0, pushed open at 4 rad/s about the
+  // hinge: it swings to its stop at a quarter turn and its spring closes it again.
+  BodyDef door = box(Vec3(1, 0.05, 2), 20, Vec3(0.5, 0, 1.01));
+  door.angular_velocity = Vec3(0, 0, 4);
+  door.linear_velocity = Vec3(0, 2, 0);  // the centre, 0.5 m from the hinge
+  scene.bodies.push_back(door);
+  SceneJoint hinge;
+  hinge.def.kind = JointKind::kHinge;
+  hinge.def.anchor = Vec3(0, 0, 1.01);
+  hinge.def.axis = Vec3::UnitZ();
+  hinge.def.limit = {true, -std::numbers::pi / 2, 0};  // b (the world) turns back as the door opens
+  hinge.def.spring = {true, 0, 20, 4};
+  hinge.a = 1;
+  scene.joints.push_back(hinge);
+  return scene;
+}
+
+SceneDef rope_bridge_scene(int planks) {
+  SceneDef scene = base_scene("rope-bridge-" + std::to_string(planks), 10);
+  scene.bodies.push_back(ground());
+  // Planks 0.3 m long across a gap, hinged to each other about y and to the world at both ends:
+  // the joints close a loop through the world (solved by Gauss-Seidel sweeps).
+  const double plank = 0.3, height = 3;
+  for (int i = 0; i < planks; ++i) {
+    scene.bodies.push_back(box(Vec3(plank - 0.02, 1, 0.05), 2, Vec3(plank * (i + 0.5), 0, height)));
+    SceneJoint joint;
+    joint.def.kind = JointKind::kHinge;
+    joint.def.axis = Vec3::UnitY();
+    joint.def.anchor = Vec3(plank * i, 0, height);
+    joint.a = scene.bodies.size() - 1;
+    if (i > 0) joint.b = scene.bodies.size() - 2;
+    scene.joints.push_back(joint);
+  }
+  SceneJoint end;
+  end.def.kind = JointKind::kHinge;
+  end.def.axis = Vec3::UnitY();
+  end.def.anchor = Vec3(plank * planks, 0, height);
+  end.a = scene.bodies.size() - 1;
+  scene.joints.push_back(end);
+  return scene;
+}
+
 namespace {
 
 Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bodies) {
@@ -193,7 +284,8 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   // Counted, ground included, before anything is built, so a request for a huge scene costs
   // nothing.
-  if (name == "pile" || name == "pyramid" || name == "tower" || name == "chain") {
+  if (name == "pile" || name == "pyramid" || name == "tower" || name == "chain" ||
+      name == "rope-bridge") {
     const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(name == "pile" ? 1000 : 20));
     const std::uint64_t bodies = (name == "pyramid" ? n * (n + 1) / 2 : n) + 1;
     if (bodies > max_bodies)
@@ -229,6 +321,19 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     return bounce_scene();
   }
   if (name == "chain") return chain_scene(size.value_or(20));
+  if (name == "rope-bridge") return rope_bridge_scene(size.value_or(20));
+  if (name == "double-pendulum") {
+    if (Status s = sized("double-pendulum"); !s) return s;
+    return double_pendulum_scene();
+  }
+  if (name == "cradle") {
+    if (Status s = sized("cradle"); !s) return s;
+    return cradle_scene();
+  }
+  if (name == "door") {
+    if (Status s = sized("door"); !s) return s;
+    return door_scene();
+  }
   if (name == "pendulum") {
     if (Status s = sized("pendulum"); !s) return s;
     return pendulum_scene();
@@ -239,7 +344,8 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   return Status::error("scene '" + shown(spec) +
                        "': unknown; the standard scenes are pile, pyramid, tower, mass-ratio, "
-                       "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, chain, default");
+                       "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
+                       "chain, cradle, door, rope-bridge, default");
 }
 
 }  // namespace

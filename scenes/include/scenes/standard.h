@@ -43,10 +43,18 @@ SceneDef bounce_scene(double height = 1,
 // `links` ball-jointed 0.2 m links hung from a fixed point and released level, 10 s.
 SceneDef pendulum_scene();
 SceneDef chain_scene(int links = 20);
+// Two 1 kg bobs on 1 m rods, released level, 20 s; Newton's cradle (five 1 kg balls of 5 cm on
+// 1 m rods, the first pulled out 45 degrees), 10 s; a 20 kg door on a hinge with a stop at a
+// quarter turn and a closing spring, pushed open, 10 s; a rope bridge of `planks` hinged planks
+// held at both ends (a loop of joints), 10 s.
+SceneDef double_pendulum_scene();
+SceneDef cradle_scene();
+SceneDef door_scene();
+SceneDef rope_bridge_scene(int planks = 20);
 
 // A standard scene by name, with an optional size: "pile", "pile:250", "pyramid:10", "tower:5",
-// "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "pendulum", "chain:20",
-// "default". A size whose
+// "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "pendulum",
+// "double-pendulum", "chain:20", "cradle", "door", "rope-bridge:20", "default". A size whose
 // scene would have more than `max_bodies` bodies is refused before anything is built.
 Result<SceneDef> standard_scene(std::string_view name, std::size_t max_bodies = 1000000);
 
