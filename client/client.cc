@@ -110,6 +110,33 @@ Status Client::apply_impulses(const std::vector<v1::Impulse>& impulses) {
   return call<v1::ApplyImpulseResponse>(&v1::World::Stub::ApplyImpulse, request).status();
 }
 
+Result<std::vector<std::uint64_t>> Client::create_joints(const std::vector<v1::JointSpec>& joints) {
+  v1::CreateJointsRequest request;
+  request.mutable_joints()->Add(joints.begin(), joints.end());
+  Result<v1::CreateJointsResponse> made =
+      call<v1::CreateJointsResponse>(&v1::World::Stub::CreateJoints, request);
+  if (!made) return made.status();
+  return std::vector<std::uint64_t>(made.value().ids().begin(), made.value().ids().end());
+}
+
+Status Client::remove_joints(const std::vector<std::uint64_t>& ids) {
+  v1::RemoveJointsRequest request;
+  request.mutable_ids()->Add(ids.begin(), ids.end());
+  return call<v1::RemoveJointsResponse>(&v1::World::Stub::RemoveJoints, request).status();
+}
+
+Status Client::set_joint_drives(const std::vector<v1::JointDriveUpdate>& updates) {
+  v1::SetJointDrivesRequest request;
+  request.mutable_updates()->Add(updates.begin(), updates.end());
+  return call<v1::SetJointDrivesResponse>(&v1::World::Stub::SetJointDrives, request).status();
+}
+
+Result<v1::GetJointsResponse> Client::joints(const std::vector<std::uint64_t>& ids) {
+  v1::GetJointsRequest request;
+  request.mutable_ids()->Add(ids.begin(), ids.end());
+  return call<v1::GetJointsResponse>(&v1::World::Stub::GetJoints, request);
+}
+
 Result<v1::ControlResponse> Client::control(const v1::ControlRequest& request) {
   return call<v1::ControlResponse>(&v1::World::Stub::Control, request);
 }

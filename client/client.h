@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "tumble/wire_status.h"
 #include "tumble/v1/world.grpc.pb.h"
+#include "tumble/wire_status.h"
 
 namespace tumble::client {
 
@@ -56,6 +56,11 @@ class Client {
   // All or nothing: one refused update or impulse leaves every body as it was.
   Status set_states(const std::vector<v1::BodyStateUpdate>& updates);
   Status apply_impulses(const std::vector<v1::Impulse>& impulses);
+  // Joints (docs/SERVICE.md, "Joints"), all or nothing.
+  Result<std::vector<std::uint64_t>> create_joints(const std::vector<v1::JointSpec>& joints);
+  Status remove_joints(const std::vector<std::uint64_t>& ids);
+  Status set_joint_drives(const std::vector<v1::JointDriveUpdate>& updates);
+  Result<v1::GetJointsResponse> joints(const std::vector<std::uint64_t>& ids = {});
   Result<v1::ControlResponse> control(const v1::ControlRequest& request);
   Result<v1::LoadSceneResponse> load_scene(const v1::LoadSceneRequest& request);
   Result<v1::SnapshotResponse> snapshot();

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string_view>
@@ -222,6 +223,51 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(3);
 
+  CLI::App* joint =
+      app.add_subcommand("joint", "join body A to body B (or the world); prints its id");
+  std::string joint_kind;
+  std::uint64_t joint_a = 0, joint_b = 0;
+  std::vector<double> anchor, anchor_b, axis, limit, motor, spring;
+  double length = 0, max_swing = 0;
+  bool collide = false, motor_off = false, spring_off = false;
+  joint->add_option("kind", joint_kind, "ball, hinge, fixed, distance or slider")
+      ->required()
+      ->check(CLI::IsMember({"ball", "hinge", "fixed", "distance", "slider"}));
+  joint->add_option("a", joint_a, "a body's id")->required();
+  joint->add_option("b", joint_b, "another body's id (default: the world)");
+  joint->add_option("--anchor", anchor, "x,y,z (m, world): where the joint is")
+      ->required()
+      ->delimiter(',')
+      ->expected(3);
+  joint->add_option("--anchor-b", anchor_b, "x,y,z (m): a distance joint's end on b")
+      ->delimiter(',')
+      ->expected(3);
+  joint->add_option("--axis", axis, "x,y,z: a hinge's or slider's axis, a ball's twist axis")
+      ->delimiter(',')
+      ->expected(3);
+  joint->add_option("--length", length, "a distance joint's length (m; default: as made)");
+  joint->add_option("--limit", limit, "lower,upper of the angle (rad) or offset (m)")
+      ->delimiter(',')
+      ->expected(2);
+  joint->add_option("--motor", motor, "speed,max_force (rad/s,N m or m/s,N)")
+      ->delimiter(',')
+      ->expected(2);
+  joint->add_option("--spring", spring, "target,stiffness,damping")->delimiter(',')->expected(3);
+  joint->add_option("--max-swing", max_swing, "a ball's cone (rad)");
+  joint->add_flag("--collide", collide, "the two bodies still collide");
+
+  CLI::App* joints = app.add_subcommand("joints", "joints' definitions and states as JSON lines");
+  joints->add_option("ids", ids, "joint ids, by spaces or commas (default: all)")->delimiter(',');
+  CLI::App* unjoint = app.add_subcommand("remove-joints", "remove joints by id");
+  unjoint->add_option("ids", ids, "joint ids, by spaces or commas")->required()->delimiter(',');
+  CLI::App* drive = app.add_subcommand("drive", "change a joint's motor or spring while it runs");
+  std::uint64_t joint_id = 0;
+  drive->add_option("id", joint_id, "the joint's id")->required();
+  drive->add_option("--motor", motor, "speed,max_force")->delimiter(',')->expected(2);
+  drive->add_option("--spring", spring, "target,stiffness,damping")->delimiter(',')->expected(3);
+  drive->add_flag("--motor-off", motor_off, "remove the motor");
+  drive->add_flag("--spring-off", spring_off, "remove the spring");
+
   CLI::App* play = app.add_subcommand("play", "run continuously");
   CLI::App* pause = app.add_subcommand("pause", "stop after the current step");
   CLI::App* reset = app.add_subcommand("reset", "back to the scene as loaded");
@@ -341,6 +387,82 @@ int main(int argc, char** argv) {
     std::printf("%s: %d bodies\n", loaded.value().name().c_str(), loaded.value().ids_size());
   } else if (*remove) {
     if (Status s = client.remove(ids); !s) return fail("remove", s);
+  } else if (*joint) {
+    const auto kinds = std::map<std::string, v1::JointKind>{{"ball", v1::JOINT_KIND_BALL},
+                                                            {"hinge", v1::JOINT_KIND_HINGE},
+                                                            {"fixed", v1::JOINT_KIND_FIXED},
+                                                            {"distance", v1::JOINT_KIND_DISTANCE},
+                                                            {"slider", v1::JOINT_KIND_SLIDER}};
+    const auto put = [](const std::vector<double>& x, v1::Vec3* out) {
+      out->set_x(x[0]);
+      out->set_y(x[1]);
+      out->set_z(x[2]);
+    };
+    v1::JointSpec spec;
+    spec.set_kind(kinds.at(joint_kind));
+    spec.set_a(joint_a);
+    spec.set_b(joint_b);
+    put(anchor, spec.mutable_anchor());
+    if (!anchor_b.empty()) put(anchor_b, spec.mutable_anchor_b());
+    if (!axis.empty()) put(axis, spec.mutable_axis());
+    spec.set_length(length);
+    spec.set_collide_connected(collide);
+    if (!limit.empty()) {
+      spec.mutable_limit()->set_lower(limit[0]);
+      spec.mutable_limit()->set_upper(limit[1]);
+    }
+    if (!motor.empty()) {
+      spec.mutable_motor()->set_speed(motor[0]);
+      spec.mutable_motor()->set_max_force(motor[1]);
+    }
+    if (!spring.empty()) {
+      spec.mutable_spring()->set_target(spring[0]);
+      spec.mutable_spring()->set_stiffness(spring[1]);
+      spec.mutable_spring()->set_damping(spring[2]);
+    }
+    if (max_swing != 0) spec.set_max_swing(max_swing);
+    Result<std::vector<std::uint64_t>> made = client.create_joints({spec});
+    if (!made) return fail("joint", made.status());
+    print_line(std::to_string(made.value()[0]));
+  } else if (*joints) {
+    Result<v1::GetJointsResponse> got = client.joints(ids);
+    if (!got) return fail("joints", got.status());
+    const auto v = [](const v1::Vec3& x) { return nlohmann::json{x.x(), x.y(), x.z()}; };
+    for (int i = 0; i < got.value().ids_size(); ++i) {
+      const v1::JointSpec& spec = got.value().specs(i);
+      const v1::JointState& state = got.value().states(i);
+      std::string kind = v1::JointKind_Name(spec.kind()).substr(std::string("JOINT_KIND_").size());
+      for (char& c : kind)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      print_line(nlohmann::json{{"id", got.value().ids(i)},
+                                {"kind", kind},
+                                {"a", spec.a()},
+                                {"b", spec.b()},
+                                {"position", state.position()},
+                                {"speed", state.speed()},
+                                {"effort", state.effort()},
+                                {"force", v(state.force())},
+                                {"torque", v(state.torque())},
+                                {"error", state.error()}}
+                     .dump());
+    }
+  } else if (*unjoint) {
+    if (Status s = client.remove_joints(ids); !s) return fail("remove-joints", s);
+  } else if (*drive) {
+    v1::JointDriveUpdate update;
+    update.set_id(joint_id);
+    if (!motor.empty()) {
+      update.mutable_motor()->set_speed(motor[0]);
+      update.mutable_motor()->set_max_force(motor[1]);
+    }
+    if (!spring.empty()) {
+      update.mutable_spring()->set_target(spring[0]);
+      update.mutable_spring()->set_stiffness(spring[1]);
+      update.mutable_spring()->set_damping(spring[2]);
+    }
+    update.set_motor_off(motor_off);
+    update.set_spring_off(spring_off);
+    if (Status s = client.set_joint_drives({update}); !s) return fail("drive", s);
   } else if (*bodies) {
     Result<v1::GetBodiesResponse> got = client.bodies(ids);
     if (!got) return fail("bodies", got.status());

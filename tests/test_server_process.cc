@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <cstdlib>
@@ -114,8 +115,9 @@ TEST(ServerProcess, CliCommandsHealthSnapshotRecordAndReplay) {
   const std::string tumble = cli(server);
   TempDir dir;
   for (const char* command :
-       {"info", "health", "spawn", "spawn-scene", "remove", "bodies", "play", "pause", "reset",
-        "step", "set", "snapshot", "restore", "stream", "record", "replay"}) {
+       {"info",   "health", "spawn", "spawn-scene", "remove",        "bodies",  "play",
+        "pause",  "reset",  "step",  "set",         "snapshot",      "restore", "stream",
+        "record", "replay", "joint", "joints",      "remove-joints", "drive"}) {
     const Output help = run(tumble + command + " --help");
     EXPECT_EQ(help.code, 0) << command;
     EXPECT_NE(help.text.find("Usage"), std::string::npos) << command << ": " << help.text;
@@ -177,6 +179,35 @@ TEST(ServerProcess, CliCommandsHealthSnapshotRecordAndReplay) {
   const Output refused = run(tumble + "restore " + dir / "run.rec");
   EXPECT_NE(refused.code, 0);
   EXPECT_NE(refused.text.find("state"), std::string::npos) << refused.text;
+}
+
+TEST(ServerProcess, CliJoinsDrivesReadsAndRemovesJoints) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  const Output spawned = run(tumble + "spawn box --size 1,1,0.2 --mass 1 --pos 0,0,20");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  const std::string body = spawned.text.substr(0, spawned.text.find('\n'));
+  const Output made =
+      run(tumble + "joint hinge " + body + " --anchor 0,0,20 --axis 0,0,1 --motor 2,100");
+  ASSERT_EQ(made.code, 0) << made.text;
+  const std::string joint = made.text.substr(0, made.text.find('\n'));
+  ASSERT_EQ(run(tumble + "step 60").code, 0);
+  const Output read = run(tumble + "joints " + joint);
+  ASSERT_EQ(read.code, 0) << read.text;
+  const nlohmann::json state = nlohmann::json::parse(read.text);
+  EXPECT_EQ(state["kind"], "hinge");
+  EXPECT_NEAR(state["speed"].get<double>(), 2, 1e-9);
+  ASSERT_EQ(run(tumble + "drive " + joint + " --motor -1,100").code, 0);
+  ASSERT_EQ(run(tumble + "step 30").code, 0);
+  EXPECT_NEAR(nlohmann::json::parse(run(tumble + "joints").text)["speed"].get<double>(), -1, 1e-9);
+  const Output refused = run(tumble + "joint ball " + body + " --anchor 0,0,20 --motor 1,1");
+  EXPECT_NE(refused.code, 0);
+  EXPECT_NE(refused.text.find("joints[0].motor: only hinges and sliders"), std::string::npos)
+      << refused.text;
+  ASSERT_EQ(run(tumble + "remove-joints " + joint).code, 0);
+  EXPECT_EQ(run(tumble + "joints").text, "");
+  EXPECT_NE(run(tumble + "remove-joints " + joint).code, 0);  // gone
 }
 
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
