@@ -363,6 +363,7 @@ int main(int argc, char** argv) {
                               {"step", i.step()},
                               {"time", i.time()},
                               {"bodies", i.body_count()},
+                              {"joints", i.joint_count()},
                               {"running", i.running()},
                               {"subscribers", i.subscribers()},
                               {"achieved_real_time_factor", i.achieved_real_time_factor()},

@@ -192,6 +192,7 @@ TEST(ServerProcess, CliJoinsDrivesReadsAndRemovesJoints) {
       run(tumble + "joint hinge " + body + " --anchor 0,0,20 --axis 0,0,1 --motor 2,100");
   ASSERT_EQ(made.code, 0) << made.text;
   const std::string joint = made.text.substr(0, made.text.find('\n'));
+  EXPECT_EQ(nlohmann::json::parse(run(tumble + "info").text)["joints"], 1);
   ASSERT_EQ(run(tumble + "step 60").code, 0);
   const Output read = run(tumble + "joints " + joint);
   ASSERT_EQ(read.code, 0) << read.text;

@@ -167,6 +167,7 @@ Result<std::string> LocalWorld::info() const {
   response.set_step(hosted_.world.step_count());
   response.set_time(hosted_.world.time());
   response.set_body_count(static_cast<std::uint32_t>(hosted_.world.body_count()));
+  response.set_joint_count(static_cast<std::uint32_t>(hosted_.world.joint_count()));
   response.set_running(running_);
   server::run_settings_to_proto(hosted_.dt, real_time_factor_, hosted_.world.settings(),
                                 response.mutable_settings());

@@ -49,6 +49,7 @@ def test_bad_joints_are_refused_naming_the_field_and_removal_is_all_or_nothing(w
     with pytest.raises(tumble.Error, match="kind: must be one of"):
         world.joint("rope", ball)
     rod = world.joint("distance", ball, anchor=(0, 0, 3), anchor_b=(0, 0, 4))
+    assert world.info().joint_count == 1
     with pytest.raises(tumble.Error, match=r"ids\[1\]: no joint"):
         world.remove_joints([rod, 987654])
     assert len(world.joints()) == 1

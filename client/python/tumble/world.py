@@ -65,6 +65,7 @@ class Info:
     # world is late on its real-time factor (by more than a quarter second).
     achieved_real_time_factor: float = 0.0
     behind: bool = False
+    joint_count: int = 0
 
 
 @dataclass
@@ -363,7 +364,7 @@ class WorldCalls:
         return Info(response.version, response.step, response.time, response.body_count,
                     response.running, Settings.from_proto(response.settings),
                     plain(response.last_step), response.subscribers,
-                    response.achieved_real_time_factor, response.behind)
+                    response.achieved_real_time_factor, response.behind, response.joint_count)
 
     # --- snapshots ---------------------------------------------------------------------------
 
