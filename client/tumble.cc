@@ -142,6 +142,17 @@ std::optional<v1::SolverKind> solver_kind(const std::string& name) {
   return std::nullopt;
 }
 
+// A joint's motor (speed, max_force) and spring (target, stiffness, damping) from the CLI's lists.
+void put_motor(const std::vector<double>& m, v1::JointMotor* out) {
+  out->set_speed(m[0]);
+  out->set_max_force(m[1]);
+}
+void put_spring(const std::vector<double>& s, v1::JointSpring* out) {
+  out->set_target(s[0]);
+  out->set_stiffness(s[1]);
+  out->set_damping(s[2]);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -412,15 +423,8 @@ int main(int argc, char** argv) {
       spec.mutable_limit()->set_lower(limit[0]);
       spec.mutable_limit()->set_upper(limit[1]);
     }
-    if (!motor.empty()) {
-      spec.mutable_motor()->set_speed(motor[0]);
-      spec.mutable_motor()->set_max_force(motor[1]);
-    }
-    if (!spring.empty()) {
-      spec.mutable_spring()->set_target(spring[0]);
-      spec.mutable_spring()->set_stiffness(spring[1]);
-      spec.mutable_spring()->set_damping(spring[2]);
-    }
+    if (!motor.empty()) put_motor(motor, spec.mutable_motor());
+    if (!spring.empty()) put_spring(spring, spec.mutable_spring());
     if (max_swing != 0) spec.set_max_swing(max_swing);
     Result<std::vector<std::uint64_t>> made = client.create_joints({spec});
     if (!made) return fail("joint", made.status());
@@ -452,15 +456,8 @@ int main(int argc, char** argv) {
   } else if (*drive) {
     v1::JointDriveUpdate update;
     update.set_id(joint_id);
-    if (!motor.empty()) {
-      update.mutable_motor()->set_speed(motor[0]);
-      update.mutable_motor()->set_max_force(motor[1]);
-    }
-    if (!spring.empty()) {
-      update.mutable_spring()->set_target(spring[0]);
-      update.mutable_spring()->set_stiffness(spring[1]);
-      update.mutable_spring()->set_damping(spring[2]);
-    }
+    if (!motor.empty()) put_motor(motor, update.mutable_motor());
+    if (!spring.empty()) put_spring(spring, update.mutable_spring());
     update.set_motor_off(motor_off);
     update.set_spring_off(spring_off);
     if (Status s = client.set_joint_drives({update}); !s) return fail("drive", s);

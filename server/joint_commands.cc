@@ -14,12 +14,6 @@ std::string entry(const char* list, int i) {
   return std::string(list) + "[" + std::to_string(i) + "]";
 }
 
-void set(const Vec3& v, v1::Vec3* out) {
-  out->set_x(v.x());
-  out->set_y(v.y());
-  out->set_z(v.z());
-}
-
 JointMotor motor_from_proto(const v1::JointMotor& m) {
   return {true, m.speed(), m.max_force()};
 }
@@ -86,9 +80,9 @@ void joint_to_proto(const JointDef& def, const HostedWorld& hosted, v1::JointSpe
   out->set_kind(static_cast<v1::JointKind>(static_cast<int>(def.kind)));
   out->set_a(hosted.ids.wire(def.a));
   out->set_b(def.b.is_valid() ? hosted.ids.wire(def.b) : 0);
-  set(def.anchor, out->mutable_anchor());
-  if (def.kind == JointKind::kDistance) set(def.anchor_b, out->mutable_anchor_b());
-  set(def.axis, out->mutable_axis());
+  vec_to_proto(def.anchor, out->mutable_anchor());
+  if (def.kind == JointKind::kDistance) vec_to_proto(def.anchor_b, out->mutable_anchor_b());
+  vec_to_proto(def.axis, out->mutable_axis());
   out->set_length(def.length);
   out->set_collide_connected(def.collide_connected);
   if (def.limit.enabled) {
@@ -223,8 +217,8 @@ Status get_joints(const HostedWorld& hosted, const v1::GetJointsRequest& request
     state->set_position(reading.position);
     state->set_speed(reading.speed);
     state->set_effort(reading.effort);
-    set(reading.force, state->mutable_force());
-    set(reading.torque, state->mutable_torque());
+    vec_to_proto(reading.force, state->mutable_force());
+    vec_to_proto(reading.torque, state->mutable_torque());
     state->set_error(world.joint_error(id).value());
   }
   return Status::ok();
