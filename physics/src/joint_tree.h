@@ -2,7 +2,8 @@
 // (joint_solver.h, JointEquations) solved together and exactly, in time linear in the joints
 // (Baraff 1996, "Linear-time dynamics using Lagrange multipliers", SIGGRAPH). Gauss-Seidel passes
 // a chain's load one link a sweep, so a chain with a heavy end stretches (1:1000 by centimetres);
-// solved directly it holds whatever the masses.
+// solved directly, with the joints' geometric stiffness (joint_tree.cc), it holds whatever the
+// masses.
 //
 // The system is the block matrix [M J^T; J 0] over the jointed moving bodies and the joints, a
 // tree (a forest) when the joints close no loop: each body and each joint a node, a joint joined
@@ -53,6 +54,10 @@ class JointTree {
     Mat6 to_parent = Mat6::Zero();
     Mat6 pivot = Mat6::Zero();  // the node's diagonal block once its children are eliminated
     Vec6 rhs = Vec6::Zero();
+    // A body's share of its joints' geometric stiffness, times h^2 (linear, angular), added to
+    // its mass in the velocity solve.
+    Mat3 linear_stiffness = Mat3::Zero(), angular_stiffness = Mat3::Zero();
+    Vec3 longest_lever = Vec3::Zero();  // from the body's centre to its farthest joint anchor
   };
 
   // Fills the joints' rows and targets (a body's right side: M v for velocities, else 0),
@@ -60,6 +65,9 @@ class JointTree {
   template <class Equations>
   void factor_and_solve(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                         bool velocities, Equations equations);
+  // Sets each body's stiffness (Node) for a substep of h (joint_tree.cc: why and how much).
+  void set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
+                               std::span<const Pose> poses, double h);
 
   std::vector<Node> nodes_;                  // children before their parents
   std::vector<std::uint32_t> node_of_body_;  // by solver index: kNone if none
