@@ -18,6 +18,23 @@ bool moves(std::span<const SolverBody> bodies, std::uint32_t body) {
   return body != kWorldAnchor && bodies[body].inverse_mass > 0;
 }
 
+// The inverse of a symmetric definite 6x6 block (a body's, positive; a joint's, negative) by its
+// 3x3 blocks' Schur complement: fixed-size closed forms, several times faster than a general
+// factorisation of a small matrix. A singular block gives non-finite entries.
+Eigen::Matrix<double, 6, 6> inverse_of_definite(const Eigen::Matrix<double, 6, 6>& m) {
+  const Mat3 a_inverse = m.topLeftCorner<3, 3>().inverse();
+  const Mat3 b = m.topRightCorner<3, 3>();
+  const Mat3 a_inverse_b = a_inverse * b;
+  const Mat3 schur_inverse = (m.bottomRightCorner<3, 3>() - b.transpose() * a_inverse_b).inverse();
+  const Mat3 corner = -a_inverse_b * schur_inverse;
+  Eigen::Matrix<double, 6, 6> inverse;
+  inverse.topLeftCorner<3, 3>() = a_inverse - corner * a_inverse_b.transpose();
+  inverse.topRightCorner<3, 3>() = corner;
+  inverse.bottomLeftCorner<3, 3>() = corner.transpose();
+  inverse.bottomRightCorner<3, 3>() = schur_inverse;
+  return inverse;
+}
+
 }  // namespace
 
 bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
@@ -121,7 +138,8 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
   for (std::uint32_t body : bodies_used_)
     node_of_body_[body] = new_index[node_of_body_[body]];
   equations_.resize(n);
-  target_refreshes_ = 0;
+  velocities_factored_ = false;
+  targets_taken_ = false;
   return true;
 }
 
@@ -210,32 +228,26 @@ void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
 }
 
 template <class Equations>
-void JointTree::factor_and_solve(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
-                                 bool velocities, Equations equations) {
+void JointTree::factor(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
+                       bool velocities, Equations equations) {
   const std::size_t n = nodes_.size();
-  // The blocks: a body's mass matrix, a joint's zero (its unused rows -1, so that each pivot is
-  // definite), and each node's block with its parent.
+  // The blocks: a body's mass matrix (with its stiffness for velocities), a joint's zero (its
+  // unused rows -1, so that each pivot is definite), and each node's block with its parent.
   for (std::size_t k = 0; k < n; ++k) {
     Node& node = nodes_[k];
+    node.pivot.setZero();
     if (node.is_joint) {
       equations_[k] = equations(k);
-      const JointEquations& e = equations_[k];
-      node.pivot.setZero();
-      for (int r = e.rows; r < 6; ++r)
+      for (int r = equations_[k].rows; r < 6; ++r)
         node.pivot(r, r) = -1;
-      node.rhs = e.target;
     } else {
       const SolverBody& body = bodies[node.index];
-      node.pivot.setZero();
+      node.inertia = body.inverse_inertia.inverse();
       node.pivot.topLeftCorner<3, 3>().diagonal().setConstant(1 / body.inverse_mass);
-      node.pivot.bottomRightCorner<3, 3>() = body.inverse_inertia.inverse();
+      node.pivot.bottomRightCorner<3, 3>() = node.inertia;
       if (velocities) {
-        node.rhs.head<3>() = body.v / body.inverse_mass;
-        node.rhs.tail<3>() = node.pivot.bottomRightCorner<3, 3>() * body.w;
         node.pivot.topLeftCorner<3, 3>() += node.linear_stiffness;
         node.pivot.bottomRightCorner<3, 3>() += node.angular_stiffness;
-      } else {
-        node.rhs.setZero();
       }
     }
   }
@@ -252,52 +264,75 @@ void JointTree::factor_and_solve(std::span<const JointRow> rows, std::span<const
     else
       node.to_parent = jacobian.transpose();
   }
-  // Eliminate children into their parents, then solve from the roots down.
+  // Children eliminated into their parents.
   for (std::size_t k = 0; k < n; ++k) {
     Node& node = nodes_[k];
-    const Eigen::LDLT<Mat6> pivot(node.pivot);
-    node.pivot = pivot.solve(Mat6::Identity());  // kept as its inverse
+    node.pivot = inverse_of_definite(node.pivot);  // kept as its inverse
     if (node.parent == kNone) continue;
-    Node& parent = nodes_[node.parent];
-    const Mat6 reach = node.pivot * node.to_parent;
-    parent.pivot -= node.to_parent.transpose() * reach;
-    parent.rhs -= reach.transpose() * node.rhs;
+    node.reach = node.pivot * node.to_parent;
+    nodes_[node.parent].pivot -= node.to_parent.transpose() * node.reach;
+  }
+}
+
+template <class Targets>
+void JointTree::solve(std::span<const SolverBody> bodies, bool velocities, Targets targets) {
+  const std::size_t n = nodes_.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    Node& node = nodes_[k];
+    if (node.is_joint) {
+      node.rhs = targets(k);
+    } else if (velocities) {
+      const SolverBody& body = bodies[node.index];
+      node.rhs.head<3>() = body.v / body.inverse_mass;
+      node.rhs.tail<3>() = node.inertia * body.w;
+    } else {
+      node.rhs.setZero();
+    }
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const Node& node = nodes_[k];
+    if (node.parent != kNone) nodes_[node.parent].rhs -= node.reach.transpose() * node.rhs;
   }
   for (std::size_t k = n; k-- > 0;) {
     Node& node = nodes_[k];
     if (node.parent == kNone)
       node.rhs = node.pivot * node.rhs;
     else
-      node.rhs = node.pivot * (node.rhs - node.to_parent * nodes_[node.parent].rhs);
+      node.rhs = node.pivot * node.rhs - node.reach * nodes_[node.parent].rhs;
   }
 }
 
 double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBody> bodies,
                                    std::span<const Pose> poses, const JointTarget& target) {
   if (nodes_.empty()) return 0;
+  // The poses stay put between moves: one factoring serves every sweep until the next.
+  if (!velocities_factored_) {
+    set_geometric_stiffness(rows, bodies, poses, target.substep);
+    factor(rows, bodies, true, [&](std::size_t k) {
+      JointTarget plain = target;
+      plain.h = 0;
+      return velocity_equations(rows[nodes_[k].index], bodies, poses, plain);
+    });
+    velocities_factored_ = true;
+  }
   // The targets of a move ahead (the turns' curvature) depend on the velocities: SHAKE's
   // iteration, which converges for a pendulum and diverges for a chain with a heavy end (a
   // 1000 times heavier end gained kilojoules in a step when every sweep took them afresh, and
   // still gained when they were taken twice). So they are taken once a substep, from velocities
   // that already hold every joint (a first solve without them), and kept for its other sweeps.
-  if (target.h > 0 && target_refreshes_ < kTargetRefreshes) {
-    if (target_refreshes_ == 0) {
-      JointTarget plain = target;
-      plain.h = 0;
-      solve_velocities(rows, bodies, poses, plain);
-    }
+  // Without a move ahead the rows' rates are held at zero.
+  if (target.h > 0 && !targets_taken_) {
+    JointTarget plain = target;
+    plain.h = 0;
+    solve_velocities(rows, bodies, poses, plain);
     kept_targets_.resize(nodes_.size());
     for (std::size_t k = 0; k < nodes_.size(); ++k)
       if (nodes_[k].is_joint)
         kept_targets_[k] = velocity_equations(rows[nodes_[k].index], bodies, poses, target).target;
-    ++target_refreshes_;
+    targets_taken_ = true;
   }
-  set_geometric_stiffness(rows, bodies, poses, target.substep);
-  factor_and_solve(rows, bodies, true, [&](std::size_t k) {
-    JointEquations e = velocity_equations(rows[nodes_[k].index], bodies, poses, target);
-    if (target.h > 0) e.target = kept_targets_[k];
-    return e;
-  });
+  solve(bodies, true,
+        [&](std::size_t k) { return target.h > 0 ? kept_targets_[k] : Vec6(Vec6::Zero()); });
   // A degenerate joint (its rows dependent) leaves a pivot without an inverse: nothing is
   // applied, and the Gauss-Seidel position passes and next sweeps carry on.
   for (const Node& node : nodes_)
@@ -320,12 +355,22 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
 }
 
 void JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                                std::span<Pose> poses) {
+                                std::span<Pose> poses, bool refactor) {
   if (nodes_.empty()) return;
-  target_refreshes_ = 0;  // a move came before: the next sweeps take their targets afresh
-  factor_and_solve(rows, bodies, false, [&](std::size_t k) {
-    return position_equations(rows[nodes_[k].index], bodies, poses);
-  });
+  // A move came before: the next sweeps factor again and take their targets afresh.
+  velocities_factored_ = false;
+  targets_taken_ = false;
+  if (refactor) {
+    factor(rows, bodies, false, [&](std::size_t k) {
+      equations_[k] = position_equations(rows[nodes_[k].index], bodies, poses);
+      return equations_[k];
+    });
+    solve(bodies, false, [&](std::size_t k) { return equations_[k].target; });
+  } else {
+    solve(bodies, false, [&](std::size_t k) {
+      return position_equations(rows[nodes_[k].index], bodies, poses).target;
+    });
+  }
   for (const Node& node : nodes_)
     if (!node.rhs.allFinite()) return;
   for (const Node& node : nodes_)

@@ -35,9 +35,11 @@ class JointTree {
   double solve_velocities(std::span<JointRow> rows, std::span<SolverBody> bodies,
                           std::span<const Pose> poses, const JointTarget& target);
   // Moves the bodies onto every joint's rows, to first order (one Newton step; velocities
-  // untouched): a position pass.
+  // untouched): a position pass. Without `refactor`, with the rows of the pass before (a chord
+  // step: the passes after the first correct errors a million times smaller, through rows that
+  // barely turned).
   void solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                       std::span<Pose> poses);
+                       std::span<Pose> poses, bool refactor);
 
  private:
   using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -53,18 +55,24 @@ class JointTree {
     // body, or a body's Jacobian columns of its parent joint, transposed).
     Mat6 to_parent = Mat6::Zero();
     Mat6 pivot = Mat6::Zero();  // the node's diagonal block once its children are eliminated
+    Mat6 reach = Mat6::Zero();  // pivot^-1 to_parent, once factored
     Vec6 rhs = Vec6::Zero();
+    Mat3 inertia = Mat3::Zero();  // a body's, world axes
     // A body's share of its joints' geometric stiffness, times h^2 (linear, angular), added to
     // its mass in the velocity solve.
     Mat3 linear_stiffness = Mat3::Zero(), angular_stiffness = Mat3::Zero();
     Vec3 longest_lever = Vec3::Zero();  // from the body's centre to its farthest joint anchor
   };
 
-  // Fills the joints' rows and targets (a body's right side: M v for velocities, else 0),
-  // factors, solves; the solution per node in rhs.
+  // Fills the joints' rows (equations(k) for joint node k) and the bodies' masses (with their
+  // stiffness for velocities) and eliminates the children into their parents.
   template <class Equations>
-  void factor_and_solve(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
-                        bool velocities, Equations equations);
+  void factor(std::span<const JointRow> rows, std::span<const SolverBody> bodies, bool velocities,
+              Equations equations);
+  // With the factors: the right side (a body's M v for velocities, else 0; a joint's rows'
+  // targets(k)) solved, the solution per node in rhs.
+  template <class Targets>
+  void solve(std::span<const SolverBody> bodies, bool velocities, Targets targets);
   // Sets each body's stiffness (Node) for a substep of h (joint_tree.cc: why and how much).
   void set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                                std::span<const Pose> poses, double h);
@@ -75,8 +83,8 @@ class JointTree {
   std::vector<JointEquations> equations_;    // by node, for joints
   // A substep's targets for its sweeps before the move (solve_velocities).
   std::vector<Eigen::Matrix<double, 6, 1>> kept_targets_;
-  int target_refreshes_ = 0;  // since the last move
-  static constexpr int kTargetRefreshes = 1;
+  bool velocities_factored_ = false;  // since the last move
+  bool targets_taken_ = false;        // since the last move
   // For building: each node's neighbours and the visit.
   std::vector<std::uint32_t> first_edge_, next_edge_, edge_to_, pending_, parent_of_, order_;
   std::vector<std::uint8_t> visited_;
