@@ -128,6 +128,21 @@ Json tf_json(const tf2_msgs_msg_dds__TFMessage_& m) {
   return {{"topic", "tf"}, {"time", time}, {"transforms", transforms}};
 }
 
+Json joint_states_json(const sensor_msgs_msg_dds__JointState_& m) {
+  Json names = Json::array();
+  for (std::uint32_t i = 0; i < m.name._length; ++i)
+    names.push_back(m.name._buffer[i]);
+  auto doubles = [](const dds_sequence_double& values) {
+    return std::vector<double>(values._buffer, values._buffer + values._length);
+  };
+  return {{"topic", "joint_states"},
+          {"time", stamp(m.header)},
+          {"name", names},
+          {"position", doubles(m.position)},
+          {"velocity", doubles(m.velocity)},
+          {"effort", doubles(m.effort)}};
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"Prints what tumble-server --dds publishes, as JSON lines."};
   tumble::cli::keep_conventions(app, "tumble-dds-echo");
@@ -137,9 +152,11 @@ int main(int argc, char** argv) {
   double timeout = 0;
   app.add_option("--domain", domain, "the DDS domain")->envname("TUMBLE_DDS_DOMAIN");
   app.add_option("--topics", topics,
-                 "which of poses, pose_ids, contacts, stats, bodies, and of ROS 2's clock and tf")
+                 "which of poses, pose_ids, contacts, stats, bodies, and of ROS 2's clock, tf and "
+                 "joint_states")
       ->delimiter(',')
-      ->check(CLI::IsMember({"poses", "pose_ids", "contacts", "stats", "bodies", "clock", "tf"}));
+      ->check(CLI::IsMember(
+          {"poses", "pose_ids", "contacts", "stats", "bodies", "clock", "tf", "joint_states"}));
   app.add_option("--count", count, "stop after this many samples (0: never)")
       ->check(tumble::cli::non_negative);
   app.add_option("--timeout", timeout,
@@ -177,20 +194,23 @@ int main(int argc, char** argv) {
     return true;
   };
   using geometry_msgs_msg_dds__PoseArray = geometry_msgs_msg_dds__PoseArray_;
-  const bool ok = subscribe("poses", "rt/tumble/poses", &geometry_msgs_msg_dds__PoseArray__desc,
-                            states, convert<geometry_msgs_msg_dds__PoseArray, poses_json>) &&
-                  subscribe("pose_ids", "rt/tumble/pose_ids", &tumble_msgs_msg_dds__BodyIds__desc,
-                            states, convert<tumble_msgs_msg_dds__BodyIds_, ids_json>) &&
-                  subscribe("contacts", "rt/tumble/contacts", &tumble_msgs_msg_dds__Contacts__desc,
-                            states, convert<tumble_msgs_msg_dds__Contacts_, contacts_json>) &&
-                  subscribe("stats", "rt/tumble/stats", &tumble_msgs_msg_dds__StepStats__desc,
-                            states, convert<tumble_msgs_msg_dds__StepStats_, stats_json>) &&
-                  subscribe("bodies", "rt/tumble/bodies", &tumble_msgs_msg_dds__Body__desc,
-                            catalogue, convert<tumble_msgs_msg_dds__Body_, body_json>) &&
-                  subscribe("clock", "rt/clock", &rosgraph_msgs_msg_dds__Clock__desc, ros2,
-                            convert<rosgraph_msgs_msg_dds__Clock_, clock_json>) &&
-                  subscribe("tf", "rt/tf", &tf2_msgs_msg_dds__TFMessage__desc, ros2,
-                            convert<tf2_msgs_msg_dds__TFMessage_, tf_json>);
+  const bool ok =
+      subscribe("poses", "rt/tumble/poses", &geometry_msgs_msg_dds__PoseArray__desc, states,
+                convert<geometry_msgs_msg_dds__PoseArray, poses_json>) &&
+      subscribe("pose_ids", "rt/tumble/pose_ids", &tumble_msgs_msg_dds__BodyIds__desc, states,
+                convert<tumble_msgs_msg_dds__BodyIds_, ids_json>) &&
+      subscribe("contacts", "rt/tumble/contacts", &tumble_msgs_msg_dds__Contacts__desc, states,
+                convert<tumble_msgs_msg_dds__Contacts_, contacts_json>) &&
+      subscribe("stats", "rt/tumble/stats", &tumble_msgs_msg_dds__StepStats__desc, states,
+                convert<tumble_msgs_msg_dds__StepStats_, stats_json>) &&
+      subscribe("bodies", "rt/tumble/bodies", &tumble_msgs_msg_dds__Body__desc, catalogue,
+                convert<tumble_msgs_msg_dds__Body_, body_json>) &&
+      subscribe("clock", "rt/clock", &rosgraph_msgs_msg_dds__Clock__desc, ros2,
+                convert<rosgraph_msgs_msg_dds__Clock_, clock_json>) &&
+      subscribe("tf", "rt/tf", &tf2_msgs_msg_dds__TFMessage__desc, ros2,
+                convert<tf2_msgs_msg_dds__TFMessage_, tf_json>) &&
+      subscribe("joint_states", "rt/joint_states", &sensor_msgs_msg_dds__JointState__desc, ros2,
+                convert<sensor_msgs_msg_dds__JointState_, joint_states_json>);
   dds_delete_qos(states);
   dds_delete_qos(catalogue);
   dds_delete_qos(ros2);

@@ -141,6 +141,36 @@ std::string frame_to_json_line(const v1::Frame& frame) {
   }
   if (frame.removed_size() > 0) line["removed"] = slice(frame.removed(), 0, frame.removed_size());
   if (frame.has_stats()) line["stats"] = stats_json(frame.stats());
+  if (frame.has_joints()) {
+    const v1::JointStates& j = frame.joints();
+    Json joints = Json::array();
+    const bool placed = j.anchors_size() == 3 * j.ids_size() && j.axes_size() == 3 * j.ids_size();
+    for (int i = 0; i < j.ids_size() && j.forces_size() == 3 * j.ids_size(); ++i) {
+      Json joint = {{"id", j.ids(i)},
+                    {"position", j.positions(i)},
+                    {"speed", j.speeds(i)},
+                    {"effort", j.efforts(i)},
+                    {"force", slice(j.forces(), 3 * i, 3)},
+                    {"torque", slice(j.torques(), 3 * i, 3)}};
+      if (placed) {
+        joint["anchor"] = slice(j.anchors(), 3 * i, 3);
+        joint["axis"] = slice(j.axes(), 3 * i, 3);
+      }
+      joints.push_back(std::move(joint));
+    }
+    line["joints"] = std::move(joints);
+  }
+  if (frame.joints_added_size() > 0) {
+    Json added = Json::array();
+    for (const v1::JointDescription& d : frame.joints_added())
+      added.push_back({{"id", d.id()},
+                       {"kind", v1::JointKind_Name(d.spec().kind())},
+                       {"a", d.spec().a()},
+                       {"b", d.spec().b()}});
+    line["joints_added"] = std::move(added);
+  }
+  if (frame.joints_removed_size() > 0)
+    line["joints_removed"] = slice(frame.joints_removed(), 0, frame.joints_removed_size());
   return line.dump();
 }
 

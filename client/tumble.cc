@@ -79,7 +79,7 @@ struct StreamOptions {
   std::string format = "jsonl";
   std::uint64_t frames = 0;
   double rate = 0;
-  bool velocities = false, contacts = false, stats = false;
+  bool velocities = false, contacts = false, stats = false, joints = false;
   std::vector<std::uint64_t> ids;
   bool changes_only = false;
   double full_every = 0;
@@ -94,6 +94,7 @@ struct StreamOptions {
     command->add_flag("--velocities", velocities, "include velocities");
     command->add_flag("--contacts", contacts, "include contact points");
     command->add_flag("--stats", stats, "include the step statistics");
+    command->add_flag("--joints", joints, "include every joint's state and the joints' catalogue");
     command->add_option("--ids", ids, "only these bodies (default: all)")->delimiter(',');
     command->add_flag("--changes-only", changes_only,
                       "list only the bodies changed since the previous frame (the first frame, "
@@ -110,6 +111,7 @@ struct StreamOptions {
     request.set_velocities(velocities);
     request.set_contacts(contacts);
     request.set_stats(stats);
+    request.set_joints(joints);
     request.mutable_ids()->Add(ids.begin(), ids.end());
     request.set_changes_only(changes_only);
     request.set_full_frame_interval(full_every);
@@ -359,9 +361,9 @@ int main(int argc, char** argv) {
   }
 
   if (*stream && stream_options.format == "csv" &&
-      (stream_options.contacts || stream_options.stats))
-    return fail("stream", Status::error("--contacts and --stats need --format jsonl: a CSV row "
-                                        "holds one body's pose"));
+      (stream_options.contacts || stream_options.stats || stream_options.joints))
+    return fail("stream", Status::error("--contacts, --stats and --joints need --format jsonl: a "
+                                        "CSV row holds one body's pose"));
 
   Result<client::Client> connected = client::Client::connect(connection);
   if (!connected) return fail("--tls-ca", connected.status());

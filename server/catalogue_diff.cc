@@ -44,4 +44,27 @@ void CatalogueDiff::add_changes(const FrameData& data, const std::vector<std::ui
   known_catalogue_ = data.catalogue;
 }
 
+void CatalogueDiff::add_joint_changes(const FrameData& data, v1::Frame* out) {
+  // As for bodies: a new catalogue whenever the set of joints changes; a new world describes
+  // every joint again and removes only the ids it no longer has.
+  if (data.joint_catalogue == known_joints_) return;
+  const JointCatalogue& current = *data.joint_catalogue;
+  static const JointCatalogue none;
+  const JointCatalogue& known = known_joints_ != nullptr ? *known_joints_ : none;
+  const bool new_world = data.epoch != joints_epoch_;
+  for (std::size_t i = 0; i < current.ids.size(); ++i) {
+    if (new_world || !std::binary_search(known.ids.begin(), known.ids.end(), current.ids[i])) {
+      v1::JointDescription* added = out->add_joints_added();
+      added->set_id(current.ids[i]);
+      joint_spec_to_proto(current.defs[i], current.body_a[i], current.body_b[i],
+                          added->mutable_spec());
+    }
+  }
+  for (std::uint64_t id : known.ids)
+    if (!std::binary_search(current.ids.begin(), current.ids.end(), id))
+      out->add_joints_removed(id);
+  joints_epoch_ = data.epoch;
+  known_joints_ = data.joint_catalogue;
+}
+
 }  // namespace tumble::server

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace tumble::server {
@@ -300,6 +301,44 @@ void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Fra
     }
   }
   if (options.stats) stats_to_proto(frame.stats, out->mutable_stats());
+  if (options.joints && frame.joints.size() > 0) {
+    const JointTable& table = frame.joints;
+    v1::JointStates* joints = out->mutable_joints();
+    joints->mutable_ids()->Add(table.ids.begin(), table.ids.end());
+    joints->mutable_positions()->Add(table.positions.begin(), table.positions.end());
+    joints->mutable_speeds()->Add(table.speeds.begin(), table.speeds.end());
+    joints->mutable_efforts()->Add(table.efforts.begin(), table.efforts.end());
+    joints->mutable_forces()->Add(table.forces.begin(), table.forces.end());
+    joints->mutable_torques()->Add(table.torques.begin(), table.torques.end());
+    joints->mutable_anchors()->Add(table.anchors.begin(), table.anchors.end());
+    joints->mutable_axes()->Add(table.axes.begin(), table.axes.end());
+  }
+}
+
+void joint_spec_to_proto(const JointDef& def, std::uint64_t a, std::uint64_t b,
+                         v1::JointSpec* out) {
+  out->set_kind(static_cast<v1::JointKind>(static_cast<int>(def.kind)));
+  out->set_a(a);
+  out->set_b(b);
+  vec_to_proto(def.anchor, out->mutable_anchor());
+  if (def.kind == JointKind::kDistance) vec_to_proto(def.anchor_b, out->mutable_anchor_b());
+  vec_to_proto(def.axis, out->mutable_axis());
+  out->set_length(def.length);
+  out->set_collide_connected(def.collide_connected);
+  if (def.limit.enabled) {
+    out->mutable_limit()->set_lower(def.limit.lower);
+    out->mutable_limit()->set_upper(def.limit.upper);
+  }
+  if (def.motor.enabled) {
+    out->mutable_motor()->set_speed(def.motor.speed);
+    out->mutable_motor()->set_max_force(def.motor.max_force);
+  }
+  if (def.spring.enabled) {
+    out->mutable_spring()->set_target(def.spring.target);
+    out->mutable_spring()->set_stiffness(def.spring.stiffness);
+    out->mutable_spring()->set_damping(def.spring.damping);
+  }
+  if (def.max_swing < std::numbers::pi) out->set_max_swing(def.max_swing);
 }
 
 Vec3 vec_from_proto(const v1::Vec3& v) {

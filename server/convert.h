@@ -22,7 +22,7 @@ BodyMotion motion_from_proto(const v1::BodyStateUpdate& update);
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
 
 struct FrameOptions {
-  bool velocities = false, contacts = false, stats = false;
+  bool velocities = false, contacts = false, stats = false, joints = false;
   std::vector<std::uint64_t> ids;  // sorted; empty: every body
   bool changes_only = false;       // StreamFramesRequest.changes_only
   double full_frame_interval = 0;  // s; 0: full frames only when needed
@@ -35,6 +35,9 @@ void frame_to_proto(const FrameData& frame, const FrameOptions& options, v1::Fra
                     std::uint64_t changed_after = 0);
 
 void stats_to_proto(const StepStats& stats, v1::StepStats* out);
+
+// A joint's definition as a JointSpec, its bodies' wire ids given (b: 0 for the world).
+void joint_spec_to_proto(const JointDef& def, std::uint64_t a, std::uint64_t b, v1::JointSpec* out);
 
 // What a Control request changes, checked field by field ("dt: must be finite and > 0").
 struct RunChange {

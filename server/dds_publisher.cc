@@ -31,6 +31,7 @@ using TfMessage = tf2_msgs_msg_dds__TFMessage_;
 using Clock = rosgraph_msgs_msg_dds__Clock_;
 using Marker = visualization_msgs_msg_dds__Marker_;
 using MarkerArray = visualization_msgs_msg_dds__MarkerArray_;
+using JointStates = sensor_msgs_msg_dds__JointState_;
 
 // visualization_msgs/Marker's types and actions.
 constexpr std::int32_t kCube = 1, kSphere = 2, kCylinder = 3, kTriangleList = 11;
@@ -94,7 +95,12 @@ std::string dds_error(const char* what, dds_return_t code) {
 struct DdsPublisher::Writers {
   dds_entity_t participant = 0;
   dds_entity_t poses = 0, ids = 0, contacts = 0, stats = 0, bodies = 0;
-  dds_entity_t tf = 0, clock = 0, markers = 0;  // ROS 2's own types
+  dds_entity_t tf = 0, clock = 0, markers = 0, joint_states = 0;  // ROS 2's own types
+  // Each joint's name ("joint_<id>") by the order of the frame's joints, kept while it is the
+  // same (names are strings: not remade each step).
+  std::vector<std::uint64_t> joint_ids;
+  std::vector<std::string> joint_names;
+  std::vector<char*> joint_name_pointers;
   // What each body looks like to ROS 2, made when the catalogue changes: its frame's name, and
   // its marker (type, scale, colour, the triangles of a hull), the pose filled in per step.
   struct RosLook {
@@ -153,6 +159,7 @@ Result<std::unique_ptr<DdsPublisher>> DdsPublisher::start(WorldHost& host, DdsOp
   writers->clock = writer(&rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", ros2);
   writers->markers =
       writer(&visualization_msgs_msg_dds__MarkerArray__desc, "rt/tumble/markers", ros2);
+  writers->joint_states = writer(&sensor_msgs_msg_dds__JointState__desc, "rt/joint_states", ros2);
   dds_delete_qos(ros2);
   dds_delete_qos(states);
   dds_delete_qos(catalogue);
@@ -267,6 +274,7 @@ void DdsPublisher::publish_ros2(const FrameData& frame, const std_msgs_msg_dds__
   Writers& w = *writers_;
   Clock clock{header.stamp};
   dds_write(w.clock, &clock);
+  publish_joint_states(frame, header);
 
   // /tf and the markers carry the bodies changed since the previous sample: tf buffers and RViz
   // keep the last transform and marker of each body, so a world of sleeping bodies costs them
@@ -430,6 +438,31 @@ void DdsPublisher::publish_catalogue(const FrameData& frame) {
   }
   describe_for_ros2(now);
   catalogue_ = frame.catalogue;
+}
+
+void DdsPublisher::publish_joint_states(const FrameData& frame,
+                                        const std_msgs_msg_dds__Header_& header) {
+  // sensor_msgs/JointState, as robot_state_publisher and RViz read it: a world without joints
+  // sends nothing.
+  const JointTable& joints = frame.joints;
+  if (joints.size() == 0) return;
+  Writers& w = *writers_;
+  if (w.joint_ids != joints.ids) {
+    w.joint_ids = joints.ids;
+    w.joint_names.clear();
+    for (std::uint64_t id : joints.ids)
+      w.joint_names.push_back("joint_" + std::to_string(id));
+    w.joint_name_pointers.clear();
+    for (std::string& name : w.joint_names)
+      w.joint_name_pointers.push_back(name.data());
+  }
+  // DDS reads the buffers on write and never writes them: the frame's own arrays serve.
+  auto doubles = [](const std::vector<double>& values) {
+    return view<dds_sequence_double>(const_cast<std::vector<double>&>(values));
+  };
+  JointStates states{header, view<dds_sequence_string>(w.joint_name_pointers),
+                     doubles(joints.positions), doubles(joints.speeds), doubles(joints.efforts)};
+  dds_write(w.joint_states, &states);
 }
 
 }  // namespace tumble::server

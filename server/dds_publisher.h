@@ -46,6 +46,8 @@ class DdsPublisher {
   void publish_catalogue(const FrameData& frame);
   // ROS 2's own topics of a step: the clock, a transform per body, a marker per body.
   void publish_ros2(const FrameData& frame, const ::std_msgs_msg_dds__Header_& header);
+  // sensor_msgs/JointState on rt/joint_states (the frame's joints; none: nothing sent).
+  void publish_joint_states(const FrameData& frame, const ::std_msgs_msg_dds__Header_& header);
   // Each body's frame name and marker, made once per body when the catalogue changes.
   void describe_for_ros2(const Catalogue& now);
 

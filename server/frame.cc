@@ -48,6 +48,71 @@ void note_changes(HostedWorld& hosted) {
   world.clear_body_events();
 }
 
+namespace {
+
+// The joints' states into `frame`, and their catalogue: the one before while the same joints
+// live in the same world. A world without joints pays one comparison.
+void add_joints(HostedWorld& hosted, FrameData* frame) {
+  const World& world = hosted.world;
+  static const auto none = std::make_shared<const JointCatalogue>();
+  if (world.joint_count() == 0 &&
+      (hosted.joint_catalogue == nullptr || hosted.joint_catalogue->ids.empty())) {
+    frame->joint_catalogue = none;
+    return;
+  }
+  JointTable& table = frame->joints;
+  std::vector<JointId> live;
+  live.reserve(world.joint_count());
+  for (std::uint32_t slot = 0; slot < world.joint_slot_count(); ++slot) {
+    const JointId id = world.joint_at(slot);
+    const std::uint64_t wire = hosted.joint_ids.wire(id);
+    if (!id.is_valid() || wire == 0) continue;  // gone, or not yet given an id
+    live.push_back(id);
+    const JointReading reading = world.joint_reading(id).value();
+    table.ids.push_back(wire);
+    table.positions.push_back(reading.position);
+    table.speeds.push_back(reading.speed);
+    table.efforts.push_back(reading.effort);
+    table.forces.insert(table.forces.end(),
+                        {reading.force.x(), reading.force.y(), reading.force.z()});
+    table.torques.insert(table.torques.end(),
+                         {reading.torque.x(), reading.torque.y(), reading.torque.z()});
+    const JointDef def = world.joint_def(id).value();
+    Vec3 axis = def.axis;
+    if (def.kind == JointKind::kDistance) {
+      const Vec3 rod = def.anchor_b - def.anchor;
+      if (rod.norm() > 0) axis = rod.normalized();
+    }
+    table.anchors.insert(table.anchors.end(), {def.anchor.x(), def.anchor.y(), def.anchor.z()});
+    table.axes.insert(table.axes.end(), {axis.x(), axis.y(), axis.z()});
+  }
+  std::vector<std::size_t> order(live.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t x, std::size_t y) { return table.ids[x] < table.ids[y]; });
+  const std::shared_ptr<const JointCatalogue>& known = hosted.joint_catalogue;
+  bool same = known != nullptr && hosted.joint_catalogue_epoch == hosted.epoch &&
+              known->ids.size() == order.size();
+  for (std::size_t i = 0; same && i < order.size(); ++i)
+    same = known->ids[i] == table.ids[order[i]];
+  if (!same) {
+    auto fresh = std::make_shared<JointCatalogue>();
+    for (std::size_t i : order) {
+      const JointDef def = world.joint_def(live[i]).value();
+      fresh->ids.push_back(table.ids[i]);
+      fresh->body_a.push_back(hosted.ids.wire(def.a));
+      fresh->body_b.push_back(def.b.is_valid() ? hosted.ids.wire(def.b) : 0);
+      fresh->defs.push_back(def);
+    }
+    hosted.joint_catalogue = std::move(fresh);
+    hosted.joint_catalogue_epoch = hosted.epoch;
+  }
+  frame->joint_catalogue = hosted.joint_catalogue;
+}
+
+}  // namespace
+
 std::shared_ptr<const FrameData> make_frame(HostedWorld& hosted, double dt,
                                             std::shared_ptr<const Catalogue> catalogue) {
   const World& world = hosted.world;
@@ -115,6 +180,7 @@ std::shared_ptr<const FrameData> make_frame(HostedWorld& hosted, double dt,
     hosted.resting_table_dt = dt;
   }
   frame->resting_contacts = hosted.resting_table;
+  add_joints(hosted, frame.get());
   return frame;
 }
 

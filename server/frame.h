@@ -35,6 +35,23 @@ struct ContactTable {
   std::size_t size() const { return a.size(); }
 };
 
+// Every joint's state at a step, as parallel arrays (empty in a world without joints).
+struct JointTable {
+  std::vector<std::uint64_t> ids;                  // wire ids, slot order
+  std::vector<double> positions, speeds, efforts;  // along the free coordinate (physics/joint.h)
+  std::vector<double> forces, torques;             // x y z per joint: on b, N and N m, world
+  std::vector<double> anchors, axes;  // x y z per joint: its anchor on a (m) and axis, world
+  std::size_t size() const { return ids.size(); }
+};
+
+// Each live joint's definition, sorted by wire id: shared by frames until the set of joints
+// changes (its drives as they were then: GetJoints has them as they are).
+struct JointCatalogue {
+  std::vector<std::uint64_t> ids;
+  std::vector<JointDef> defs;
+  std::vector<std::uint64_t> body_a, body_b;  // wire ids of each joint's bodies (b: 0, the world)
+};
+
 // One step of the world, shared read-only by every subscriber.
 struct FrameData {
   // Encodings of this frame made for one subscriber and kept for the others that asked for the
@@ -71,6 +88,8 @@ struct FrameData {
     return none;
   }
   StepStats stats;
+  JointTable joints;
+  std::shared_ptr<const JointCatalogue> joint_catalogue;  // never null
 };
 
 BodyLook look_of(BodyView body, std::uint32_t colour);

@@ -21,7 +21,7 @@ Result<std::shared_ptr<FrameRecorder>> FrameRecorder::start(const std::string& p
 }
 
 FrameRecorder::FrameRecorder(RecordingWriter writer) : writer_(std::move(writer)) {
-  options_.velocities = options_.contacts = options_.stats = true;
+  options_.velocities = options_.contacts = options_.stats = options_.joints = true;
 }
 
 Status FrameRecorder::finish() {
@@ -71,6 +71,7 @@ void FrameRecorder::write_frames() {
     v1::Frame frame;
     frame_to_proto(*data, options_, &frame);
     catalogue_.add_changes(*data, {}, &frame);
+    catalogue_.add_joint_changes(*data, &frame);
     const Status written = from_wire(writer_.write(frame));
     lock.lock();
     if (!written) {

@@ -10,7 +10,8 @@ namespace {
 // The fields a subscription asks for, as a key of FrameData::Encodings. Subscriptions that name
 // ids encode privately (their bodies differ).
 std::uint32_t fields_key(const FrameOptions& options) {
-  return (options.velocities ? 1u : 0u) | (options.contacts ? 2u : 0u) | (options.stats ? 4u : 0u);
+  return (options.velocities ? 1u : 0u) | (options.contacts ? 2u : 0u) | (options.stats ? 4u : 0u) |
+         (options.joints ? 8u : 0u);
 }
 
 std::shared_ptr<const std::string> shared_encoding(const FrameData& frame,
@@ -161,6 +162,7 @@ void FrameStream::encode(const FrameData& data, std::uint64_t dropped) {
   own.set_dropped(dropped);
   // Bodies new to this subscriber get their descriptions; vanished ones are listed.
   catalogue_.add_changes(data, options_.ids, &own);
+  if (options_.joints) catalogue_.add_joint_changes(data, &own);
   // Changes only: the bodies changed since the tick of this subscriber's previous frame (frames
   // dropped between are covered: a body keeps the tick of its last change). Every body when it
   // joins, when the world was replaced, and at the interval it asked for.

@@ -13,6 +13,7 @@
 namespace tumble::server {
 
 struct ContactTable;
+struct JointCatalogue;
 
 // The world and what the server keeps beside it. Only the stepping thread touches it: commands
 // run there.
@@ -44,6 +45,9 @@ struct HostedWorld {
   std::shared_ptr<const ContactTable> resting_table;
   std::uint64_t resting_table_version = 0, resting_table_epoch = 0;
   double resting_table_dt = 0;
+  // The joints' catalogue of the frames, kept while the set of joints (and the epoch) is the same.
+  std::shared_ptr<const JointCatalogue> joint_catalogue;
+  std::uint64_t joint_catalogue_epoch = 0;
 
   // A new world whose bodies all get new ids.
   void replace(World replacement, double new_dt, std::vector<std::uint32_t> new_colours) {

@@ -77,28 +77,8 @@ Result<JointDef> joint_from_proto(const v1::JointSpec& spec) {
 }
 
 void joint_to_proto(const JointDef& def, const HostedWorld& hosted, v1::JointSpec* out) {
-  out->set_kind(static_cast<v1::JointKind>(static_cast<int>(def.kind)));
-  out->set_a(hosted.ids.wire(def.a));
-  out->set_b(def.b.is_valid() ? hosted.ids.wire(def.b) : 0);
-  vec_to_proto(def.anchor, out->mutable_anchor());
-  if (def.kind == JointKind::kDistance) vec_to_proto(def.anchor_b, out->mutable_anchor_b());
-  vec_to_proto(def.axis, out->mutable_axis());
-  out->set_length(def.length);
-  out->set_collide_connected(def.collide_connected);
-  if (def.limit.enabled) {
-    out->mutable_limit()->set_lower(def.limit.lower);
-    out->mutable_limit()->set_upper(def.limit.upper);
-  }
-  if (def.motor.enabled) {
-    out->mutable_motor()->set_speed(def.motor.speed);
-    out->mutable_motor()->set_max_force(def.motor.max_force);
-  }
-  if (def.spring.enabled) {
-    out->mutable_spring()->set_target(def.spring.target);
-    out->mutable_spring()->set_stiffness(def.spring.stiffness);
-    out->mutable_spring()->set_damping(def.spring.damping);
-  }
-  if (def.max_swing < std::numbers::pi) out->set_max_swing(def.max_swing);
+  joint_spec_to_proto(def, hosted.ids.wire(def.a), def.b.is_valid() ? hosted.ids.wire(def.b) : 0,
+                      out);
 }
 
 Status create_joints(HostedWorld& hosted, const v1::CreateJointsRequest& request,

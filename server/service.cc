@@ -345,6 +345,7 @@ grpc::Status WorldService::read_stream_request(const std::string& bytes, FrameOp
   options->velocities = request.velocities();
   options->contacts = request.contacts();
   options->stats = request.stats();
+  options->joints = request.joints();
   options->ids.assign(request.ids().begin(), request.ids().end());
   std::sort(options->ids.begin(), options->ids.end());
   if (!(request.full_frame_interval() >= 0) || !std::isfinite(request.full_frame_interval()))

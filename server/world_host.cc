@@ -14,6 +14,7 @@ WorldHost::WorldHost(World world, double dt, double real_time_factor)
   hosted_.world = std::move(world);
   hosted_.dt = dt;
   hosted_.ids.sync(hosted_.world);
+  hosted_.joint_ids.sync(hosted_.world);  // the scene's joints
   std::random_device entropy;
   while (hosted_.server_instance == 0)
     hosted_.server_instance = static_cast<std::uint64_t>(entropy()) << 32 | entropy();
@@ -170,6 +171,7 @@ void WorldHost::apply_pending() {
     if (result && !command.read_only) {
       changed = true;
       hosted_.ids.sync(hosted_.world);
+      hosted_.joint_ids.sync(hosted_.world);
       refresh_catalogue();
     }
     status_.bodies = hosted_.world.body_count();

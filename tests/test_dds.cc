@@ -311,6 +311,60 @@ TEST_F(DdsTest, ALateSubscriberLearnsEveryLiveBodyAndNoRemovedOne) {
   EXPECT_FALSE(described.contains(spawned.ids(1)));
 }
 
+// A world with joints publishes sensor_msgs/JointState on /joint_states (as robot_state_publisher
+// and RViz read it): each joint named "joint_<id>", its position, velocity and effort equal to the
+// gRPC frame's joint states of the same step (frames with joints asked for).
+TEST_F(DdsTest, JointStatesReachADdsReaderAsTheFramesCarryThem) {
+  Server server;
+  server.start(
+      {"--paused", "--dds", "--dds-domain", own_domain(), "--standard", "double-pendulum"});
+  auto stub = connect(server);
+  std::mutex mutex;
+  std::map<long long, v1::Frame> frames;  // by simulated time, in microseconds
+  grpc::ClientContext stream_context;
+  v1::StreamFramesRequest request;
+  request.set_joints(true);
+  auto reader = stub->StreamFrames(&stream_context, request);
+  std::thread streaming([&] {
+    v1::Frame frame;
+    while (reader->Read(&frame)) {
+      std::lock_guard lock(mutex);
+      frames[std::llround(frame.time() * 1e6)] = frame;
+    }
+  });
+  Echo echo("--topics joint_states --timeout 4");
+  std::this_thread::sleep_for(1500ms);  // discovery
+  for (int k = 0; k < 15; ++k) {
+    grpc::ClientContext context;
+    v1::ControlRequest step;
+    step.set_step(1);
+    v1::ControlResponse response;
+    EXPECT_TRUE(stub->Control(&context, step, &response).ok());
+    std::this_thread::sleep_for(100ms);
+  }
+  const std::vector<Json> lines = echo.finish();
+  stream_context.TryCancel();
+  streaming.join();
+  int equal = 0;
+  for (const Json& line : lines) {
+    ASSERT_EQ(line["topic"], "joint_states");
+    const auto found = frames.find(std::llround(line["time"].get<double>() * 1e6));
+    if (found == frames.end() || found->second.step() == 0) continue;
+    const v1::JointStates& joints = found->second.joints();
+    ASSERT_EQ(joints.ids_size(), 2);  // the double pendulum's two hinges
+    ASSERT_EQ(line["name"].size(), 2u);
+    for (int i = 0; i < joints.ids_size(); ++i) {
+      EXPECT_NE(joints.ids(i), 0u);  // the scene's joints have ids from the start
+      EXPECT_EQ(line["name"][i], "joint_" + std::to_string(joints.ids(i)));
+      EXPECT_EQ(line["position"][i].get<double>(), joints.positions(i));
+      EXPECT_EQ(line["velocity"][i].get<double>(), joints.speeds(i));
+      EXPECT_EQ(line["effort"][i].get<double>(), joints.efforts(i));
+    }
+    ++equal;
+  }
+  EXPECT_GE(equal, 10);  // ROS 2's default QoS is reliable: nearly all 15 steps
+}
+
 // Issue 31 (5): keyed by body id (never used again), Cyclone DDS 0.10 kept about 300 bytes for
 // every body ever published, disposed or not: 133 -> 654 MB over 2 million bodies. Keyed by
 // instances used again, the keys are at most the most bodies alive at once, and the server's

@@ -222,6 +222,24 @@ TEST(Recording, EveryFieldOfEveryFrameComesBackFromTheFile) {
         body->set_mass(2);
       }
     if (k == 2) frame.add_removed(12);
+    v1::JointStates* joints = frame.mutable_joints();
+    joints->add_ids(20);
+    joints->add_positions(0.5 * k);
+    joints->add_speeds(-1);
+    joints->add_efforts(3);
+    for (double v : {0.0, 0.5, 1.0}) {
+      joints->add_forces(v);
+      joints->add_torques(-v);
+      joints->add_anchors(2 * v);
+      joints->add_axes(v == 1.0 ? 1.0 : 0.0);
+    }
+    if (k == 0) {
+      v1::JointDescription* joint = frame.add_joints_added();
+      joint->set_id(20);
+      joint->mutable_spec()->set_kind(v1::JOINT_KIND_HINGE);
+      joint->mutable_spec()->set_a(10);
+    }
+    if (k == 2) frame.add_joints_removed(21);
     if (k == 1) frame.set_changes_only(true);
     written.push_back(frame);
   }

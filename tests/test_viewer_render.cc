@@ -200,6 +200,42 @@ TEST_F(RenderTest, FramesBecomeInstancesWithAnOptionalContactOverlay) {
   EXPECT_FLOAT_EQ(overlay[renderer_->sphere_mesh()][0].model(0, 0), 0.015f * around->second);
 }
 
+// A frame's joints (asked for) become a ball at each anchor and a rod along each axis; a frame
+// without them draws none.
+TEST_F(RenderTest, JointsBecomeAnOverlayOfAnchorsAndAxes) {
+  v1::Frame frame;
+  v1::BodyDescription* box = frame.add_added();
+  box->set_id(7);
+  box->mutable_shape()->mutable_box()->mutable_size()->set_x(1);
+  box->mutable_shape()->mutable_box()->mutable_size()->set_y(1);
+  box->mutable_shape()->mutable_box()->mutable_size()->set_z(1);
+  frame.add_ids(7);
+  for (double v : {0.0, 0.0, 3.0})
+    frame.add_positions(v);
+  for (double v : {1.0, 0.0, 0.0, 0.0})
+    frame.add_orientations(v);
+  WorldView view;
+  view.apply(frame);
+  EXPECT_TRUE(view.joint_overlay(*renderer_).empty());
+  v1::JointStates* joints = frame.mutable_joints();
+  joints->add_ids(1);
+  for (double v : {0.0, 0.0, 3.5})
+    joints->add_anchors(v);
+  for (double v : {1.0, 0.0, 0.0})
+    joints->add_axes(v);
+  view.apply(frame);
+  const auto overlay = view.joint_overlay(*renderer_);
+  ASSERT_EQ(overlay[renderer_->sphere_mesh()].size(), 1u);
+  ASSERT_EQ(overlay[renderer_->box_mesh()].size(), 1u);
+  const Eigen::Matrix4f& ball = overlay[renderer_->sphere_mesh()][0].model;
+  EXPECT_FLOAT_EQ(ball(2, 3), 3.5f);  // at the anchor
+  // The rod's long side (the cube's z) lies along the axis, x.
+  const Eigen::Matrix4f& rod = overlay[renderer_->box_mesh()][0].model;
+  const Eigen::Vector3f long_side = rod.block<3, 1>(0, 2), short_side = rod.block<3, 1>(0, 0);
+  EXPECT_NEAR(long_side.normalized().x(), 1.0f, 1e-5f);
+  EXPECT_GT(long_side.norm(), 10 * short_side.norm());
+}
+
 // Colours follow the order bodies were described in, not their ids: a world reset gives the same
 // bodies new ids, and they keep their colours. The camera frames what it sees.
 TEST_F(RenderTest, ColoursSurviveAResetAndTheCameraFramesTheBodies) {

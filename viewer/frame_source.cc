@@ -7,6 +7,7 @@ namespace tumble::viewer {
 void ServerSource::open() {
   v1::StreamFramesRequest request;
   request.set_contacts(contacts_);
+  request.set_joints(joints_);
   // The view keeps every body's pose from frame to frame (WorldView::apply), so it asks for the
   // bodies that changed only: a sleeping world then costs the viewer nothing a frame.
   request.set_changes_only(true);

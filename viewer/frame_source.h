@@ -37,7 +37,8 @@ class FrameSource {
 
 class ServerSource final : public FrameSource {
  public:
-  ServerSource(client::Client& client, bool contacts) : client_(client), contacts_(contacts) {}
+  ServerSource(client::Client& client, bool contacts, bool joints)
+      : client_(client), contacts_(contacts), joints_(joints) {}
   void open() override;
   bool next(v1::Frame* frame) override;
   void cancel() override;
@@ -47,7 +48,7 @@ class ServerSource final : public FrameSource {
 
  private:
   client::Client& client_;
-  bool contacts_;
+  bool contacts_, joints_;
   std::mutex mutex_;
   std::optional<client::FrameStream> stream_;
   bool cancelled_ = false;

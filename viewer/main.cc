@@ -44,6 +44,8 @@ int main(int argc, char** argv) {
       ->check(cli::existing_file);
   bool contacts = false;
   app.add_flag("--contacts", contacts, "draw contact points and normals");
+  bool joints = false;
+  app.add_flag("--joints", joints, "draw joints: each anchor and axis");
   app.add_flag("--offscreen", offscreen, "render with OSMesa into PNG files (no display needed)");
   app.add_option(
       "--screenshot", screenshot,
@@ -90,8 +92,10 @@ int main(int argc, char** argv) {
       return 2;
     }
     connected.emplace(std::move(made).value());
-    // Contacts are cheap to carry in a window, which toggles them; pictures ask only if drawn.
-    source = std::make_unique<viewer::ServerSource>(*connected, contacts || !offscreen);
+    // Contacts and joints are cheap to carry in a window, which toggles them; pictures ask only
+    // if drawn.
+    source = std::make_unique<viewer::ServerSource>(*connected, contacts || !offscreen,
+                                                    joints || !offscreen);
   }
   viewer::Camera camera;
   camera.eye = {eye[0], eye[1], eye[2]};
@@ -107,6 +111,7 @@ int main(int argc, char** argv) {
     options.screenshot = screenshot;
     options.frames = static_cast<int>(frames);
     options.contacts = contacts;
+    options.joints = joints;
     options.frame_the_scene = frame_the_scene;
     return viewer::run_window(*source, options);
   }
@@ -172,9 +177,10 @@ int main(int argc, char** argv) {
           frame_the_scene = false;
         }
       }
-      renderer.draw(
-          view.instances(renderer), camera, lighting, width, height,
-          contacts ? view.contact_overlay(renderer) : std::vector<std::vector<viewer::Instance>>{});
+      std::vector<std::vector<viewer::Instance>> overlay;
+      if (contacts) viewer::add_overlay(view.contact_overlay(renderer), &overlay);
+      if (joints) viewer::add_overlay(view.joint_overlay(renderer), &overlay);
+      renderer.draw(view.instances(renderer), camera, lighting, width, height, overlay);
       const std::vector<std::uint8_t> picture = context.read_rgba();
       char name[64];
       std::snprintf(name, sizeof name, "frame-%05u.png", written);

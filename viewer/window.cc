@@ -40,7 +40,7 @@ struct Input {
   Orbit* orbit = nullptr;
   double last_x = 0, last_y = 0;
   bool rotating = false, panning = false;
-  int play_toggles = 0, steps = 0, follow_next = 0, contact_toggles = 0;
+  int play_toggles = 0, steps = 0, follow_next = 0, contact_toggles = 0, joint_toggles = 0;
   bool stop_following = false;
 };
 
@@ -81,6 +81,7 @@ void on_key(GLFWwindow* window, int key, int, int action, int) {
   if (key == GLFW_KEY_N) ++input->steps;
   if (key == GLFW_KEY_F) ++input->follow_next;
   if (key == GLFW_KEY_C) ++input->contact_toggles;
+  if (key == GLFW_KEY_J) ++input->joint_toggles;
   if (key == GLFW_KEY_BACKSPACE) input->stop_following = true;
 }
 
@@ -164,6 +165,7 @@ int run_window(FrameSource& source, const WindowOptions& options) {
     const Lighting lighting;
     std::uint64_t following = 0;
     bool running = true, contacts = options.contacts, frame_the_scene = options.frame_the_scene;
+    bool joints = options.joints;
     int drawn = 0;
     auto second = std::chrono::steady_clock::now();
     int frames_this_second = 0;
@@ -200,6 +202,8 @@ int run_window(FrameSource& source, const WindowOptions& options) {
           if (const auto at = view.position_of(following)) orbit.target = *at;
         if (input.contact_toggles % 2 == 1) contacts = !contacts;
         input.contact_toggles = 0;
+        if (input.joint_toggles % 2 == 1) joints = !joints;
+        input.joint_toggles = 0;
         if (frame_the_scene)
           if (const auto around = view.bounds()) {
             const Camera framed_camera =
@@ -209,7 +213,9 @@ int run_window(FrameSource& source, const WindowOptions& options) {
             frame_the_scene = false;
           }
         instances = view.instances(renderer);
-        if (contacts) overlay = view.contact_overlay(renderer);
+        overlay.clear();
+        if (contacts) add_overlay(view.contact_overlay(renderer), &overlay);
+        if (joints) add_overlay(view.joint_overlay(renderer), &overlay);
         showing_world = connected;
         step = view.step();
         time = view.time();

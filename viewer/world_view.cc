@@ -84,6 +84,7 @@ void WorldView::apply(const v1::Frame& frame) {
     if (ordinals_.emplace(d.id(), next_ordinal_).second) ++next_ordinal_;
   }
   contacts_ = frame.contacts();
+  joints_ = frame.joints();
   const int n = frame.ids_size();
   if (frame.positions_size() != 3 * n || frame.orientations_size() != 4 * n) return;
   for (int i = 0; i < n; ++i) {
@@ -194,6 +195,49 @@ std::vector<std::vector<Instance>> WorldView::contact_overlay(Renderer& renderer
                  Eigen::Scaling(Eigen::Vector3f(0.3f * ball, 0.3f * ball, 2.5f * ball)))
                     .matrix();
     rod.colour = {1, 1, 1, 1};
+    add(renderer.box_mesh(), rod);
+  }
+  return out;
+}
+
+void add_overlay(const std::vector<std::vector<Instance>>& more,
+                 std::vector<std::vector<Instance>>* overlay) {
+  if (overlay->size() < more.size()) overlay->resize(more.size());
+  for (std::size_t mesh = 0; mesh < more.size(); ++mesh)
+    (*overlay)[mesh].insert((*overlay)[mesh].end(), more[mesh].begin(), more[mesh].end());
+}
+
+std::vector<std::vector<Instance>> WorldView::joint_overlay(Renderer& renderer) const {
+  std::vector<std::vector<Instance>> out;
+  auto add = [&](int mesh, const Instance& instance) {
+    if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
+    out[mesh].push_back(instance);
+  };
+  const auto around = bounds();
+  const float ball = 2 * std::max(0.015f * (around ? around->second : 1.0f), 0.005f);
+  const int joints = joints_.ids_size();
+  if (joints_.anchors_size() != 3 * joints || joints_.axes_size() != 3 * joints) return out;
+  const Eigen::Vector4f yellow{1.0f, 0.85f, 0.1f, 1};
+  for (int i = 0; i < joints; ++i) {
+    const Eigen::Vector3f p(static_cast<float>(joints_.anchors(3 * i)),
+                            static_cast<float>(joints_.anchors(3 * i + 1)),
+                            static_cast<float>(joints_.anchors(3 * i + 2)));
+    Eigen::Vector3f axis(static_cast<float>(joints_.axes(3 * i)),
+                         static_cast<float>(joints_.axes(3 * i + 1)),
+                         static_cast<float>(joints_.axes(3 * i + 2)));
+    if (!(axis.norm() > 0)) axis = Eigen::Vector3f::UnitZ();
+    Instance point;
+    point.model = (Eigen::Translation3f(p) * Eigen::Scaling(ball)).matrix();
+    point.colour = yellow;
+    add(renderer.sphere_mesh(), point);
+    // The axis: the unit cube squeezed to a quarter ball and stretched four balls each way.
+    Instance rod;
+    const Eigen::Quaternionf turn =
+        Eigen::Quaternionf::FromTwoVectors(Eigen::Vector3f::UnitZ(), axis.normalized());
+    rod.model = (Eigen::Translation3f(p) * turn *
+                 Eigen::Scaling(Eigen::Vector3f(0.25f * ball, 0.25f * ball, 4 * ball)))
+                    .matrix();
+    rod.colour = yellow;
     add(renderer.box_mesh(), rod);
   }
   return out;

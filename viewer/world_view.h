@@ -27,6 +27,9 @@ class WorldView {
   // white rod. Sized to the scene: the ball's radius is 1.5% of the radius of the sphere around the
   // bodies (at least 5 mm), the rod five times that.
   std::vector<std::vector<Instance>> contact_overlay(Renderer& renderer) const;
+  // The last frame's joints, when the stream carries them: each anchor a yellow ball, its axis a
+  // yellow rod through it, sized as the contacts' overlay (twice as large).
+  std::vector<std::vector<Instance>> joint_overlay(Renderer& renderer) const;
   // A sphere around the bodies that move and the statics of finite size (not the ground), or
   // nothing before the first frame with such bodies.
   std::optional<std::pair<Eigen::Vector3f, float>> bounds() const;
@@ -48,6 +51,7 @@ class WorldView {
   std::map<std::pair<float, float>, int> capsule_meshes_;
   std::unordered_map<std::uint64_t, int> hull_meshes_;  // by body id: each hull its own mesh
   v1::Contacts contacts_;
+  v1::JointStates joints_;
   // Each body's place in the order bodies were described, counted from the last time the view
   // held none: a colour follows it, so a world reset (new ids, the same bodies) keeps its colours.
   std::unordered_map<std::uint64_t, std::uint64_t> ordinals_;
@@ -55,6 +59,10 @@ class WorldView {
   std::uint64_t step_ = 0;
   double time_ = 0;
 };
+
+// Appends an overlay's instances to another's, mesh by mesh.
+void add_overlay(const std::vector<std::vector<Instance>>& more,
+                 std::vector<std::vector<Instance>>* overlay);
 
 // 0xRRGGBBAA as RGBA in [0, 1]; 0 picks a colour from a fixed palette by the body's ordinal.
 Eigen::Vector4f body_colour(std::uint32_t rgba, std::uint64_t ordinal, bool is_static);

@@ -181,6 +181,9 @@ wire::Status RecordingWriter::write(const v1::Frame& frame) {
   poses.set_dropped(frame.dropped());
   poses.set_stepped_at_unix_ns(frame.stepped_at_unix_ns());
   poses.set_changes_only(frame.changes_only());  // bodies not listed are as before
+  if (frame.has_joints()) *poses.mutable_joints() = frame.joints();  // a world's joints: few
+  *poses.mutable_joints_added() = frame.joints_added();
+  *poses.mutable_joints_removed() = frame.joints_removed();
   add_message(mcap::kFramesChannel, sequence, log_time, simulated, poses);
   if (frame.has_contacts())
     add_message(mcap::kContactsChannel, sequence, log_time, simulated, frame.contacts());

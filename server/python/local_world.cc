@@ -198,6 +198,7 @@ std::string LocalWorld::frame(const server::FrameOptions& options, server::Catal
   v1::Frame frame;
   server::frame_to_proto(*data, options, &frame);
   diff.add_changes(*data, options.ids, &frame);
+  if (options.joints) diff.add_joint_changes(*data, &frame);
   return frame.SerializeAsString();
 }
 

@@ -287,10 +287,14 @@ PYBIND11_MODULE(_engine, module) {
 
   py::class_<Reader>(module, "Reader")
       .def(py::init([](LocalWorld& world, bool velocities, bool contacts, bool stats,
-                       std::vector<std::uint64_t> ids) {
+                       std::vector<std::uint64_t> ids, bool joints) {
              auto reader = std::make_unique<Reader>();
              reader->world = &world;
-             reader->options = {velocities, contacts, stats, std::move(ids)};
+             reader->options.velocities = velocities;
+             reader->options.contacts = contacts;
+             reader->options.stats = stats;
+             reader->options.joints = joints;
+             reader->options.ids = std::move(ids);
              std::sort(reader->options.ids.begin(), reader->options.ids.end());
              return reader;
            }),

@@ -55,3 +55,34 @@ def test_bad_joints_are_refused_naming_the_field_and_removal_is_all_or_nothing(w
     assert len(world.joints()) == 1
     world.remove_joints(rod)
     assert world.joints() == []
+
+
+@pytest.mark.parametrize("where", ["remote", "local"])
+def test_frames_carry_the_joints_states_and_their_catalogue(world, where):
+    """frames(joints=True): every frame has each joint's state as GetJoints reads it, the first
+    frame describes every joint, later ones only what was added or removed."""
+    world = world if where == "remote" else tumble.World()
+    world.load_scene({"name": "empty", "bodies": []})
+    world.settings(real_time_factor=0)
+    plate = world.spawn_box(size=(1, 1, 0.2), mass=1.0, position=(0, 0, 5))
+    hinge = world.hinge(plate, anchor=(0, 0, 5), axis=(0, 0, 1), motor=(2.0, 100.0))
+    stream = world.frames(joints=True, count=40 if where == "local" else None)
+    frames = iter(stream)
+    if where == "remote":
+        world.step(30)
+    first = next(frames)
+    assert [d["id"] for d in first.joints_added] == [hinge]
+    assert first.joints_added[0]["kind"] == "hinge" and first.joints_added[0]["b"] == 0
+    assert list(first.joints.ids) == [hinge]
+    later = next(frames)
+    assert later.joints_added == [] and later.joints_removed == []
+    while later.step < 5:  # past the frames of the state before the steps
+        later = next(frames)
+    assert later.joints.speeds[0] == pytest.approx(2.0, abs=1e-6)
+    assert abs(later.joints.forces[0][2]) == pytest.approx(9.81, rel=1e-2)
+    assert stream.joints[hinge]["kind"] == "hinge"
+    # A frame without joints asked for has none.
+    if where == "local":
+        plain = next(iter(world.frames(count=1)))
+        assert plain.joints is None and plain.joints_added == []
+    stream.close()

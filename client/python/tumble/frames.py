@@ -58,6 +58,48 @@ class Contacts:
 
 
 @dataclass
+class JointStates:
+    """Every joint's state at the frame's step: ids[i] has positions[i] (its free coordinate: a
+    hinge's angle in rad, a slider's offset or a distance joint's length in m, a ball's twist),
+    speeds[i], efforts[i] (N m or N along it) and the reaction on b, forces[i] (N) and torques[i]
+    (N m), world; anchors[i] (m) and axes[i], where the joint is now."""
+
+    ids: np.ndarray
+    positions: np.ndarray
+    speeds: np.ndarray
+    efforts: np.ndarray
+    forces: np.ndarray
+    torques: np.ndarray
+    anchors: np.ndarray
+    axes: np.ndarray
+
+    def __len__(self):
+        return len(self.ids)
+
+    @staticmethod
+    def from_proto(joints):
+        return JointStates(
+            ids=np.array(joints.ids, dtype=np.uint64),
+            positions=np.array(joints.positions, dtype=float),
+            speeds=np.array(joints.speeds, dtype=float),
+            efforts=np.array(joints.efforts, dtype=float),
+            forces=_rows(joints.forces, 3),
+            torques=_rows(joints.torques, 3),
+            anchors=_rows(joints.anchors, 3),
+            axes=_rows(joints.axes, 3),
+        )
+
+
+def joint_description(description):
+    """A joint new to the subscriber (Frame.joints_added): its id, kind and bodies (b: 0 for the
+    world) and its definition (tumble.v1.JointSpec) as it was made."""
+    names = {v: k for k, v in pb.JointKind.items()}
+    spec = description.spec
+    return {"id": description.id, "kind": names[spec.kind].removeprefix("JOINT_KIND_").lower(),
+            "a": spec.a, "b": spec.b, "spec": spec}
+
+
+@dataclass
 class Frame:
     step: int
     time: float  # s, simulated
@@ -75,6 +117,11 @@ class Frame:
     # Only the bodies changed since the previous frame are in the arrays (frames(changes_only=
     # True)); the others are where the previous frames left them.
     changes_only: bool = False
+    # When asked for (frames(joints=True)): every joint's state, the joints new to this
+    # subscriber (joint_description) and the ids of those gone.
+    joints: Optional[JointStates] = None
+    joints_added: list = field(default_factory=list)
+    joints_removed: list = field(default_factory=list)
 
     def index(self, body_id):
         """The row of `body_id` in this frame's arrays; KeyError if it is not in the frame."""
@@ -91,13 +138,13 @@ class Frame:
     _rows: Optional[dict] = field(default=None, repr=False, compare=False)
 
     @staticmethod
-    def from_bytes(data, velocities, contacts, stats):
+    def from_bytes(data, velocities, contacts, stats, joints=False):
         """A frame from its wire bytes: the arrays read whole (tumble.wire), the rest by
         protobuf; anything unexpected in the bytes is left to protobuf entirely."""
         try:
             chunks, rest = wire.split(data, (3, 4, 5, 6, 7, 8))
             return Frame._assembled(
-                pb.Frame.FromString(rest), stats,
+                pb.Frame.FromString(rest), stats, joints,
                 ids=wire.varints(chunks[3]),
                 positions=wire.doubles(chunks[4], 3),
                 orientations=wire.doubles(chunks[5], 4),
@@ -106,12 +153,12 @@ class Frame:
                 # Several chunks of one message field merge: their bytes concatenate.
                 contacts=Contacts.from_bytes(b"".join(chunks[8])) if contacts else None)
         except ValueError:
-            return Frame.from_proto(pb.Frame.FromString(data), velocities, contacts, stats)
+            return Frame.from_proto(pb.Frame.FromString(data), velocities, contacts, stats, joints)
 
     @staticmethod
-    def from_proto(frame, velocities, contacts, stats):
+    def from_proto(frame, velocities, contacts, stats, joints=False):
         return Frame._assembled(
-            frame, stats,
+            frame, stats, joints,
             ids=np.array(frame.ids, dtype=np.uint64),
             positions=_rows(frame.positions, 3),
             orientations=_rows(frame.orientations, 4),
@@ -120,9 +167,12 @@ class Frame:
             contacts=Contacts.from_proto(frame.contacts) if contacts else None)
 
     @staticmethod
-    def _assembled(message, stats, **arrays):
+    def _assembled(message, stats, joints, **arrays):
         """The frame of the arrays given and of `message`'s other fields."""
         return Frame(
+            joints=JointStates.from_proto(message.joints) if joints else None,
+            joints_added=[joint_description(d) for d in message.joints_added],
+            joints_removed=list(message.joints_removed),
             step=message.step,
             time=message.time,
             stats=plain(message.stats) if stats else None,
@@ -139,7 +189,8 @@ class FrameStream:
     """Frames of one subscription, in order; iterate over it. Closing it (or leaving a `with`
     block, or dropping the last reference) cancels the subscription on the server.
 
-    `bodies` maps each id seen to its Description, updated from every frame's added and removed."""
+    `bodies` maps each id seen to its Description, updated from every frame's added and removed;
+    `joints`, when asked for, each joint's description (joint_description) the same way."""
 
     def __init__(self, call, request, count, timed, method):
         self._call = call
@@ -148,6 +199,7 @@ class FrameStream:
         self._left = count
         self._method = method
         self.bodies = {}
+        self.joints = {}
 
     def __iter__(self):
         return self
@@ -168,7 +220,8 @@ class FrameStream:
             self._left -= 1
         request = self._request
         try:
-            frame = Frame.from_bytes(message, request.velocities, request.contacts, request.stats)
+            frame = Frame.from_bytes(message, request.velocities, request.contacts, request.stats,
+                                     request.joints)
         except DecodeError as error:
             raise Error(grpc.StatusCode.DATA_LOSS, f"a frame could not be read: {error}",
                         self._method) from None
@@ -176,6 +229,10 @@ class FrameStream:
             self.bodies[description.id] = description
         for body_id in frame.removed:
             self.bodies.pop(body_id, None)
+        for description in frame.joints_added:
+            self.joints[description["id"]] = description
+        for joint_id in frame.joints_removed:
+            self.joints.pop(joint_id, None)
         return frame
 
     def close(self):

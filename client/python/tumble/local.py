@@ -89,7 +89,7 @@ class World(WorldCalls):
         return Contacts(**self._engine_call("contacts"))
 
     def frames(self, rate=0.0, velocities=False, contacts=False, stats=False, ids=(), count=None,
-               duration=None):
+               duration=None, joints=False):
         """Frames as the remote world streams them, one per step: each one steps the world. The
         first describes every body (Frame.added); later ones what was added and removed. Ends
         after `count` frames or `duration` seconds of wall time (default: never; break out).
@@ -98,9 +98,10 @@ class World(WorldCalls):
                                   or count < 0):
             raise ArgumentError(f"count: expected an integer >= 0, got {count!r}", "frames")
         request = pb.StreamFramesRequest(velocities=bool(velocities), contacts=bool(contacts),
-                                         stats=bool(stats), ids=[int(i) for i in ids])
+                                         stats=bool(stats), ids=[int(i) for i in ids],
+                                         joints=bool(joints))
         reader = _engine.Reader(self._engine, request.velocities, request.contacts,
-                                request.stats, list(request.ids))
+                                request.stats, list(request.ids), request.joints)
         return FrameStream(_LocalFrames(reader, duration), request, count, False, "frames")
 
     def close(self):

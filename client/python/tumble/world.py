@@ -481,7 +481,7 @@ class RemoteWorld(WorldCalls):
     # --- frames -----------------------------------------------------------------------------
 
     def frames(self, rate=0.0, velocities=False, contacts=False, stats=False, ids=(), count=None,
-               duration=None, changes_only=False, full_frame_interval=0.0):
+               duration=None, changes_only=False, full_frame_interval=0.0, joints=False):
         """Subscribes to the world's frames: every step's, or at most `rate` per second. A slow
         reader loses frames (Frame.dropped counts them), never slows the world. Frames come only
         while the world steps. The subscription ends after `count` frames or `duration` seconds,
@@ -490,11 +490,14 @@ class RemoteWorld(WorldCalls):
         With `changes_only`, a frame lists only the bodies that changed since the previous one
         (Frame.changes_only is then True; the others are where earlier frames left them): a world
         of sleeping bodies costs nothing a frame. The first frame, the first after the world is
-        replaced, and one every `full_frame_interval` seconds (0: never) list every body."""
+        replaced, and one every `full_frame_interval` seconds (0: never) list every body.
+
+        With `joints`, each frame carries every joint's state (Frame.joints) and the joints new
+        to this subscription (Frame.joints_added; FrameStream.joints keeps them)."""
         request = pb.StreamFramesRequest(max_rate=convert.number(rate, "rate"),
                                          velocities=bool(velocities), contacts=bool(contacts),
                                          stats=bool(stats), ids=convert.ids(ids),
-                                         changes_only=bool(changes_only),
+                                         changes_only=bool(changes_only), joints=bool(joints),
                                          full_frame_interval=convert.number(
                                              full_frame_interval, "full_frame_interval"))
         if count is not None and (isinstance(count, bool) or not isinstance(count, int)
