@@ -266,6 +266,120 @@ SceneDef rope_bridge_scene(int planks) {
   return scene;
 }
 
+SceneDef arm_scene() {
+  SceneDef scene = base_scene("arm", 10);
+  scene.bodies.push_back(ground());
+  const double height = 0.5;
+  // Links from the base out: size, mass, centre; each joint's anchor and axis, to the link before
+  // (the world for the base).
+  struct Link {
+    Vec3 size;
+    double mass;
+    Vec3 centre, anchor, axis;
+  };
+  const Link links[] = {
+      {{0.2, 0.2, 0.4}, 4, {0, 0, 0.3}, {0, 0, 0.1}, Vec3::UnitZ()},                  // base yaw
+      {{0.6, 0.1, 0.1}, 3, {0.3, 0, height}, {0, 0, height}, Vec3::UnitY()},          // shoulder
+      {{0.5, 0.08, 0.08}, 2, {0.85, 0, height}, {0.6, 0, height}, Vec3::UnitY()},     // elbow
+      {{0.1, 0.08, 0.08}, 0.5, {1.15, 0, height}, {1.1, 0, height}, Vec3::UnitX()},   // roll
+      {{0.1, 0.08, 0.08}, 0.5, {1.25, 0, height}, {1.2, 0, height}, Vec3::UnitY()},   // pitch
+      {{0.1, 0.08, 0.08}, 0.3, {1.35, 0, height}, {1.3, 0, height}, Vec3::UnitX()}};  // roll
+  for (std::size_t i = 0; i < std::size(links); ++i) {
+    scene.bodies.push_back(box(links[i].size, links[i].mass, links[i].centre));
+    SceneJoint joint;
+    joint.def.kind = JointKind::kHinge;
+    joint.def.anchor = links[i].anchor;
+    joint.def.axis = links[i].axis;
+    joint.def.motor = {true, i == 0 ? 0.5 : 0.0, 300};  // N m: the shoulder carries ~85
+    joint.a = scene.bodies.size() - 1;
+    if (i > 0) joint.b = scene.bodies.size() - 2;
+    scene.joints.push_back(joint);
+  }
+  scene.bodies.push_back(box(Vec3(0.2, 0.2, 0.2), 5, Vec3(1.5, 0, height)));  // the payload
+  SceneJoint grip;
+  grip.def.kind = JointKind::kFixed;
+  grip.def.anchor = Vec3(1.4, 0, height);
+  grip.a = scene.bodies.size() - 1;
+  grip.b = scene.bodies.size() - 2;
+  scene.joints.push_back(grip);
+  return scene;
+}
+
+namespace {
+
+// One ragdoll standing with its feet at `at`, facing +y turned by `yaw` about z.
+void add_ragdoll(SceneDef& scene, const Vec3& at, double yaw) {
+  const Quat turn(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+  auto place = [&](const Vec3& local) { return Vec3(at + turn * local); };
+  auto limb = [&](double radius, double length, double mass, const Vec3& centre) {
+    BodyDef def;
+    def.shape = CapsuleDef{radius, length / 2 - radius};
+    def.mass = mass;
+    def.position = place(centre);
+    def.orientation = turn;
+    def.friction = 0.5;
+    return def;
+  };
+  auto part = [&](BodyDef def) {
+    def.orientation = turn;
+    def.position = place(def.position);
+    scene.bodies.push_back(def);
+    return scene.bodies.size() - 1;
+  };
+  auto join = [&](JointKind kind, std::size_t a, std::size_t b, const Vec3& anchor,
+                  const Vec3& axis, double swing, JointLimit limit) {
+    SceneJoint joint;
+    joint.def.kind = kind;
+    joint.def.anchor = place(anchor);
+    joint.def.axis = turn * axis;
+    if (kind == JointKind::kBall) joint.def.max_swing = swing;
+    joint.def.limit = limit;
+    joint.a = a;
+    joint.b = b;
+    scene.joints.push_back(joint);
+  };
+  const std::size_t pelvis = part(box(Vec3(0.3, 0.2, 0.15), 8, Vec3(0, 0, 1.0)));
+  const std::size_t torso = part(box(Vec3(0.35, 0.2, 0.4), 15, Vec3(0, 0, 1.3)));
+  BodyDef head_def;
+  head_def.shape = SphereDef{0.1};
+  head_def.mass = 4;
+  head_def.position = Vec3(0, 0, 1.65);
+  head_def.friction = 0.5;
+  const std::size_t head = part(head_def);
+  const JointLimit none;
+  join(JointKind::kBall, torso, pelvis, {0, 0, 1.1}, Vec3::UnitZ(), 0.5, {true, -0.4, 0.4});
+  join(JointKind::kBall, head, torso, {0, 0, 1.53}, Vec3::UnitZ(), 0.6, {true, -0.8, 0.8});
+  for (double side : {-1.0, 1.0}) {
+    scene.bodies.push_back(limb(0.05, 0.3, 2, Vec3(0.25 * side, 0, 1.33)));
+    const std::size_t upper_arm = scene.bodies.size() - 1;
+    scene.bodies.push_back(limb(0.045, 0.3, 1.5, Vec3(0.25 * side, 0, 1.03)));
+    const std::size_t forearm = scene.bodies.size() - 1;
+    join(JointKind::kBall, upper_arm, torso, {0.25 * side, 0, 1.48}, Vec3::UnitZ(), 1.5, none);
+    join(JointKind::kHinge, forearm, upper_arm, {0.25 * side, 0, 1.18}, Vec3::UnitX(), 0,
+         {true, -2.5, 0});
+    scene.bodies.push_back(limb(0.06, 0.4, 7, Vec3(0.1 * side, 0, 0.7)));
+    const std::size_t thigh = scene.bodies.size() - 1;
+    scene.bodies.push_back(limb(0.05, 0.4, 4, Vec3(0.1 * side, 0, 0.28)));
+    const std::size_t shin = scene.bodies.size() - 1;
+    join(JointKind::kBall, thigh, pelvis, {0.1 * side, 0, 0.9}, Vec3::UnitZ(), 1.2, none);
+    join(JointKind::kHinge, shin, thigh, {0.1 * side, 0, 0.49}, Vec3::UnitX(), 0, {true, 0, 2.5});
+  }
+}
+
+}  // namespace
+
+SceneDef ragdolls_scene(int ragdolls) {
+  SceneDef scene = base_scene("ragdolls-" + std::to_string(ragdolls), 10);
+  scene.bodies.push_back(ground());
+  // Four a layer on a 1 m square, each layer 2 m above the one below and turned a quarter turn.
+  for (int i = 0; i < ragdolls; ++i) {
+    const int layer = i / 4, slot = i % 4;
+    const Vec3 at((slot % 2) - 0.5, (slot / 2) - 0.5, 0.05 + 2.0 * layer);
+    add_ragdoll(scene, at, std::numbers::pi / 2 * layer + 0.3 * slot);
+  }
+  return scene;
+}
+
 namespace {
 
 Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bodies) {
@@ -285,9 +399,12 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   // Counted, ground included, before anything is built, so a request for a huge scene costs
   // nothing.
   if (name == "pile" || name == "pyramid" || name == "tower" || name == "chain" ||
-      name == "rope-bridge") {
+      name == "rope-bridge" || name == "ragdolls") {
     const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(name == "pile" ? 1000 : 20));
-    const std::uint64_t bodies = (name == "pyramid" ? n * (n + 1) / 2 : n) + 1;
+    const std::uint64_t bodies = (name == "pyramid"    ? n * (n + 1) / 2
+                                  : name == "ragdolls" ? 11 * n
+                                                       : n) +
+                                 1;
     if (bodies > max_bodies)
       return Status::error("scene '" + shown(spec) + "': " + std::to_string(bodies) +
                            " bodies with the ground, more than the " + std::to_string(max_bodies) +
@@ -338,6 +455,11 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     if (Status s = sized("pendulum"); !s) return s;
     return pendulum_scene();
   }
+  if (name == "arm") {
+    if (Status s = sized("arm"); !s) return s;
+    return arm_scene();
+  }
+  if (name == "ragdolls") return ragdolls_scene(size.value_or(20));
   if (name == "default") {
     if (Status s = sized("default"); !s) return s;
     return parse_scene(default_scene_json());
@@ -345,7 +467,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   return Status::error("scene '" + shown(spec) +
                        "': unknown; the standard scenes are pile, pyramid, tower, mass-ratio, "
                        "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
-                       "chain, cradle, door, rope-bridge, default");
+                       "chain, cradle, door, rope-bridge, arm, ragdolls, default");
 }
 
 }  // namespace

@@ -51,6 +51,14 @@ SceneDef double_pendulum_scene();
 SceneDef cradle_scene();
 SceneDef door_scene();
 SceneDef rope_bridge_scene(int planks = 20);
+// A six-joint arm (base yaw, shoulder, elbow, wrist roll, pitch and roll: hinges from the world
+// out) holding a 5 kg payload at arm's length on a fixed joint, its base turning at 0.5 rad/s
+// and every other motor holding its joint still (speed 0, torques bounded), 10 s. `ragdolls`
+// ragdolls of 11 bodies each (pelvis, torso, head, arms and legs in two parts; ball joints with
+// swing cones at the spine, neck, shoulders and hips, hinges with limits at the elbows and
+// knees), dropped in layers of four onto the ground, 10 s.
+SceneDef arm_scene();
+SceneDef ragdolls_scene(int ragdolls = 20);
 
 // A standard scene by name, with an optional size: "pile", "pile:250", "pyramid:10", "tower:5",
 // "mass-ratio", "mass-ratio-inv", "bullet", "slide", "spin", "bounce", "pendulum",
