@@ -454,9 +454,9 @@ void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies,
 // (Vectors cross its boundary by reference: GCC gives the clones one calling convention only
 // that way.)
 TUMBLE_PER_CPU
-double
-solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
-           const SolverSettings& settings, const Softness* soft, double h, double* lane_changes) {
+double solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody> bodies,
+                  const SolverSettings& settings, const Softness* soft, double h,
+                  double* lane_changes) {
   const double inverse_h = 1 / h;
   const int most = pack.most_points;
   WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);

@@ -97,9 +97,9 @@ void invert_positive_definite(const Eigen::Matrix4d& k, int count, Eigen::Matrix
 
 TUMBLE_PER_CPU
 void prepare_rows(const ContactManifold& manifold, std::uint32_t solver_a, const Body& a,
-                  std::uint32_t solver_b,
-                  const Body& b, const ContactPairRecord* previous, std::uint32_t block_index,
-                  ContactRow* rows, ContactRowCold* cold, NormalBlock* block) {
+                  std::uint32_t solver_b, const Body& b, const ContactPairRecord* previous,
+                  std::uint32_t block_index, ContactRow* rows, ContactRowCold* cold,
+                  NormalBlock* block) {
   TUMBLE_ASSERT(manifold.count >= 1 && manifold.count <= 4);
   const int count = manifold.count;
   const Vec3& n = manifold.normal;

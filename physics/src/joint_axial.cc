@@ -87,7 +87,7 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
       apply_row(j, c.row, impulse);
       change = std::max(change, std::abs(impulse) * mass);
     }
-    if (joint.motor.enabled) {
+    if (joint.motor.enabled && !row.motor_in_tree && !row.motor_at_bound) {
       const double most = joint.motor.max_force * h;
       const double rate = row_rate(c.row, *j.a, b);
       const double total =

@@ -492,7 +492,24 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
 
 JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
                                   std::span<const Pose> poses, const JointTarget& target) {
-  return equations_of(row, bodies, poses, &target);
+  JointEquations e = equations_of(row, bodies, poses, &target);
+  if (row.motor_in_tree && e.rows == 5) {
+    // The motor's row: the free coordinate's rate is its speed.
+    const bool world_b = row.b == kWorldAnchor;
+    const FreeCoordinate c =
+        free_coordinate(row.joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b);
+    if (c.exists) {
+      set_row(e, 5, c.row);
+      e.target[5] = row.joint.motor.speed;
+      e.rows = 6;
+    }
+  }
+  return e;
+}
+
+bool motor_row(const JointRow& row, const JointEquations& equations) {
+  return row.motor_in_tree && equations.rows == 6 &&
+         (row.joint.kind == JointKind::kHinge || row.joint.kind == JointKind::kSlider);
 }
 
 JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
@@ -508,7 +525,9 @@ void add_equation_impulses(JointRow& row, const JointEquations& equations,
     return;
   }
   // A row that pushes a's centre is a force at the anchors; one that only turns is a torque.
-  for (int i = 0; i < equations.rows; ++i) {
+  int rows = equations.rows;
+  if (motor_row(row, equations)) joint.motor_impulse += impulses[--rows];
+  for (int i = 0; i < rows; ++i) {
     const Vec3 linear = -equations.on_a.block<1, 3>(i, 0).transpose();
     if (!linear.isZero())
       joint.linear_impulse += impulses[i] * linear;

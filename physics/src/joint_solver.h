@@ -22,6 +22,11 @@ struct JointRow {
   Joint joint;
   std::uint32_t a = 0, b = kWorldAnchor;
   std::uint32_t slot = 0;  // the world's joint slot
+  // The direct solve (joint_tree.h) holds the motor as a sixth row of the joint's equations, not
+  // a Gauss-Seidel row beside it, while its force stays within its bound; past it, the motor's
+  // impulse is held at the bound for the rest of the substep (motor_at_bound).
+  bool motor_in_tree = false;
+  bool motor_at_bound = false;
 };
 
 // Applies the row's impulses to its bodies at their present poses: the warm start.
@@ -58,6 +63,8 @@ struct JointEquations {
 // For velocities, with the sweep's target (a move ahead: the rates that end it on the joint).
 JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
                                   std::span<const Pose> poses, const JointTarget& target);
+// Whether the equations' last row is the joint's motor (JointRow::motor_in_tree).
+bool motor_row(const JointRow& row, const JointEquations& equations);
 // For positions: target = minus the error.
 JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
                                   std::span<const Pose> poses);

@@ -178,27 +178,34 @@ void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     const Pose pose_b = world_b ? Pose{} : poses[row.b];
     const joint_detail::Anchors anchors =
         joint_detail::anchors_of(joint, poses[row.a], pose_b, world_b);
-    double force = 0;
+    // The force on b (a takes the opposite).
+    Vec3 force_on_b = Vec3::Zero();
     Mat3 linear = Mat3::Zero();
     if (joint.kind == JointKind::kDistance) {
       const Vec3 d = anchors.pb - anchors.pa;
       const double length = d.norm();
       if (!(length > 1e-12)) continue;
-      force = std::abs(joint.axial_impulse) / joint.impulse_time;
       const Vec3 n = d / length;
-      linear = h2 * force / length * (Mat3::Identity() - n * n.transpose());
+      force_on_b = joint.axial_impulse / joint.impulse_time * n;
+      // A rod in tension (pulling b towards a) resists its ends' shift across it.
+      const double tension = std::max(0.0, -joint.axial_impulse / joint.impulse_time);
+      linear = h2 * tension / length * (Mat3::Identity() - n * n.transpose());
     } else if (joint.kind != JointKind::kSlider) {
-      force = joint.linear_impulse.norm() / joint.impulse_time;
+      force_on_b = joint.linear_impulse / joint.impulse_time;
     }
-    for (const auto& [body, r] : {std::pair{row.a, anchors.ra}, std::pair{row.b, anchors.rb}}) {
+    for (const auto& [body, r, force] : {std::tuple{row.a, anchors.ra, Vec3(-force_on_b)},
+                                         std::tuple{row.b, anchors.rb, force_on_b}}) {
       if (body == kWorldAnchor || node_of_body_[body] == kNone) continue;
       Node& body_node = nodes_[node_of_body_[body]];
       body_node.linear_stiffness += linear;
       const double arm = r.norm();
       if (arm > body_node.longest_lever.norm()) body_node.longest_lever = r;
-      if (arm > 1e-12)
+      // Only the pull along the lever turns the body back into line (a chain's tension); a force
+      // across it (a load held out sideways) has no stiffness of this kind to speak of.
+      const double pull = arm > 1e-12 ? force.dot(r) / arm : 0.0;
+      if (pull > 0)
         body_node.angular_stiffness +=
-            h2 * force / arm * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+            h2 * pull / arm * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
     }
   }
   // Only the part beyond kResolvedTurn: scaled by 1 - rho0 / rho, where rho = (omega h)^2 of the
@@ -331,8 +338,12 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
         kept_targets_[k] = velocity_equations(rows[nodes_[k].index], bodies, poses, target).target;
     targets_taken_ = true;
   }
-  solve(bodies, true,
-        [&](std::size_t k) { return target.h > 0 ? kept_targets_[k] : Vec6(Vec6::Zero()); });
+  solve(bodies, true, [&](std::size_t k) {
+    Vec6 rates = target.h > 0 ? kept_targets_[k] : Vec6(Vec6::Zero());
+    const JointRow& row = rows[nodes_[k].index];
+    if (motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
+    return rates;
+  });
   // A degenerate joint (its rows dependent) leaves a pivot without an inverse: nothing is
   // applied, and the Gauss-Seidel position passes and next sweeps carry on.
   for (const Node& node : nodes_)
@@ -350,6 +361,32 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
         {change, (v - body.v).lpNorm<Eigen::Infinity>(), (w - body.w).lpNorm<Eigen::Infinity>()});
     body.v = v;
     body.w = w;
+  }
+  // A motor past its force bound leaves the direct solve: its impulse is held at the bound (the
+  // excess taken back from the bodies) and it goes on as a Gauss-Seidel row, the others solved
+  // again without it.
+  bool saturated = false;
+  for (std::size_t k = 0; k < nodes_.size(); ++k) {
+    if (!nodes_[k].is_joint) continue;
+    JointRow& row = rows[nodes_[k].index];
+    if (!motor_row(row, equations_[k])) continue;
+    const double most = row.joint.motor.max_force * target.substep;
+    const double held = std::clamp(row.joint.motor_impulse, -most, most);
+    if (held == row.joint.motor_impulse) continue;
+    joint_detail::JointBodies j = joint_detail::bodies_of(row, bodies, poses);
+    const bool world_b = row.b == kWorldAnchor;
+    const joint_detail::FreeCoordinate c = joint_detail::free_coordinate(
+        row.joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b);
+    joint_detail::apply_row(j, c.row, held - row.joint.motor_impulse);
+    row.joint.motor_impulse = held;
+    row.motor_in_tree = false;
+    row.motor_at_bound = true;
+    saturated = true;
+  }
+  if (saturated) {
+    velocities_factored_ = false;
+    targets_taken_ = false;
+    change = std::max(change, solve_velocities(rows, bodies, poses, target));
   }
   return change;
 }

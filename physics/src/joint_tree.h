@@ -30,6 +30,8 @@ class JointTree {
   bool build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
              std::span<const SolverBody> bodies, std::size_t body_count);
 
+  // The rows changed (a motor joins the solve again): the next sweep factors afresh.
+  void forget_velocity_factors() { velocities_factored_ = false; }
   // Velocities that hold every joint's rows at the sweep's targets (JointTarget); the impulses
   // are added to the joints' warm start. Returns the largest velocity change it made.
   double solve_velocities(std::span<JointRow> rows, std::span<SolverBody> bodies,

@@ -143,8 +143,19 @@ class SerialIsland {
   }
   void refresh_separations() { update_separations(rows_, c_.rows, bodies_); }
   void warm_start(bool keep_last_substep) {
-    for (std::uint32_t j : c_.joints)
-      warm_start_joint(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
+    for (std::uint32_t j : c_.joints) {
+      JointRow& row = c_.scratch.joint_rows[j];
+      // With the direct solve, motors join it each substep until one needs more than its force
+      // (joint_tree.cc), starting from nothing: the solve finds the whole impulse, and a warm
+      // start's push only made a motor swing between its bounds once it met them.
+      if (tree_ != nullptr && row.joint.motor.enabled) {
+        if (!row.motor_in_tree) tree_->forget_velocity_factors();  // its row is back
+        row.motor_in_tree = true;
+        row.motor_at_bound = false;
+        row.joint.motor_impulse = 0;
+      }
+      warm_start_joint(row, bodies_, c_.scratch.poses);
+    }
     tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep);
   }
   // Joints first, then contacts (Box2D v3's order: the contacts have the last word on
