@@ -79,6 +79,18 @@ class DdsTest : public ::testing::Test {
   }
 };
 
+// Steps a paused server `steps` times, one at a time, each step left time to arrive.
+void step_one_at_a_time(v1::World::Stub& stub, int steps) {
+  for (int k = 0; k < steps; ++k) {
+    grpc::ClientContext context;
+    v1::ControlRequest step;
+    step.set_step(1);
+    v1::ControlResponse response;
+    EXPECT_TRUE(stub.Control(&context, step, &response).ok());
+    std::this_thread::sleep_for(100ms);
+  }
+}
+
 // What a subscriber printed while a paused server stepped 30 times, and the gRPC frame of every
 // step, as a gRPC subscriber received them.
 struct Received {
@@ -111,14 +123,7 @@ Received thirty_steps(const std::string& subscriber_args, const std::string& pro
 
   Echo echo(subscriber_args, program);
   std::this_thread::sleep_for(1500ms);  // discovery
-  for (int k = 0; k < 30; ++k) {        // one step at a time, each left time to arrive
-    grpc::ClientContext context;
-    v1::ControlRequest step;
-    step.set_step(1);
-    v1::ControlResponse response;
-    EXPECT_TRUE(stub->Control(&context, step, &response).ok());
-    std::this_thread::sleep_for(100ms);
-  }
+  step_one_at_a_time(*stub, 30);
   Received received{echo.finish(), {}};
   stream_context.TryCancel();
   streaming.join();
@@ -334,14 +339,7 @@ TEST_F(DdsTest, JointStatesReachADdsReaderAsTheFramesCarryThem) {
   });
   Echo echo("--topics joint_states --timeout 4");
   std::this_thread::sleep_for(1500ms);  // discovery
-  for (int k = 0; k < 15; ++k) {
-    grpc::ClientContext context;
-    v1::ControlRequest step;
-    step.set_step(1);
-    v1::ControlResponse response;
-    EXPECT_TRUE(stub->Control(&context, step, &response).ok());
-    std::this_thread::sleep_for(100ms);
-  }
+  step_one_at_a_time(*stub, 15);
   const std::vector<Json> lines = echo.finish();
   stream_context.TryCancel();
   streaming.join();

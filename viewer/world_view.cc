@@ -102,10 +102,7 @@ void WorldView::apply(const v1::Frame& frame) {
 
 std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
   std::vector<std::vector<Instance>> out(3);
-  auto add = [&](int mesh, const Instance& instance) {
-    if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
-    out[mesh].push_back(instance);
-  };
+  const auto add = [&](int mesh, const Instance& instance) { add_instance(mesh, instance, &out); };
   for (const auto& [id, pose] : poses_) {
     const auto look = looks_.find(id);
     if (look == looks_.end()) continue;  // not described yet
@@ -165,14 +162,16 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
   return out;
 }
 
+// An overlay's ball: 1.5% of the radius of the sphere around the bodies, at least 5 mm.
+float WorldView::overlay_ball() const {
+  const auto around = bounds();
+  return std::max(0.015f * (around ? around->second : 1.0f), 0.005f);
+}
+
 std::vector<std::vector<Instance>> WorldView::contact_overlay(Renderer& renderer) const {
   std::vector<std::vector<Instance>> out;
-  auto add = [&](int mesh, const Instance& instance) {
-    if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
-    out[mesh].push_back(instance);
-  };
-  const auto around = bounds();
-  const float ball = std::max(0.015f * (around ? around->second : 1.0f), 0.005f);
+  const auto add = [&](int mesh, const Instance& instance) { add_instance(mesh, instance, &out); };
+  const float ball = overlay_ball();
   const int points = contacts_.body_a_size();
   if (contacts_.points_size() != 3 * points || contacts_.normals_size() != 3 * points) return out;
   for (int i = 0; i < points; ++i) {
@@ -200,6 +199,11 @@ std::vector<std::vector<Instance>> WorldView::contact_overlay(Renderer& renderer
   return out;
 }
 
+void add_instance(int mesh, const Instance& instance, std::vector<std::vector<Instance>>* out) {
+  if (static_cast<std::size_t>(mesh) >= out->size()) out->resize(mesh + 1);
+  (*out)[mesh].push_back(instance);
+}
+
 void add_overlay(const std::vector<std::vector<Instance>>& more,
                  std::vector<std::vector<Instance>>* overlay) {
   if (overlay->size() < more.size()) overlay->resize(more.size());
@@ -209,12 +213,8 @@ void add_overlay(const std::vector<std::vector<Instance>>& more,
 
 std::vector<std::vector<Instance>> WorldView::joint_overlay(Renderer& renderer) const {
   std::vector<std::vector<Instance>> out;
-  auto add = [&](int mesh, const Instance& instance) {
-    if (static_cast<std::size_t>(mesh) >= out.size()) out.resize(mesh + 1);
-    out[mesh].push_back(instance);
-  };
-  const auto around = bounds();
-  const float ball = 2 * std::max(0.015f * (around ? around->second : 1.0f), 0.005f);
+  const auto add = [&](int mesh, const Instance& instance) { add_instance(mesh, instance, &out); };
+  const float ball = 2 * overlay_ball();
   const int joints = joints_.ids_size();
   if (joints_.anchors_size() != 3 * joints || joints_.axes_size() != 3 * joints) return out;
   const Eigen::Vector4f yellow{1.0f, 0.85f, 0.1f, 1};

@@ -33,6 +33,7 @@ class WorldView {
   // A sphere around the bodies that move and the statics of finite size (not the ground), or
   // nothing before the first frame with such bodies.
   std::optional<std::pair<Eigen::Vector3f, float>> bounds() const;
+  float overlay_ball() const;
 
   std::uint64_t step() const { return step_; }
   double time() const { return time_; }
@@ -60,6 +61,8 @@ class WorldView {
   double time_ = 0;
 };
 
+// Adds an instance of `mesh` to a list of instances by mesh.
+void add_instance(int mesh, const Instance& instance, std::vector<std::vector<Instance>>* out);
 // Appends an overlay's instances to another's, mesh by mesh.
 void add_overlay(const std::vector<std::vector<Instance>>& more,
                  std::vector<std::vector<Instance>>* overlay);
