@@ -40,6 +40,8 @@ class BulletSimulation final : public Simulation {
   }
 
   ~BulletSimulation() override {
+    for (auto& constraint : constraints_)
+      world_.removeConstraint(constraint.get());
     for (auto& body : bodies_)
       world_.removeRigidBody(body.get());
   }
@@ -89,6 +91,60 @@ class BulletSimulation final : public Simulation {
     return true;
   }
 
+  // The joint as Bullet's constraint of the same kind: a ball as btPoint2PointConstraint, a
+  // hinge as btHingeConstraint (its motor as the angular motor, its force bound as the impulse of
+  // a step), a fixed joint as btFixedConstraint, each in the bodies' frames at their poses now.
+  // False (with the reason) for what this adapter does not map: cones, limits, springs, sliders,
+  // distance joints.
+  bool join(const SceneJoint& joint, std::string* why_not) {
+    const JointDef& def = joint.def;
+    if (def.limit.enabled || def.spring.enabled || def.max_swing < 3.14159265358979) {
+      *why_not = "joint limits, springs and cones are not mapped to Bullet";
+      return false;
+    }
+    btRigidBody& a = *bodies_[joint.a];
+    btRigidBody& b = joint.b ? *bodies_[*joint.b] : btTypedConstraint::getFixedBody();
+    auto in_body = [](const btRigidBody& body, const Vec3& point) {
+      return body.getCenterOfMassTransform().inverse() * to_bt(point);
+    };
+    auto axis_in = [](const btRigidBody& body, const Vec3& axis) {
+      return quatRotate(body.getOrientation().inverse(), to_bt(axis));
+    };
+    std::unique_ptr<btTypedConstraint> constraint;
+    switch (def.kind) {
+      case JointKind::kBall:
+        constraint = std::make_unique<btPoint2PointConstraint>(a, b, in_body(a, def.anchor),
+                                                               in_body(b, def.anchor));
+        break;
+      case JointKind::kHinge: {
+        auto hinge = std::make_unique<btHingeConstraint>(
+            a, b, in_body(a, def.anchor), in_body(b, def.anchor), axis_in(a, def.axis),
+            axis_in(b, def.axis));
+        if (def.motor.enabled)
+          hinge->enableAngularMotor(true, def.motor.speed, def.motor.max_force * dt_);
+        constraint = std::move(hinge);
+        break;
+      }
+      case JointKind::kFixed: {
+        btTransform frame_a, frame_b;
+        frame_a.setIdentity();
+        frame_b.setIdentity();
+        frame_a.setOrigin(in_body(a, def.anchor));
+        frame_a.setRotation(a.getOrientation().inverse());
+        frame_b.setOrigin(in_body(b, def.anchor));
+        frame_b.setRotation(b.getOrientation().inverse());
+        constraint = std::make_unique<btFixedConstraint>(a, b, frame_a, frame_b);
+        break;
+      }
+      default:
+        *why_not = "sliders and distance joints are not mapped to Bullet";
+        return false;
+    }
+    world_.addConstraint(constraint.get(), !def.collide_connected);
+    constraints_.push_back(std::move(constraint));
+    return true;
+  }
+
   bool step() override {
     world_.stepSimulation(dt_, 0);
     return true;
@@ -113,6 +169,7 @@ class BulletSimulation final : public Simulation {
   std::vector<std::unique_ptr<btDefaultMotionState>> states_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
   std::vector<btRigidBody*> dynamic_;
+  std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
 };
 
 Simulation* build(const PeerScene& peer, const PeerOptions& options, std::string* why_not) {
@@ -120,6 +177,8 @@ Simulation* build(const PeerScene& peer, const PeerOptions& options, std::string
   for (std::size_t i = 0; i < peer.scene->bodies.size(); ++i)
     if (!simulation->add(peer.scene->bodies[i], peer.mass[i], peer.inertia[i], options, why_not))
       return nullptr;
+  for (const SceneJoint& joint : peer.scene->joints)
+    if (!simulation->join(joint, why_not)) return nullptr;
   return simulation.release();
 }
 

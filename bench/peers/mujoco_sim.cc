@@ -67,6 +67,10 @@ void write_vector(std::ostream& out, const Vec3& v) {
 std::unique_ptr<Simulation> make_mujoco(const PeerScene& peer, const PeerOptions& /*options*/,
                                         std::string* why_not) {
   const SceneDef& scene = *peer.scene;
+  if (!scene.joints.empty()) {
+    *why_not = "joints are not mapped to MuJoCo yet";
+    return nullptr;
+  }
   std::size_t dynamic = 0;
   for (const BodyDef& def : scene.bodies) {
     dynamic += def.type == BodyType::kDynamic ? 1 : 0;

@@ -132,6 +132,10 @@ class OdeSimulation final : public Simulation {
 
 std::unique_ptr<Simulation> make_ode(const PeerScene& peer, const PeerOptions& /*options*/,
                                      std::string* why_not) {
+  if (!peer.scene->joints.empty()) {
+    *why_not = "joints are not mapped to ODE yet";
+    return nullptr;
+  }
   auto simulation = std::make_unique<OdeSimulation>(*peer.scene);
   for (std::size_t i = 0; i < peer.scene->bodies.size(); ++i)
     if (!simulation->add(peer.scene->bodies[i], peer.mass[i], peer.inertia[i], why_not))
