@@ -26,7 +26,7 @@ struct HostedWorld {
   // calls ids.sync(world) itself.
   BodyIds ids;
   // The joints' ids, as the bodies' (a joint removed with its body loses its id at the next
-  // sync). A restored world's joints get new ids.
+  // sync). A snapshot of this server gives its joints back their ids, as its bodies.
   JointIds joint_ids;
   // Chosen at random when the server starts, and written into snapshots: a snapshot made here
   // gives its bodies back their ids; one from elsewhere gets new ones, which cannot collide with
@@ -60,15 +60,16 @@ struct HostedWorld {
     joint_ids.sync(world);
     ++epoch;
   }
-  // A restored world whose bodies keep the ids they had (by slot; see BodyIds::adopt).
+  // A restored world whose bodies and joints keep the ids they had (by slot; see
+  // SlotIds::adopt).
   void restore(World replacement, double new_dt, std::vector<std::uint32_t> new_colours,
-               std::span<const std::uint64_t> wire_ids, std::uint64_t next_id) {
+               std::span<const std::uint64_t> wire_ids, std::uint64_t next_id,
+               std::span<const std::uint64_t> joint_wire_ids, std::uint64_t next_joint_id) {
     world = std::move(replacement);
     dt = new_dt;
     colours = std::move(new_colours);
     ids.adopt(world, wire_ids, next_id);
-    joint_ids.clear();
-    joint_ids.sync(world);
+    joint_ids.adopt(world, joint_wire_ids, next_joint_id);
     ++epoch;
   }
   void set_colour(BodyId id, std::uint32_t colour) {

@@ -152,6 +152,8 @@ std::string encode_snapshot(const SavedWorld& saved) {
   out.mutable_ids()->Add(saved.ids.begin(), saved.ids.end());
   out.set_server_instance(saved.server_instance);
   out.set_next_id(saved.next_id);
+  out.mutable_joint_ids()->mutable_ids()->Add(saved.joint_ids.begin(), saved.joint_ids.end());
+  out.mutable_joint_ids()->set_next(saved.next_joint_id);
   return out.SerializeAsString();
 }
 
@@ -192,6 +194,20 @@ Result<SavedWorld> decode_snapshot(std::string_view bytes) {
   }
   if (in.next_id() >= kMaxBodyId) return Status::error("next_id: must be below 2^53");
   saved.next_id = in.next_id();
+  // Joint ids: checked alike; matched to the engine's joint slots when restored (a joint slot
+  // without a live joint, or beyond the engine's, takes no id; a joint without one gets a new one).
+  saved.joint_ids.assign(in.joint_ids().ids().begin(), in.joint_ids().ids().end());
+  std::unordered_set<std::uint64_t> joint_ids;
+  for (std::size_t i = 0; i < saved.joint_ids.size(); ++i) {
+    const std::uint64_t id = saved.joint_ids[i];
+    if (id == 0) continue;
+    const std::string field = "joint_ids.ids[" + std::to_string(i) + "]: ";
+    if (id >= kMaxBodyId) return Status::error(field + "must be below 2^53");
+    if (!joint_ids.insert(id).second) return Status::error(field + "used by another slot too");
+  }
+  if (in.joint_ids().next() >= kMaxBodyId)
+    return Status::error("joint_ids.next: must be below 2^53");
+  saved.next_joint_id = in.joint_ids().next();
   saved.server_instance = in.server_instance();
   saved.state = std::move(*in.mutable_engine_state());
   return saved;

@@ -22,6 +22,9 @@ struct SavedWorld {
   std::uint64_t next_id = 0;
   std::uint64_t server_instance = 0;
   std::uint64_t step = 0;  // the world's step count, for the response (not encoded twice)
+  // Joint ids by joint slot (0 where none) and the next joint id, as for bodies.
+  std::vector<std::uint64_t> joint_ids;
+  std::uint64_t next_joint_id = 0;
 };
 
 // Ids stay below 2^53 so that JSON tools (doubles) read them exactly.

@@ -187,9 +187,12 @@ Status replace_world(HostedWorld& hosted, World world, double dt, std::vector<st
 }
 
 SavedWorld save_world(const HostedWorld& hosted) {
-  return {hosted.world.settings(), hosted.world.save_state(), hosted.dt,
-          hosted.colours,          hosted.ids.by_slot(),      hosted.ids.next(),
-          hosted.server_instance,  hosted.world.step_count()};
+  SavedWorld saved{hosted.world.settings(), hosted.world.save_state(), hosted.dt,
+                   hosted.colours,          hosted.ids.by_slot(),      hosted.ids.next(),
+                   hosted.server_instance,  hosted.world.step_count()};
+  saved.joint_ids = hosted.joint_ids.by_slot();
+  saved.next_joint_id = hosted.joint_ids.next();
+  return saved;
 }
 
 Result<RestoredWorld> decode_restore(std::string_view bytes, const WorldLimits& limits,
@@ -228,7 +231,8 @@ Status restore_world(HostedWorld& hosted, RestoredWorld restored,
   if (Status t = world.set_settings(settings); !t) return t;
   if (saved.server_instance == hosted.server_instance) {
     // Ids this host gave to these very bodies: they keep them.
-    hosted.restore(std::move(world), saved.dt, std::move(saved.colours), saved.ids, saved.next_id);
+    hosted.restore(std::move(world), saved.dt, std::move(saved.colours), saved.ids, saved.next_id,
+                   saved.joint_ids, saved.next_joint_id);
     return Status::ok();
   }
   // Another host's ids could name bodies of ours: every body gets a new one.

@@ -230,7 +230,7 @@ TEST_F(JointServiceTest, JointsComeBackFromASnapshot) {
   ASSERT_TRUE(stub_->Restore(&restore_context, restore, &restored).ok());
   const v1::GetJointsResponse read = joints();
   ASSERT_EQ(read.ids_size(), 1);
-  EXPECT_NE(read.ids(0), created.ids(0));  // a restored joint gets a new id
+  EXPECT_EQ(read.ids(0), created.ids(0));  // a snapshot of this server: the joint's own id
   EXPECT_EQ(read.specs(0).motor().speed(), 2);
   EXPECT_NEAR(read.states(0).speed(), 2, 1e-9);
 }
