@@ -213,6 +213,12 @@ void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
   const double resolved = kResolvedTurn * kResolvedTurn;
   // rho: the largest eigenvalue of W^1/2 K W^1/2 (W the inverse mass or inertia).
   auto keep_excess = [&](Mat3& stiffness, const Mat3& inverse_mass) {
+    // The trace of K W bounds rho from above (both are positive semidefinite): most bodies
+    // (every body of a pendulum or of a chain of like links) end here, without the eigenvalues.
+    if ((stiffness * inverse_mass).trace() <= resolved) {
+      stiffness.setZero();
+      return;
+    }
     const Mat3 root = Eigen::LLT<Mat3>(inverse_mass).matrixL();
     const Mat3 relative = root.transpose() * stiffness * root;
     const double rho =
