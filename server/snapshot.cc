@@ -142,6 +142,24 @@ Result<WorldSettings> take_settings(const pb::WorldSettings& in) {
 
 }  // namespace
 
+namespace {
+
+// Ids by slot (0: none) below 2^53, none used twice, and the next id below 2^53 too.
+Status check_ids(const std::vector<std::uint64_t>& ids, const std::string& field,
+                 std::uint64_t next, const std::string& next_field) {
+  std::unordered_set<std::uint64_t> seen;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (ids[i] == 0) continue;
+    const std::string at = field + "[" + std::to_string(i) + "]: ";
+    if (ids[i] >= kMaxBodyId) return Status::error(at + "must be below 2^53");
+    if (!seen.insert(ids[i]).second) return Status::error(at + "used by another slot too");
+  }
+  if (next >= kMaxBodyId) return Status::error(next_field + ": must be below 2^53");
+  return Status::ok();
+}
+
+}  // namespace
+
 std::string encode_snapshot(const SavedWorld& saved) {
   pb::WorldSnapshot out;
   out.set_version(pb::VERSION_2);
@@ -184,29 +202,15 @@ Result<SavedWorld> decode_snapshot(std::string_view bytes) {
                          std::to_string(slots) + " slots");
   saved.colours.assign(in.colors().begin(), in.colors().end());
   saved.ids.assign(in.ids().begin(), in.ids().end());
-  std::unordered_set<std::uint64_t> ids;
-  for (std::size_t i = 0; i < saved.ids.size(); ++i) {
-    const std::uint64_t id = saved.ids[i];
-    if (id == 0) continue;
-    const std::string field = "ids[" + std::to_string(i) + "]: ";
-    if (id >= kMaxBodyId) return Status::error(field + "must be below 2^53");
-    if (!ids.insert(id).second) return Status::error(field + "used by another slot too");
-  }
-  if (in.next_id() >= kMaxBodyId) return Status::error("next_id: must be below 2^53");
+  if (Status s = check_ids(saved.ids, "ids", in.next_id(), "next_id"); !s) return s;
   saved.next_id = in.next_id();
   // Joint ids: checked alike; matched to the engine's joint slots when restored (a joint slot
   // without a live joint, or beyond the engine's, takes no id; a joint without one gets a new one).
   saved.joint_ids.assign(in.joint_ids().ids().begin(), in.joint_ids().ids().end());
-  std::unordered_set<std::uint64_t> joint_ids;
-  for (std::size_t i = 0; i < saved.joint_ids.size(); ++i) {
-    const std::uint64_t id = saved.joint_ids[i];
-    if (id == 0) continue;
-    const std::string field = "joint_ids.ids[" + std::to_string(i) + "]: ";
-    if (id >= kMaxBodyId) return Status::error(field + "must be below 2^53");
-    if (!joint_ids.insert(id).second) return Status::error(field + "used by another slot too");
-  }
-  if (in.joint_ids().next() >= kMaxBodyId)
-    return Status::error("joint_ids.next: must be below 2^53");
+  if (Status s =
+          check_ids(saved.joint_ids, "joint_ids.ids", in.joint_ids().next(), "joint_ids.next");
+      !s)
+    return s;
   saved.next_joint_id = in.joint_ids().next();
   saved.server_instance = in.server_instance();
   saved.state = std::move(*in.mutable_engine_state());
