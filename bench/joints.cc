@@ -4,8 +4,8 @@
 // every step, read from the bodies' poses the same way for every engine) and the median step time;
 // then the standard chain:100 (falling onto the ground) for step time alone. Ours with the direct
 // solve of joint trees (auto) and with Gauss-Seidel joints (soft); Bullet 3.24 float and double,
-// btPoint2PointConstraint, 10 sequential-impulse iterations. ODE and MuJoCo have no joints in
-// their adapters yet. Usage: bench_joints [seconds] (default 20).
+// btPoint2PointConstraint, 10 sequential-impulse iterations. ODE and MuJoCo join in the report's
+// joints section (make report). Usage: bench_joints [seconds] (default 20).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -21,31 +21,14 @@ namespace {
 
 constexpr int kLinks = 20;
 constexpr double kLink = 0.2;
-const Vec3 kPivot(0, 0, 10);
 
 SceneDef heavy_chain(double ratio, SolverKind solver) {
-  SceneDef scene;
-  scene.name = "heavy-chain";
-  scene.dt = 1.0 / 60;
+  SceneDef scene = hanging_chain_scene(kLinks, ratio);
   scene.world.solver.kind = solver;
-  scene.world.solver.sleeping = false;
   scene.world.threads = 1;
-  for (int i = 0; i < kLinks; ++i) {
-    BodyDef link;
-    link.shape = BoxDef{Vec3(0.02, 0.02, kLink / 2)};
-    link.position = kPivot - Vec3(0, 0, kLink * (i + 0.5));
-    link.mass = i == kLinks - 1 ? 0.5 * ratio : 0.5;
-    if (i == kLinks - 1) link.linear_velocity = Vec3(1, 0, 0);
-    scene.bodies.push_back(link);
-    SceneJoint joint;
-    joint.def.kind = JointKind::kBall;
-    joint.def.anchor = kPivot - Vec3(0, 0, kLink * i);
-    joint.a = scene.bodies.size() - 1;
-    if (i > 0) joint.b = scene.bodies.size() - 2;
-    scene.joints.push_back(joint);
-  }
   return scene;
 }
+const Vec3 kPivot = hanging_chain_scene(kLinks).joints[0].def.anchor;
 
 // The largest gap at any joint now: each link's ends from its pose.
 double largest_gap(const Simulation& sim) {

@@ -219,6 +219,14 @@ TEST(StandardScenes, PendulumAndChainSwingOnTheirJoints) {
   EXPECT_EQ(standard_scene("chain:12").value().bodies.size(), 13u);
   EXPECT_FALSE(standard_scene("pendulum:3"));
   EXPECT_FALSE(standard_scene("chain:5000", 1000));
+  // chain:N:R: the end link R times heavier, the others as they were.
+  const SceneDef heavy = standard_scene("chain:12:1000").value();
+  EXPECT_EQ(heavy.bodies.back().mass, 500);
+  EXPECT_EQ(heavy.bodies[1].mass, 0.5);
+  EXPECT_EQ(standard_scene("chain:12:0").error(),
+            "scene 'chain:12:0': the end's mass ratio after the second ':' must be an integer in "
+            "[1, 1000000]");
+  EXPECT_FALSE(standard_scene("pile:12:3"));
 }
 
 // The joint scenes of docs/SCENES.md run and do what they are for: the cradle never gains energy

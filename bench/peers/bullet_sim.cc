@@ -91,49 +91,68 @@ class BulletSimulation final : public Simulation {
     return true;
   }
 
-  // The joint as Bullet's constraint of the same kind: a ball as btPoint2PointConstraint, a
-  // hinge as btHingeConstraint (its motor as the angular motor, its force bound as the impulse of
-  // a step), a fixed joint as btFixedConstraint, each in the bodies' frames at their poses now.
-  // False (with the reason) for what this adapter does not map: cones, limits, springs, sliders,
-  // distance joints.
+  // The joint as Bullet's constraint of the same kind, each built from one frame at the joint
+  // (origin at the anchor, z or for cones x along the axis) taken into both bodies' frames at
+  // their poses now, so that every angle starts at zero: a ball as btPoint2PointConstraint, or
+  // btConeTwistConstraint where it has a cone (its twist limit symmetric); a hinge as
+  // btHingeConstraint (its motor as the angular motor with the force bound as the impulse of a
+  // step; its limits); a fixed joint as btFixedConstraint. False (with the reason) for what this
+  // adapter does not map: springs, asymmetric twist limits, sliders, distance joints.
   bool join(const SceneJoint& joint, std::string* why_not) {
     const JointDef& def = joint.def;
-    if (def.limit.enabled || def.spring.enabled || def.max_swing < 3.14159265358979) {
-      *why_not = "joint limits, springs and cones are not mapped to Bullet";
+    const bool cone = def.kind == JointKind::kBall && def.max_swing < 3.14159265358979;
+    if (def.spring.enabled || (def.kind == JointKind::kBall && def.limit.enabled &&
+                               (!cone || def.limit.lower != -def.limit.upper))) {
+      *why_not =
+          "joint springs, and twist limits other than symmetric ones within a cone, are not "
+          "mapped to Bullet";
       return false;
     }
     btRigidBody& a = *bodies_[joint.a];
     btRigidBody& b = joint.b ? *bodies_[*joint.b] : btTypedConstraint::getFixedBody();
-    auto in_body = [](const btRigidBody& body, const Vec3& point) {
-      return body.getCenterOfMassTransform().inverse() * to_bt(point);
+    // A world frame at the anchor whose `along` axis (0 x, 2 z) is the joint's axis.
+    auto joint_frame = [&](int along) {
+      const Vec3 axis = def.axis.normalized();
+      const Quat turn = Quat::FromTwoVectors(along == 0 ? Vec3::UnitX() : Vec3::UnitZ(), axis);
+      const Quat r = turn.normalized();
+      btTransform frame;
+      frame.setOrigin(to_bt(def.anchor));
+      frame.setRotation(btQuaternion(r.x(), r.y(), r.z(), r.w()));
+      return frame;
     };
-    auto axis_in = [](const btRigidBody& body, const Vec3& axis) {
-      return quatRotate(body.getOrientation().inverse(), to_bt(axis));
+    auto in_body = [](const btRigidBody& body, const btTransform& world) {
+      return body.getCenterOfMassTransform().inverse() * world;
     };
     std::unique_ptr<btTypedConstraint> constraint;
     switch (def.kind) {
       case JointKind::kBall:
-        constraint = std::make_unique<btPoint2PointConstraint>(a, b, in_body(a, def.anchor),
-                                                               in_body(b, def.anchor));
+        if (cone) {
+          const btTransform frame = joint_frame(0);
+          auto cone_twist =
+              std::make_unique<btConeTwistConstraint>(a, b, in_body(a, frame), in_body(b, frame));
+          cone_twist->setLimit(def.max_swing, def.max_swing,
+                               def.limit.enabled ? def.limit.upper : 3.14159265358979);
+          constraint = std::move(cone_twist);
+        } else {
+          constraint = std::make_unique<btPoint2PointConstraint>(
+              a, b, in_body(a, joint_frame(2)).getOrigin(), in_body(b, joint_frame(2)).getOrigin());
+        }
         break;
       case JointKind::kHinge: {
-        auto hinge = std::make_unique<btHingeConstraint>(
-            a, b, in_body(a, def.anchor), in_body(b, def.anchor), axis_in(a, def.axis),
-            axis_in(b, def.axis));
+        const btTransform frame = joint_frame(2);
+        auto hinge =
+            std::make_unique<btHingeConstraint>(a, b, in_body(a, frame), in_body(b, frame));
+        // Bullet's angle and motor are a's turn against b's; ours, b's against a's.
+        if (def.limit.enabled) hinge->setLimit(-def.limit.upper, -def.limit.lower);
         if (def.motor.enabled)
-          hinge->enableAngularMotor(true, def.motor.speed, def.motor.max_force * dt_);
+          hinge->enableAngularMotor(true, -def.motor.speed, def.motor.max_force * dt_);
         constraint = std::move(hinge);
         break;
       }
       case JointKind::kFixed: {
-        btTransform frame_a, frame_b;
-        frame_a.setIdentity();
-        frame_b.setIdentity();
-        frame_a.setOrigin(in_body(a, def.anchor));
-        frame_a.setRotation(a.getOrientation().inverse());
-        frame_b.setOrigin(in_body(b, def.anchor));
-        frame_b.setRotation(b.getOrientation().inverse());
-        constraint = std::make_unique<btFixedConstraint>(a, b, frame_a, frame_b);
+        const btTransform frame = joint_frame(2);
+        constraint =
+            std::make_unique<btFixedConstraint>(a, b, in_body(a, frame), in_body(b, frame));
         break;
       }
       default:

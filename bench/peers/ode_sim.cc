@@ -2,10 +2,16 @@
 // ERP 0.2 and CFM 1e-10 (its defaults), dHashSpace, up to 8 contacts per geom pair,
 // dContactApprox1 so that mu is a Coulomb coefficient. Friction sqrt(mu_a mu_b) and the larger
 // restitution per pair, as ours combines them; impacts slower than 1 m/s do not bounce (ours).
+// Joints as ODE's own of the same kind (ball, hinge, slider, fixed; a distance joint as dDBall),
+// limits as its stops and motors as its motor rows, both exact rows of its LCP; cones, twist
+// limits, springs and distance ranges are refused. With `ode_world_step`, dWorldStep.
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "peers/simulation.h"
@@ -19,11 +25,12 @@ struct Material {
 
 class OdeSimulation final : public Simulation {
  public:
-  explicit OdeSimulation(const SceneDef& scene) : dt_(scene.dt) {
+  OdeSimulation(const SceneDef& scene, bool world_step) : dt_(scene.dt), world_step_(world_step) {
     static std::once_flag once;
     std::call_once(once, [] { dInitODE2(0); });
     engine_ = "ODE 0.16 double";
-    settings_ = "quickstep, 20 iterations, ERP 0.2, CFM 1e-10";
+    settings_ = world_step ? "dWorldStep (direct LCP), ERP 0.2, CFM 1e-10"
+                           : "quickstep, 20 iterations, ERP 0.2, CFM 1e-10";
     world_ = dWorldCreate();
     space_ = dHashSpaceCreate(nullptr);
     contacts_ = dJointGroupCreate(0);
@@ -39,6 +46,7 @@ class OdeSimulation final : public Simulation {
   }
 
   bool add(const BodyDef& def, double mass_kg, const Vec3& inertia, std::string* why_not) {
+    scene_bodies_.push_back(nullptr);
     dGeomID geom = nullptr;
     if (std::holds_alternative<HalfSpaceDef>(def.shape)) {
       const Vec3 n = def.orientation * Vec3::UnitZ();
@@ -76,13 +84,90 @@ class OdeSimulation final : public Simulation {
                        def.angular_velocity.z());
     dGeomSetBody(geom, body);
     dynamic_.push_back(body);
+    scene_bodies_.back() = body;
+    return true;
+  }
+  // The ODE body of the scene's body `i`: null for a static one, as ODE's joints take the world.
+  dBodyID body_of(std::size_t i) const { return scene_bodies_[i]; }
+
+  // ODE measures a hinge's angle and a slider's offset as its first body's against its second
+  // (the world's when that is null), ours as b's against a: attached as (a, b), every bound and
+  // speed changes sign.
+  bool join(const SceneJoint& joint, std::string* why_not) {
+    const JointDef& def = joint.def;
+    if (def.spring.enabled || def.max_swing < 3.14159265358979 ||
+        (def.limit.enabled && def.kind != JointKind::kHinge && def.kind != JointKind::kSlider)) {
+      *why_not = "joint springs, cones, twist limits and distance ranges are not mapped to ODE";
+      return false;
+    }
+    dBodyID a = body_of(joint.a), b = joint.b ? body_of(*joint.b) : nullptr;
+    const Vec3& p = def.anchor;
+    const Vec3 axis = def.axis.normalized();
+    dJointID made = nullptr;
+    int limit_and_motor_kind = 0;  // 1 hinge, 2 slider
+    switch (def.kind) {
+      case JointKind::kBall:
+        made = dJointCreateBall(world_, nullptr);
+        dJointAttach(made, a, b);
+        dJointSetBallAnchor(made, p.x(), p.y(), p.z());
+        break;
+      case JointKind::kHinge:
+        made = dJointCreateHinge(world_, nullptr);
+        dJointAttach(made, a, b);
+        dJointSetHingeAnchor(made, p.x(), p.y(), p.z());
+        dJointSetHingeAxis(made, axis.x(), axis.y(), axis.z());
+        limit_and_motor_kind = 1;
+        break;
+      case JointKind::kSlider:
+        made = dJointCreateSlider(world_, nullptr);
+        dJointAttach(made, a, b);
+        dJointSetSliderAxis(made, axis.x(), axis.y(), axis.z());
+        limit_and_motor_kind = 2;
+        break;
+      case JointKind::kFixed:
+        made = dJointCreateFixed(world_, nullptr);
+        dJointAttach(made, a, b);
+        dJointSetFixed(made);
+        break;
+      case JointKind::kDistance: {
+        made = dJointCreateDBall(world_, nullptr);
+        dJointAttach(made, a, b);
+        const Vec3& q = def.anchor_b;
+        dJointSetDBallAnchor1(made, p.x(), p.y(), p.z());
+        dJointSetDBallAnchor2(made, q.x(), q.y(), q.z());
+        dJointSetDBallDistance(made, def.length > 0 ? def.length : (q - p).norm());
+        break;
+      }
+    }
+    if (limit_and_motor_kind != 0) {
+      auto set = [&](int parameter, double value) {
+        if (limit_and_motor_kind == 1) dJointSetHingeParam(made, parameter, value);
+        if (limit_and_motor_kind == 2) dJointSetSliderParam(made, parameter, value);
+      };
+      if (def.limit.enabled) {
+        set(dParamLoStop, -def.limit.upper);
+        set(dParamHiStop, -def.limit.lower);
+      }
+      if (def.motor.enabled) {
+        set(dParamVel, -def.motor.speed);
+        set(dParamFMax, def.motor.max_force);
+      }
+    } else if (def.motor.enabled) {
+      *why_not = "motors on balls, fixed and distance joints do not exist";
+      return false;
+    }
+    if (!def.collide_connected && a != nullptr && b != nullptr) apart_.insert(std::minmax(a, b));
     return true;
   }
 
   bool step() override {
     depth_ = 0;
     dSpaceCollide(space_, this, &OdeSimulation::near_callback);
-    dWorldQuickStep(world_, dt_);
+    if (world_step_) {
+      dWorldStep(world_, dt_);
+    } else {
+      dWorldQuickStep(world_, dt_);
+    }
     dJointGroupEmpty(contacts_);
     return true;
   }
@@ -102,6 +187,7 @@ class OdeSimulation final : public Simulation {
     auto* self = static_cast<OdeSimulation*>(data);
     dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
     if (ba == nullptr && bb == nullptr) return;
+    if (self->apart_.contains(std::minmax(ba, bb))) return;
     const auto* ma = static_cast<const Material*>(dGeomGetData(a));
     const auto* mb = static_cast<const Material*>(dGeomGetData(b));
     dContact contact[8];
@@ -124,22 +210,26 @@ class OdeSimulation final : public Simulation {
   dSpaceID space_;
   dJointGroupID contacts_;
   double dt_, depth_ = 0;
+  bool world_step_;
   std::vector<Material> materials_;
-  std::vector<dBodyID> dynamic_;
+  std::vector<dBodyID> dynamic_, scene_bodies_;
+  std::set<std::pair<dBodyID, dBodyID>> apart_;  // jointed pairs that do not collide
 };
 
 }  // namespace
 
-std::unique_ptr<Simulation> make_ode(const PeerScene& peer, const PeerOptions& /*options*/,
+std::unique_ptr<Simulation> make_ode(const PeerScene& peer, const PeerOptions& options,
                                      std::string* why_not) {
-  if (!peer.scene->joints.empty()) {
-    *why_not = "joints are not mapped to ODE yet";
+  if (options.ode_world_step && peer.scene->joints.empty()) {
+    *why_not = "dWorldStep is measured on the scenes with joints only";
     return nullptr;
   }
-  auto simulation = std::make_unique<OdeSimulation>(*peer.scene);
+  auto simulation = std::make_unique<OdeSimulation>(*peer.scene, options.ode_world_step);
   for (std::size_t i = 0; i < peer.scene->bodies.size(); ++i)
     if (!simulation->add(peer.scene->bodies[i], peer.mass[i], peer.inertia[i], why_not))
       return nullptr;
+  for (const SceneJoint& joint : peer.scene->joints)
+    if (!simulation->join(joint, why_not)) return nullptr;
   return simulation;
 }
 

@@ -55,6 +55,9 @@ PeerScene peer_scene(const SceneDef& scene);
 struct PeerOptions {
   bool sleeping = true;  // Bullet: deactivation; ODE and MuJoCo never sleep here
   bool ccd = false;      // Bullet: swept-sphere CCD as SCENES.md's "bullet-ccd" sets it
+  // ODE: dWorldStep (its direct, pivoting LCP solver: cubic in a island's rows) instead of
+  // dWorldQuickStep; offered on scenes with joints only, where it is ODE's accurate choice.
+  bool ode_world_step = false;
 };
 
 // Ours, with the scene's world settings (solver, threads, sleeping) as they are.

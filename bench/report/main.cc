@@ -2,7 +2,7 @@
 // Tumble solver and every peer engine built in, measured in one run. Writes REPORT.md and CSV
 // files into --out; scripts/report-plots draws the PNG plots from the CSV.
 //
-//   tumble-report [--quick] [--out DIR] [--only work|stability] [--time-limit SECONDS]
+//   tumble-report [--quick] [--out DIR] [--only work|stability|joints] [--time-limit SECONDS]
 //                 [--commit ID] [--sweeps] [--engines SUBSTRING,...]
 //
 // --sweeps adds the soft solver's other splits of substeps and sweeps; --engines keeps the
@@ -89,15 +89,15 @@ int main(int argc, char** argv) {
       if (arg == "--time-limit") time_limit = std::stod(value);
     } else {
       std::fprintf(stderr,
-                   "usage: tumble-report [--quick] [--out DIR] [--only work|stability] "
+                   "usage: tumble-report [--quick] [--out DIR] [--only work|stability|joints] "
                    "[--time-limit SECONDS] [--commit ID] [--sweeps] [--engines SUBSTRING,...]\n"
                    "(unknown or incomplete argument '%s')\n",
                    arg.c_str());
       return 2;
     }
   }
-  if (!only.empty() && only != "work" && only != "stability") {
-    std::fprintf(stderr, "--only: expected work or stability, got '%s'\n", only.c_str());
+  if (!only.empty() && only != "work" && only != "stability" && only != "joints") {
+    std::fprintf(stderr, "--only: expected work, stability or joints, got '%s'\n", only.c_str());
     return 2;
   }
   if (quick) time_limit = std::min(time_limit, 20.0);
@@ -146,20 +146,25 @@ int main(int argc, char** argv) {
 
   std::vector<WorkPrecisionRow> work;
   std::vector<StabilityRow> stability;
-  if (only.empty() || only == "work") {
+  std::vector<CostRow> cost;
+  const bool joints = only == "joints";
+  if (only.empty() || only == "work" || joints) {
     Progress progress{.phase = "error against run time"};
-    work = measure_work_precision(engines, {quick, time_limit, progress});
+    work = measure_work_precision(engines, {quick, time_limit, progress, joints});
   }
-  if (only.empty() || only == "stability") {
+  if (only.empty() || only == "stability" || joints) {
     Progress progress{.phase = "stability"};
-    stability = measure_stability(engines, {quick, time_limit, progress});
+    stability = measure_stability(engines, {quick, time_limit, progress, joints});
+    Progress cost_progress{.phase = "joints' cost"};
+    cost = measure_joint_cost(engines, {quick, time_limit, cost_progress, joints});
   }
   std::string error;
-  if (!write_csv(out, work, stability, &error) ||
-      !write_markdown(out + "/REPORT.md", header, work, stability, &error)) {
+  if (!write_csv(out, work, stability, cost, &error) ||
+      !write_markdown(out + "/REPORT.md", header, work, stability, cost, &error)) {
     std::fprintf(stderr, "%s\n", error.c_str());
     return 1;
   }
-  std::fprintf(stderr, "wrote %s/REPORT.md, work_precision.csv, stability.csv\n", out.c_str());
+  std::fprintf(stderr, "wrote %s/REPORT.md, work_precision.csv, stability.csv, joint_cost.csv\n",
+               out.c_str());
   return 0;
 }

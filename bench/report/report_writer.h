@@ -18,10 +18,12 @@ struct ReportHeader {
 
 // False with *error set when a file cannot be written.
 bool write_csv(const std::string& directory, const std::vector<WorkPrecisionRow>& work,
-               const std::vector<StabilityRow>& stability, std::string* error);
+               const std::vector<StabilityRow>& stability, const std::vector<CostRow>& cost,
+               std::string* error);
 bool write_markdown(const std::string& path, const ReportHeader& header,
                     const std::vector<WorkPrecisionRow>& work,
-                    const std::vector<StabilityRow>& stability, std::string* error);
+                    const std::vector<StabilityRow>& stability, const std::vector<CostRow>& cost,
+                    std::string* error);
 
 // What each engine survives in a scenario: the largest passing value before the first failure
 // (NaN when the first value already fails), and the first failure's value and mode (empty when

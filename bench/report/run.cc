@@ -23,7 +23,7 @@ RunOutcome run_scene(const Engine& engine, const SceneDef& scene, const bench::P
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     out.steps = s;
     if (!ok) {
-      out.why_not = "engine stopped: it reported it cannot go on (buffers full)";
+      out.why_not = "engine stopped: it reported it cannot go on (buffers full or unstable)";
       out.stopped_early = true;
       return out;
     }

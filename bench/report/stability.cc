@@ -5,26 +5,34 @@
 #include <memory>
 
 #include "run.h"
+#include "scenario.h"
 #include "scenes/standard.h"
 
 namespace tumble::report {
-namespace {
-
-// Judges a run step by step: "" while it passes, else the failure mode (the run stops there).
-using Checker = std::function<std::string(const bench::Simulation&, double t, bool last)>;
-
-struct Scenario {
-  ScenarioInfo info;
-  std::function<SceneDef(double value)> build;
-  std::function<Checker(double value, const SceneDef&)> checker;
-  bool ccd = false;  // peers get their continuous collision where they have it
-};
 
 std::string format(const char* pattern, double x) {
   char text[160];
   std::snprintf(text, sizeof text, pattern, x);
   return text;
 }
+
+std::vector<Vec3> start_positions(const SceneDef& scene) {
+  std::vector<Vec3> out;
+  for (const BodyDef& def : scene.bodies)
+    if (def.type == BodyType::kDynamic) out.push_back(def.position);
+  return out;
+}
+
+std::string common_failure(const bench::Simulation& sim, const std::vector<Vec3>& start) {
+  for (std::size_t i = 0; i < sim.body_count(); ++i) {
+    const bench::BodyState s = sim.body(i);
+    if (non_finite(s)) return "NaN in the state";
+    if ((s.position - start[i]).norm() > 1000) return "escaped (a body 1 km from its start)";
+  }
+  return "";
+}
+
+namespace {
 
 BodyDef box(const Vec3& size, const Vec3& position, double mass) {
   BodyDef def;
@@ -48,23 +56,6 @@ SceneDef scene_of(std::string name, double duration, std::vector<BodyDef> bodies
   scene.world.solver.sleeping = sleeping;
   scene.bodies = std::move(bodies);
   return scene;
-}
-
-std::vector<Vec3> start_positions(const SceneDef& scene) {
-  std::vector<Vec3> out;
-  for (const BodyDef& def : scene.bodies)
-    if (def.type == BodyType::kDynamic) out.push_back(def.position);
-  return out;
-}
-
-// NaN anywhere, or a body 1000 m from where it started: every scenario fails on these first.
-std::string common_failure(const bench::Simulation& sim, const std::vector<Vec3>& start) {
-  for (std::size_t i = 0; i < sim.body_count(); ++i) {
-    const bench::BodyState s = sim.body(i);
-    if (non_finite(s)) return "NaN in the state";
-    if ((s.position - start[i]).norm() > 1000) return "escaped (a body 1 km from its start)";
-  }
-  return "";
 }
 
 // Fails when body `i` ends displaced beyond the bounds (checked at the end of the run).
@@ -355,6 +346,8 @@ std::vector<Scenario> scenarios(bool quick) {
       mass_ratio(true), mass_ratio(false), tower(false), tower(true),       pyramid(),
       fast_thin(0.01),  fast_thin(0.1),    overlap(),    far_from_origin(), spin_rate(),
       size_ratio(true), size_ratio(false), degenerate()};
+  for (Scenario& joints : joint_scenarios())
+    all.push_back(std::move(joints));
   if (quick) {
     // Fewer values and shorter runs: the quick report checks the machinery, not the limits.
     for (Scenario& s : all) {
@@ -362,6 +355,7 @@ std::vector<Scenario> scenarios(bool quick) {
       for (std::size_t i = 0; i < s.info.values.size(); i += 2)
         few.push_back(s.info.values[i]);
       if (s.info.name.rfind("tower", 0) == 0 || s.info.name == "pyramid") few = {10};
+      if (s.info.joints) few = {s.info.values[0], s.info.values[1]};
       s.info.values = few;
     }
   }
@@ -380,7 +374,8 @@ std::vector<ScenarioInfo> stability_scenarios(bool quick) {
 std::vector<StabilityRow> measure_stability(const std::vector<Engine>& engines,
                                             const StabilityOptions& options) {
   std::vector<StabilityRow> rows;
-  const std::vector<Scenario> all = scenarios(options.quick);
+  std::vector<Scenario> all = scenarios(options.quick);
+  if (options.joints_only) std::erase_if(all, [](const Scenario& s) { return !s.info.joints; });
   std::size_t total = 0, done = 0;
   for (const Scenario& s : all)
     total += s.info.values.size() * engines.size();

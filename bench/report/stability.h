@@ -14,6 +14,7 @@ namespace tumble::report {
 struct ScenarioInfo {
   std::string name, axis, criterion;
   std::vector<double> values;
+  bool joints = false;  // reported in the joints section
 };
 
 struct StabilityRow {
@@ -29,9 +30,20 @@ struct StabilityOptions {
   double time_limit = 60;  // s of wall time per run
   // Called after each run: what ran, runs done, runs in all.
   std::function<void(const std::string&, std::size_t, std::size_t)> progress;
+  bool joints_only = false;  // the joints' scenes alone (tumble-report --only joints)
 };
 
 std::vector<ScenarioInfo> stability_scenarios(bool quick);
+
+// Step time of jointed scenes (a chain of 100 links, a pile of ragdolls) in every engine that
+// maps them: ms per step, or the note saying why there is none.
+struct CostRow {
+  std::string scene, engine, settings;
+  double ms_per_step = 0;
+  std::string note;
+};
+std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
+                                        const StabilityOptions& options);
 // Each engine climbs each scenario's values in order and stops at its first failure.
 std::vector<StabilityRow> measure_stability(const std::vector<Engine>& engines,
                                             const StabilityOptions& options);

@@ -6,6 +6,7 @@
 #include <memory>
 #include <mutex>
 
+#include "reference.h"
 #include "run.h"
 #include "scenes/standard.h"
 
@@ -13,20 +14,6 @@ namespace tumble::report {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// Measures one run's error from the states after each step.
-class ErrorMeter {
- public:
-  virtual ~ErrorMeter() = default;
-  virtual void observe(const bench::Simulation& sim, double t) = 0;
-  virtual double error() const = 0;
-};
-
-struct Reference {
-  ReferenceInfo info;
-  SceneDef scene;  // dt is set per run
-  std::function<std::unique_ptr<ErrorMeter>()> meter;
-};
 
 // The error of the final value of f(states) against a known one, relative.
 class FinalValue final : public ErrorMeter {
@@ -310,6 +297,8 @@ std::vector<Reference> references(bool quick) {
   SceneDef tower = tower_scene(10);
   tower.duration = 2;
   out.push_back(converged_reference(tower, "tower of 10 boxes: positions after 2 s", quick));
+  for (Reference& joint : joint_references(quick))
+    out.push_back(std::move(joint));
   return out;
 }
 
@@ -330,7 +319,8 @@ std::vector<ReferenceInfo> reference_scenes(bool quick) {
 std::vector<WorkPrecisionRow> measure_work_precision(const std::vector<Engine>& engines,
                                                      const WorkPrecisionOptions& options) {
   std::vector<WorkPrecisionRow> rows;
-  const std::vector<Reference> scenes = references(options.quick);
+  std::vector<Reference> scenes = references(options.quick);
+  if (options.joints_only) std::erase_if(scenes, [](const Reference& r) { return !r.info.joints; });
   const std::vector<int> rates = swept_rates(options.quick);
   const std::size_t total = scenes.size() * engines.size() * rates.size();
   for (const Reference& reference : scenes) {
@@ -339,8 +329,10 @@ std::vector<WorkPrecisionRow> measure_work_precision(const std::vector<Engine>& 
         SceneDef scene = reference.scene;
         scene.dt = 1.0 / rate;
         std::unique_ptr<ErrorMeter> meter = reference.meter();
+        bench::PeerOptions peer_options;
+        peer_options.sleeping = scene.world.solver.sleeping;
         const RunOutcome outcome = run_scene(
-            engine, scene, {},
+            engine, scene, peer_options,
             [&](const bench::Simulation& sim, double t, bool) {
               meter->observe(sim, t);
               return true;

@@ -21,6 +21,7 @@ struct WorkPrecisionRow {
 
 struct ReferenceInfo {
   std::string name, what, reference, unit;
+  bool joints = false;  // reported in the joints section
 };
 
 struct WorkPrecisionOptions {
@@ -28,6 +29,7 @@ struct WorkPrecisionOptions {
   double time_limit = 60;  // s of wall time per run
   // Called after each run: what ran, runs done, runs in all.
   std::function<void(const std::string&, std::size_t, std::size_t)> progress;
+  bool joints_only = false;  // the joints' scenes alone (tumble-report --only joints)
 };
 
 // The scenes, in report order, with what their error measures and against what.

@@ -160,15 +160,36 @@ SceneDef pendulum_scene() {
   return scene;
 }
 
-SceneDef chain_scene(int links) {
+SceneDef chain_scene(int links, double end_ratio) {
   SceneDef scene = base_scene("chain-" + std::to_string(links), 10);
+  if (end_ratio != 1) scene.name += "-" + std::to_string(std::lround(end_ratio));
   scene.bodies.push_back(ground());
   const Vec3 top(0, 0, 0.2 * links + 1);
   for (int i = 0; i < links; ++i) {
-    scene.bodies.push_back(box(Vec3(0.2, 0.04, 0.04), 0.5, top + Vec3(0.2 * i + 0.1, 0, 0)));
+    scene.bodies.push_back(box(Vec3(0.2, 0.04, 0.04), i == links - 1 ? 0.5 * end_ratio : 0.5,
+                               top + Vec3(0.2 * i + 0.1, 0, 0)));
     SceneJoint joint;
     joint.def.kind = JointKind::kBall;
     joint.def.anchor = top + Vec3(0.2 * i, 0, 0);
+    joint.a = scene.bodies.size() - 1;
+    if (i > 0) joint.b = scene.bodies.size() - 2;
+    scene.joints.push_back(joint);
+  }
+  return scene;
+}
+
+SceneDef hanging_chain_scene(int links, double end_ratio) {
+  SceneDef scene = base_scene("hanging-chain-" + std::to_string(links), 20);
+  scene.world.solver.sleeping = false;
+  const Vec3 pivot(0, 0, 0.2 * links + 1);
+  for (int i = 0; i < links; ++i) {
+    BodyDef link = box(Vec3(0.04, 0.04, 0.2), i == links - 1 ? 0.5 * end_ratio : 0.5,
+                       pivot - Vec3(0, 0, 0.2 * (i + 0.5)));
+    if (i == links - 1) link.linear_velocity = Vec3(1, 0, 0);
+    scene.bodies.push_back(link);
+    SceneJoint joint;
+    joint.def.kind = JointKind::kBall;
+    joint.def.anchor = pivot - Vec3(0, 0, 0.2 * i);
     joint.a = scene.bodies.size() - 1;
     if (i > 0) joint.b = scene.bodies.size() - 2;
     scene.joints.push_back(joint);
@@ -385,9 +406,24 @@ namespace {
 Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bodies) {
   std::string_view name = spec;
   std::optional<int> size;
+  std::optional<int> ratio;  // chain:N:R alone
   if (const std::size_t colon = spec.find(':'); colon != std::string_view::npos) {
     name = spec.substr(0, colon);
-    const std::string_view digits = spec.substr(colon + 1);
+    std::string_view digits = spec.substr(colon + 1);
+    if (const std::size_t second = digits.find(':');
+        name == "chain" && second != std::string_view::npos) {
+      const std::string_view ratio_digits = digits.substr(second + 1);
+      digits = digits.substr(0, second);
+      int value = 0;
+      const auto [end, error] =
+          std::from_chars(ratio_digits.data(), ratio_digits.data() + ratio_digits.size(), value);
+      if (error != std::errc() || end != ratio_digits.data() + ratio_digits.size() || value < 1 ||
+          value > 1000000)
+        return Status::error("scene '" + shown(spec) +
+                             "': the end's mass ratio after the second ':' must be an integer in "
+                             "[1, 1000000]");
+      ratio = value;
+    }
     int value = 0;
     const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (error != std::errc() || end != digits.data() + digits.size() || value < 1 ||
@@ -437,7 +473,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     if (Status s = sized("bounce"); !s) return s;
     return bounce_scene();
   }
-  if (name == "chain") return chain_scene(size.value_or(20));
+  if (name == "chain") return chain_scene(size.value_or(20), ratio.value_or(1));
   if (name == "rope-bridge") return rope_bridge_scene(size.value_or(20));
   if (name == "double-pendulum") {
     if (Status s = sized("double-pendulum"); !s) return s;

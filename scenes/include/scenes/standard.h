@@ -40,9 +40,12 @@ SceneDef bounce_scene(double height = 1,
                                                   // (bottom face above ground), 3 s
 
 // Joints (docs/SCENES.md): a 1 m rod pendulum released level with its pivot, 10 s; a chain of
-// `links` ball-jointed 0.2 m links hung from a fixed point and released level, 10 s.
+// `links` ball-jointed 0.2 m links of 0.5 kg hung from a fixed point and released level, its last
+// link `end_ratio` times heavier, 10 s; the same chain hanging straight down (no ground), its end
+// pushed sideways at 1 m/s, 20 s, sleeping off.
 SceneDef pendulum_scene();
-SceneDef chain_scene(int links = 20);
+SceneDef chain_scene(int links = 20, double end_ratio = 1);
+SceneDef hanging_chain_scene(int links = 20, double end_ratio = 1);
 // Two 1 kg bobs on 1 m rods, released level, 20 s; Newton's cradle (five 1 kg balls of 5 cm on
 // 1 m rods, the first pulled out 45 degrees), 10 s; a 20 kg door on a hinge with a stop at a
 // quarter turn and a closing spring, pushed open, 10 s; a rope bridge of `planks` hinged planks

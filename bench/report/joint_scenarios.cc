@@ -1,0 +1,311 @@
+// The joints' stability scenarios: a chain's end made heavier, a chain made longer, a motor
+// driven faster, a heavy slider driven into its stop faster, and Newton's cradle with more balls;
+// each until an engine fails.
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include "joint_gaps.h"
+#include "run.h"
+#include "scenario.h"
+#include "scenes/standard.h"
+
+namespace tumble::report {
+namespace {
+
+constexpr double kG = 9.81;
+
+// Fails where any joint comes more than `limit` apart at any step.
+Checker holds_together(const SceneDef& scene, double limit) {
+  auto gaps = std::make_shared<JointGaps>(scene);
+  std::vector<Vec3> start = start_positions(scene);
+  return [=](const bench::Simulation& sim, double, bool) -> std::string {
+    if (std::string f = common_failure(sim, start); !f.empty()) return f;
+    const double gap = gaps->largest(sim);
+    return gap > limit ? format("a joint came %.3g m apart", gap) : "";
+  };
+}
+
+Scenario chain_mass_ratio() {
+  Scenario s;
+  s.info = {"chain end mass ratio",
+            "mass ratio of the end link",
+            "a chain of 20 ball-jointed links (0.2 m, 0.5 kg) hanging from a fixed point, its end "
+            "link R times heavier and pushed sideways at 1 m/s, 10 s: no joint ever 1 cm apart",
+            {1, 10, 100, 1e3, 1e4, 1e5, 1e6},
+            true};
+  s.build = [](double ratio) {
+    SceneDef scene = hanging_chain_scene(20, ratio);
+    scene.duration = 10;
+    return scene;
+  };
+  s.checker = [](double, const SceneDef& scene) { return holds_together(scene, 0.01); };
+  return s;
+}
+
+Scenario chain_length() {
+  Scenario s;
+  s.info = {"chain length",
+            "links",
+            "the standard chain:N (0.2 m, 0.5 kg ball-jointed links) released level from a fixed "
+            "point, 5 s: no joint ever 1 cm apart",
+            {10, 30, 100, 300, 1000},
+            true};
+  s.build = [](double links) {
+    SceneDef scene = chain_scene(static_cast<int>(links));
+    scene.duration = 5;
+    scene.world.solver.sleeping = false;
+    return scene;
+  };
+  s.checker = [](double, const SceneDef& scene) { return holds_together(scene, 0.01); };
+  return s;
+}
+
+// A 0.2 m, 1 kg cube on a hinge about z through its centre, its motor (100 N m at most) driving
+// it from rest toward `speed`.
+Scenario motor_speed() {
+  Scenario s;
+  s.info = {"motor speed",
+            "target speed, rad/s",
+            "a 0.2 m cube of 1 kg on a hinge about z through its centre, driven from rest by a "
+            "motor of at most 100 N m, 2 s: it ends within 1% of the target speed, turning the "
+            "right way about the hinge's axis alone (other rates under 1% of it), the hinge "
+            "under 1 mm apart",
+            {1, 10, 100, 1e3, 1e4},
+            true};
+  s.build = [](double speed) {
+    SceneDef scene;
+    scene.name = "motor";
+    scene.duration = 2;
+    scene.world.solver.sleeping = false;
+    BodyDef wheel;
+    wheel.shape = BoxDef{Vec3::Constant(0.1)};
+    wheel.mass = 1;
+    wheel.position = Vec3(0, 0, 1);
+    scene.bodies = {wheel};
+    SceneJoint hinge;
+    hinge.def.kind = JointKind::kHinge;
+    hinge.def.anchor = wheel.position;
+    hinge.def.axis = Vec3::UnitZ();
+    // The free coordinate is b's (the world's) turn against the wheel's: minus the wheel's.
+    hinge.def.motor = {true, -speed, 100};
+    hinge.a = 0;
+    scene.joints = {hinge};
+    return scene;
+  };
+  s.checker = [](double speed, const SceneDef& scene) {
+    Checker together = holds_together(scene, 1e-3);
+    return [=](const bench::Simulation& sim, double t, bool last) -> std::string {
+      if (std::string f = together(sim, t, last); !f.empty()) return f;
+      if (!last) return "";
+      const Vec3 w = sim.body(0).angular_velocity;
+      if (w.head<2>().norm() > 0.01 * speed)
+        return format("turned off its axis (%.3g rad/s across it)", w.head<2>().norm());
+      if (std::abs(w.z() - speed) > 0.01 * speed)
+        return format("ended at %.6g rad/s about the axis", w.z());
+      return "";
+    };
+  };
+  return s;
+}
+
+// A 1000 kg, 0.5 m cube on a slider along x, free between x = -0.2 and 0.5 m, starting at 0
+// toward the upper stop at `speed`.
+Scenario slider_stop() {
+  Scenario s;
+  s.info = {"slider stop",
+            "speed into the stop, m/s",
+            "a 1000 kg, 0.5 m cube on a slider along x (free from -0.2 to 0.5 m) sent from 0 into "
+            "its upper stop, 2 s: it reaches the stop, never passes either stop by 1 cm, never "
+            "leaves the axis by 1 mm and never gains speed",
+            {1, 10, 100, 1e3, 1e4},
+            true};
+  s.build = [](double speed) {
+    SceneDef scene;
+    scene.name = "slider-stop";
+    scene.duration = 2;
+    scene.world.solver.sleeping = false;
+    BodyDef block;
+    block.shape = BoxDef{Vec3::Constant(0.25)};
+    block.mass = 1000;
+    block.position = Vec3(0, 0, 1);
+    block.linear_velocity = Vec3(speed, 0, 0);
+    scene.bodies = {block};
+    SceneJoint slider;
+    slider.def.kind = JointKind::kSlider;
+    slider.def.anchor = block.position;
+    slider.def.axis = Vec3::UnitX();
+    // The offset of b's anchor (fixed in the world) from a's (the block's): minus the block's x.
+    slider.def.limit = {true, -0.5, 0.2};
+    slider.a = 0;
+    scene.joints = {slider};
+    return scene;
+  };
+  s.checker = [](double speed, const SceneDef& scene) {
+    Checker together = holds_together(scene, 1e-3);
+    auto reached = std::make_shared<double>(-1e300);
+    return [=](const bench::Simulation& sim, double t, bool last) -> std::string {
+      if (std::string f = together(sim, t, last); !f.empty()) return f;
+      const bench::BodyState b = sim.body(0);
+      const double x = b.position.x();
+      *reached = std::max(*reached, x);
+      if (x > 0.51 || x < -0.21) return format("passed a stop (x = %.3g m)", x);
+      if (b.linear_velocity.norm() > 1.01 * speed)
+        return format("gained speed (%.6g m/s)", b.linear_velocity.norm());
+      if (last && *reached < 0.49)
+        return format("never reached its stop (x at most %.3g m)", *reached);
+      return "";
+    };
+  };
+  return s;
+}
+
+// A 1 m, 2 kg rod hinged at one end about y, level, sent down at `speed` toward a stop 30 degrees
+// below level.
+Scenario hinge_stop() {
+  Scenario s;
+  s.info = {"hinge stop",
+            "speed into the stop, rad/s",
+            "a 1 m rod of 2 kg hinged at one end about y, free from 0.1 rad above level to 30 "
+            "degrees below, sent down from level, 2 s: it ends resting within 1 degree of the "
+            "stop (gravity holds it there), the hinge never 1 cm apart",
+            {1, 10, 100, 1e3},
+            true};
+  s.build = [](double speed) {
+    SceneDef scene;
+    scene.name = "hinge-stop";
+    scene.duration = 2;
+    scene.world.solver.sleeping = false;
+    BodyDef rod;
+    rod.shape = BoxDef{Vec3(0.5, 0.025, 0.025)};
+    rod.mass = 2;
+    rod.position = Vec3(0.5, 0, 1);
+    rod.angular_velocity = Vec3(0, speed, 0);  // +y turns +x down
+    rod.linear_velocity = Vec3(0, 0, -0.5 * speed);
+    scene.bodies = {rod};
+    SceneJoint hinge;
+    hinge.def.kind = JointKind::kHinge;
+    hinge.def.anchor = Vec3(0, 0, 1);
+    hinge.def.axis = Vec3::UnitY();
+    // b's (the world's) turn against the rod's: minus the rod's turn down.
+    hinge.def.limit = {true, -std::numbers::pi / 6, 0.1};
+    hinge.a = 0;
+    scene.joints = {hinge};
+    return scene;
+  };
+  s.checker = [](double, const SceneDef& scene) {
+    Checker together = holds_together(scene, 0.01);
+    return [=](const bench::Simulation& sim, double t, bool last) -> std::string {
+      if (std::string f = together(sim, t, last); !f.empty()) return f;
+      if (!last) return "";
+      const Vec3 along = sim.body(0).orientation * Vec3::UnitX();
+      const double down = std::atan2(-along.z(), along.x());
+      const double off = down - std::numbers::pi / 6;
+      if (std::abs(off) > std::numbers::pi / 180)
+        return format("ended %.3g degrees from its stop", off * 180 / std::numbers::pi);
+      return "";
+    };
+  };
+  return s;
+}
+
+// `balls` balls (5 cm, 1 kg, restitution 1, no friction) on hinges about y 1 m above their
+// centres, hanging touching; the first pulled out 45 degrees and released.
+Scenario cradle() {
+  Scenario s;
+  s.info = {"Newton's cradle",
+            "balls",
+            "balls of 5 cm and 1 kg (restitution 1, no friction) hanging touching on hinges 1 m "
+            "above them, the first released from 45 degrees, 1.5 s: the last ball leaves at 90% "
+            "of the first's impact speed or more, and the energy never grows by 1% of what the "
+            "first ball brought",
+            {2, 3, 5, 10, 20},
+            true};
+  s.build = [](double count) {
+    SceneDef scene;
+    scene.name = "cradle";
+    scene.duration = 1.5;
+    scene.world.solver.sleeping = false;
+    const double radius = 0.05, top = 1.5;
+    for (int i = 0; i < static_cast<int>(count); ++i) {
+      const Vec3 pivot(2 * radius * i, 0, top);
+      const double angle = i == 0 ? -std::numbers::pi / 4 : 0;
+      BodyDef ball;
+      ball.shape = SphereDef{radius};
+      ball.mass = 1;
+      ball.restitution = 1;
+      ball.friction = 0;
+      ball.position = pivot + Vec3(std::sin(angle), 0, -std::cos(angle));
+      scene.bodies.push_back(ball);
+      SceneJoint hinge;
+      hinge.def.kind = JointKind::kHinge;
+      hinge.def.anchor = pivot;
+      hinge.def.axis = Vec3::UnitY();
+      hinge.a = scene.bodies.size() - 1;
+      scene.joints.push_back(hinge);
+    }
+    return scene;
+  };
+  s.checker = [](double, const SceneDef& scene) {
+    const bench::PeerScene peer = bench::peer_scene(scene);
+    const double brought = kG * (1 - std::cos(std::numbers::pi / 4));  // 1 kg, 1 m
+    const double impact = std::sqrt(2 * brought);
+    double initial = 0;
+    for (const BodyDef& def : scene.bodies)
+      initial += def.mass * kG * def.position.z();
+    std::vector<Vec3> start = start_positions(scene);
+    auto fastest_last = std::make_shared<double>(0);
+    return [=](const bench::Simulation& sim, double, bool last) -> std::string {
+      if (std::string f = common_failure(sim, start); !f.empty()) return f;
+      double energy = 0;
+      for (std::size_t i = 0; i < sim.body_count(); ++i) {
+        const bench::BodyState b = sim.body(i);
+        energy +=
+            kinetic_energy(b, peer.mass[i], peer.inertia[i]) + peer.mass[i] * kG * b.position.z();
+      }
+      if (energy > initial + 0.01 * brought)
+        return format("energy grew by %.3g of what the first ball brought",
+                      (energy - initial) / brought);
+      *fastest_last =
+          std::max(*fastest_last, sim.body(sim.body_count() - 1).linear_velocity.norm());
+      if (last && *fastest_last < 0.9 * impact)
+        return format("the last ball left at %.3g of the impact speed", *fastest_last / impact);
+      return "";
+    };
+  };
+  return s;
+}
+
+}  // namespace
+
+std::vector<Scenario> joint_scenarios() {
+  return {chain_mass_ratio(), chain_length(), motor_speed(), hinge_stop(), slider_stop(), cradle()};
+}
+
+std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
+                                        const StabilityOptions& options) {
+  std::vector<CostRow> rows;
+  const char* specs[] = {"chain:100", "ragdolls:8"};
+  const std::size_t total = std::size(specs) * engines.size();
+  for (const char* spec : specs) {
+    SceneDef scene = standard_scene(spec).value();
+    scene.duration = options.quick ? 0.5 : 5;
+    scene.world.solver.sleeping = false;
+    for (const Engine& engine : engines) {
+      bench::PeerOptions peer_options;
+      peer_options.sleeping = false;
+      const RunOutcome outcome = run_scene(
+          engine, scene, peer_options, [](const bench::Simulation&, double, bool) { return true; },
+          options.time_limit);
+      CostRow row{spec, engine.label, outcome.settings, 0, outcome.why_not};
+      if (outcome.steps > 0 && outcome.why_not.empty())
+        row.ms_per_step = 1e3 * outcome.step_seconds / static_cast<double>(outcome.steps);
+      rows.push_back(row);
+      if (options.progress)
+        options.progress(std::string("cost ") + spec + ", " + engine.label, rows.size(), total);
+    }
+  }
+  return rows;
+}
+
+}  // namespace tumble::report
