@@ -159,6 +159,9 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
 // |f| |r| (1 - r r^T / |r|^2), and a rod's (a distance joint's) on its ends' positions,
 // |f| / length (1 - n n^T); the forces are the joints' impulses over the time they took.
 constexpr double kResolvedTurn = 0.5;  // omega h, rad
+// How far SHAKE's second iterate of the curvature targets may move them (relative to the first)
+// and still be taken (solve_velocities: measured choices there).
+constexpr double kConvergedTakes = 0.03;
 
 void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
@@ -329,11 +332,23 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     velocities_factored_ = true;
   }
   // The targets of a move ahead (the turns' curvature) depend on the velocities: SHAKE's
-  // iteration, which converges for a pendulum and diverges for a chain with a heavy end (a
-  // 1000 times heavier end gained kilojoules in a step when every sweep took them afresh, and
-  // still gained when they were taken twice). So they are taken once a substep, from velocities
-  // that already hold every joint (a first solve without them), and kept for its other sweeps.
+  // iteration. Taken afresh in every sweep they fed on themselves (a chain with a 1000 times
+  // heavier end gained kilojoules in a step), so they are taken a substep at a time, from
+  // velocities that already hold every joint (a first solve without them), and kept for its other
+  // sweeps. Taken once, they are a step behind the velocities they produce: a pendulum lost a
+  // little energy every swing (at 170 degrees its half period shortened by 2e-4 of itself every
+  // half swing). So they are taken a second time, from the velocities the first produce, where the
+  // iteration converges (the second changes them by under kConvergedTakes of the first: a
+  // pendulum's by 2e-4, a heavy chain's by about 0.36, a chain of beads' erratically by up to 20;
+  // taken at a tenth, a falling chain at dt 1/30 opened 1.4e-6 m, at 0.03 1.3e-7 m as with one
+  // take): else the first are kept.
   // Without a move ahead the rows' rates are held at zero.
+  auto rates_of = [&](std::size_t k, const std::vector<Vec6>& targets) {
+    Vec6 rates = target.h > 0 ? targets[k] : Vec6(Vec6::Zero());
+    const JointRow& row = rows[nodes_[k].index];
+    if (motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
+    return rates;
+  };
   if (target.h > 0 && !targets_taken_) {
     JointTarget plain = target;
     plain.h = 0;
@@ -342,14 +357,10 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     for (std::size_t k = 0; k < nodes_.size(); ++k)
       if (nodes_[k].is_joint)
         kept_targets_[k] = velocity_equations(rows[nodes_[k].index], bodies, poses, target).target;
+    take_second_targets(rows, bodies, poses, target, rates_of);
     targets_taken_ = true;
   }
-  solve(bodies, true, [&](std::size_t k) {
-    Vec6 rates = target.h > 0 ? kept_targets_[k] : Vec6(Vec6::Zero());
-    const JointRow& row = rows[nodes_[k].index];
-    if (motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
-    return rates;
-  });
+  solve(bodies, true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
   // A degenerate joint (its rows dependent) leaves a pivot without an inverse: nothing is
   // applied, and the Gauss-Seidel position passes and next sweeps carry on.
   for (const Node& node : nodes_)
@@ -395,6 +406,37 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     change = std::max(change, solve_velocities(rows, bodies, poses, target));
   }
   return change;
+}
+
+template <class Rates>
+void JointTree::take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
+                                    std::span<const Pose> poses, const JointTarget& target,
+                                    Rates rates_of) {
+  const std::size_t n = nodes_.size();
+  held_velocities_.resize(n);
+  second_targets_.resize(n);
+  solve(bodies, true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
+  for (std::size_t k = 0; k < n; ++k) {
+    if (nodes_[k].is_joint || !nodes_[k].rhs.allFinite()) continue;
+    SolverBody& body = bodies[nodes_[k].index];
+    held_velocities_[k] << body.v, body.w;
+    body.v = nodes_[k].rhs.head<3>();
+    body.w = nodes_[k].rhs.tail<3>();
+  }
+  double first = 0, change = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!nodes_[k].is_joint) continue;
+    second_targets_[k] = velocity_equations(rows[nodes_[k].index], bodies, poses, target).target;
+    first = std::max(first, kept_targets_[k].lpNorm<Eigen::Infinity>());
+    change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    if (nodes_[k].is_joint || !nodes_[k].rhs.allFinite()) continue;
+    SolverBody& body = bodies[nodes_[k].index];
+    body.v = held_velocities_[k].head<3>();
+    body.w = held_velocities_[k].tail<3>();
+  }
+  if (change <= kConvergedTakes * first) kept_targets_.swap(second_targets_);
 }
 
 void JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,

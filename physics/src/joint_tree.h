@@ -75,6 +75,11 @@ class JointTree {
   // targets(k)) solved, the solution per node in rhs.
   template <class Targets>
   void solve(std::span<const SolverBody> bodies, bool velocities, Targets targets);
+  // SHAKE's second iterate of the curvature targets in kept_targets_, where it converges
+  // (solve_velocities); the bodies' velocities are left as they were.
+  template <class Rates>
+  void take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
+                           std::span<const Pose> poses, const JointTarget& target, Rates rates_of);
   // Sets each body's stiffness (Node) for a substep of h (joint_tree.cc: why and how much).
   void set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                                std::span<const Pose> poses, double h);
@@ -85,6 +90,8 @@ class JointTree {
   std::vector<JointEquations> equations_;    // by node, for joints
   // A substep's targets for its sweeps before the move (solve_velocities).
   std::vector<Eigen::Matrix<double, 6, 1>> kept_targets_;
+  // The targets of SHAKE's second iterate, and the bodies' velocities it starts from.
+  std::vector<Eigen::Matrix<double, 6, 1>> second_targets_, held_velocities_;
   bool velocities_factored_ = false;  // since the last move
   bool targets_taken_ = false;        // since the last move
   // For building: each node's neighbours and the visit.
