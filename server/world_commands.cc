@@ -187,12 +187,10 @@ Status replace_world(HostedWorld& hosted, World world, double dt, std::vector<st
 }
 
 SavedWorld save_world(const HostedWorld& hosted) {
-  SavedWorld saved{hosted.world.settings(), hosted.world.save_state(), hosted.dt,
-                   hosted.colours,          hosted.ids.by_slot(),      hosted.ids.next(),
-                   hosted.server_instance,  hosted.world.step_count()};
-  saved.joint_ids = hosted.joint_ids.by_slot();
-  saved.next_joint_id = hosted.joint_ids.next();
-  return saved;
+  return {hosted.world.settings(), hosted.world.save_state(), hosted.dt,
+          hosted.colours,          hosted.ids.by_slot(),      hosted.ids.next(),
+          hosted.server_instance,  hosted.world.step_count(), hosted.joint_ids.by_slot(),
+          hosted.joint_ids.next()};
 }
 
 Result<RestoredWorld> decode_restore(std::string_view bytes, const WorldLimits& limits,

@@ -142,7 +142,10 @@ std::string landed_pile_snapshot() {
   World world = make_world(pile_scene(20)).value();
   for (int k = 0; k < 40; ++k)
     EXPECT_TRUE(world.step(1.0 / 60).is_ok());
-  server::SavedWorld saved{world.settings(), world.save_state(), 1.0 / 60};
+  server::SavedWorld saved;
+  saved.settings = world.settings();
+  saved.state = world.save_state();
+  saved.dt = 1.0 / 60;
   for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
     saved.ids.push_back(world.id_at(slot).is_valid() ? slot + 1 : 0);
     saved.colours.push_back(0xffffffffu);

@@ -14,7 +14,10 @@ server::SavedWorld landed_pile() {
   World world = make_world(pile_scene(20)).value();
   for (int k = 0; k < 40; ++k)
     EXPECT_TRUE(world.step(1.0 / 60).is_ok());
-  server::SavedWorld saved{world.settings(), world.save_state(), 1.0 / 60};
+  server::SavedWorld saved;
+  saved.settings = world.settings();
+  saved.state = world.save_state();
+  saved.dt = 1.0 / 60;
   for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
     saved.ids.push_back(world.id_at(slot).is_valid() ? 100 + slot : 0);
     saved.colours.push_back(0x11223300u + slot);

@@ -51,9 +51,11 @@ bool restored_safely(const WorldSettings& settings, const std::string& bytes) {
   }
   for (int step = 0; step < 5; ++step)
     EXPECT_TRUE(restored.value().step(kDt));
-  for (std::uint32_t slot = 0; slot < restored.value().slot_count(); ++slot)
-    if (const BodyId id = restored.value().id_at(slot); id.is_valid())
+  for (std::uint32_t slot = 0; slot < restored.value().slot_count(); ++slot) {
+    if (const BodyId id = restored.value().id_at(slot); id.is_valid()) {
       EXPECT_TRUE(check_limits(restored.value().body(id), settings.limits));
+    }
+  }
   return true;
 }
 

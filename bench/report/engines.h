@@ -18,6 +18,7 @@ struct Engine {
   std::function<std::unique_ptr<bench::Simulation>(const SceneDef&, const bench::PeerOptions&,
                                                    std::string*)>
       make;
+  bool joints_only = false;  // measured on the joints' scenes alone (ODE's dWorldStep)
 };
 
 // Tumble's configurations: solver, iterations, substeps, threads. `quick` keeps one of each kind.

@@ -138,9 +138,10 @@ int main(int argc, char** argv) {
   header.machine = machine();
   header.commit = commit;
   const tumble::SceneDef probe = tumble::standard_scene("tower:2").value();
+  const tumble::SceneDef jointed = tumble::standard_scene("pendulum").value();
   for (const Engine& engine : engines) {
     std::string why_not;
-    const auto sim = engine.make(probe, {}, &why_not);
+    const auto sim = engine.make(engine.joints_only ? jointed : probe, {}, &why_not);
     header.engines.push_back(engine.label + ": " + (sim ? sim->settings() : why_not));
   }
 

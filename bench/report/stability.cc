@@ -378,9 +378,11 @@ std::vector<StabilityRow> measure_stability(const std::vector<Engine>& engines,
   if (options.joints_only) std::erase_if(all, [](const Scenario& s) { return !s.info.joints; });
   std::size_t total = 0, done = 0;
   for (const Scenario& s : all)
-    total += s.info.values.size() * engines.size();
+    for (const Engine& engine : engines)
+      total += engine.joints_only && !s.info.joints ? 0 : s.info.values.size();
   for (const Scenario& scenario : all) {
     for (const Engine& engine : engines) {
+      if (engine.joints_only && !scenario.info.joints) continue;
       bool failed = false;
       for (double value : scenario.info.values) {
         ++done;

@@ -322,9 +322,13 @@ std::vector<WorkPrecisionRow> measure_work_precision(const std::vector<Engine>& 
   std::vector<Reference> scenes = references(options.quick);
   if (options.joints_only) std::erase_if(scenes, [](const Reference& r) { return !r.info.joints; });
   const std::vector<int> rates = swept_rates(options.quick);
-  const std::size_t total = scenes.size() * engines.size() * rates.size();
+  std::size_t total = 0;
+  for (const Reference& reference : scenes)
+    for (const Engine& engine : engines)
+      total += engine.joints_only && !reference.info.joints ? 0 : rates.size();
   for (const Reference& reference : scenes) {
     for (const Engine& engine : engines) {
+      if (engine.joints_only && !reference.info.joints) continue;
       for (int rate : rates) {
         SceneDef scene = reference.scene;
         scene.dt = 1.0 / rate;
