@@ -26,6 +26,24 @@ Checker holds_together(const SceneDef& scene, double limit) {
   };
 }
 
+// One body joined to the world (a = the body, b = the world), 2 s, sleeping off; the caller sets
+// the joint's drives and limits.
+SceneDef one_joint_scene(std::string name, const BodyDef& body, JointKind kind, const Vec3& anchor,
+                         const Vec3& axis) {
+  SceneDef scene;
+  scene.name = std::move(name);
+  scene.duration = 2;
+  scene.world.solver.sleeping = false;
+  scene.bodies = {body};
+  SceneJoint joint;
+  joint.def.kind = kind;
+  joint.def.anchor = anchor;
+  joint.def.axis = axis;
+  joint.a = 0;
+  scene.joints = {joint};
+  return scene;
+}
+
 Scenario chain_mass_ratio() {
   Scenario s;
   s.info = {"chain end mass ratio",
@@ -74,23 +92,14 @@ Scenario motor_speed() {
             {1, 10, 100, 1e3, 1e4},
             true};
   s.build = [](double speed) {
-    SceneDef scene;
-    scene.name = "motor";
-    scene.duration = 2;
-    scene.world.solver.sleeping = false;
     BodyDef wheel;
     wheel.shape = BoxDef{Vec3::Constant(0.1)};
     wheel.mass = 1;
     wheel.position = Vec3(0, 0, 1);
-    scene.bodies = {wheel};
-    SceneJoint hinge;
-    hinge.def.kind = JointKind::kHinge;
-    hinge.def.anchor = wheel.position;
-    hinge.def.axis = Vec3::UnitZ();
+    SceneDef scene =
+        one_joint_scene("motor", wheel, JointKind::kHinge, wheel.position, Vec3::UnitZ());
     // The free coordinate is b's (the world's) turn against the wheel's: minus the wheel's.
-    hinge.def.motor = {true, -speed, 100};
-    hinge.a = 0;
-    scene.joints = {hinge};
+    scene.joints[0].def.motor = {true, -speed, 100};
     return scene;
   };
   s.checker = [](double speed, const SceneDef& scene) {
@@ -121,24 +130,15 @@ Scenario slider_stop() {
             {1, 10, 100, 1e3, 1e4},
             true};
   s.build = [](double speed) {
-    SceneDef scene;
-    scene.name = "slider-stop";
-    scene.duration = 2;
-    scene.world.solver.sleeping = false;
     BodyDef block;
     block.shape = BoxDef{Vec3::Constant(0.25)};
     block.mass = 1000;
     block.position = Vec3(0, 0, 1);
     block.linear_velocity = Vec3(speed, 0, 0);
-    scene.bodies = {block};
-    SceneJoint slider;
-    slider.def.kind = JointKind::kSlider;
-    slider.def.anchor = block.position;
-    slider.def.axis = Vec3::UnitX();
+    SceneDef scene =
+        one_joint_scene("slider-stop", block, JointKind::kSlider, block.position, Vec3::UnitX());
     // The offset of b's anchor (fixed in the world) from a's (the block's): minus the block's x.
-    slider.def.limit = {true, -0.5, 0.2};
-    slider.a = 0;
-    scene.joints = {slider};
+    scene.joints[0].def.limit = {true, -0.5, 0.2};
     return scene;
   };
   s.checker = [](double speed, const SceneDef& scene) {
@@ -172,25 +172,16 @@ Scenario hinge_stop() {
             {1, 10, 100, 1e3},
             true};
   s.build = [](double speed) {
-    SceneDef scene;
-    scene.name = "hinge-stop";
-    scene.duration = 2;
-    scene.world.solver.sleeping = false;
     BodyDef rod;
     rod.shape = BoxDef{Vec3(0.5, 0.025, 0.025)};
     rod.mass = 2;
     rod.position = Vec3(0.5, 0, 1);
     rod.angular_velocity = Vec3(0, speed, 0);  // +y turns +x down
     rod.linear_velocity = Vec3(0, 0, -0.5 * speed);
-    scene.bodies = {rod};
-    SceneJoint hinge;
-    hinge.def.kind = JointKind::kHinge;
-    hinge.def.anchor = Vec3(0, 0, 1);
-    hinge.def.axis = Vec3::UnitY();
+    SceneDef scene =
+        one_joint_scene("hinge-stop", rod, JointKind::kHinge, Vec3(0, 0, 1), Vec3::UnitY());
     // b's (the world's) turn against the rod's: minus the rod's turn down.
-    hinge.def.limit = {true, -std::numbers::pi / 6, 0.1};
-    hinge.a = 0;
-    scene.joints = {hinge};
+    scene.joints[0].def.limit = {true, -std::numbers::pi / 6, 0.1};
     return scene;
   };
   s.checker = [](double, const SceneDef& scene) {
