@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_file, "a scene file (JSON, see docs/SCENES.md)");
   app.add_option("--standard", standard,
                  "a standard scene: pile[:N], pyramid[:N], tower[:N], mass-ratio, mass-ratio-inv, "
-                 "bullet, slide, spin, bounce, default");
+                 "bullet, slide, spin, bounce, pendulum, double-pendulum, chain[:N[:R]], cradle, "
+                 "door, rope-bridge[:N], arm, ragdolls[:N], default (docs/SCENES.md)");
   app.add_option("--solver", solver, "exact, pgs, soft or auto (default: the scene's)");
   app.add_option("--duration", duration, "simulated seconds (default: the scene's)");
   app.add_option("--threads", threads, "OpenMP threads (0 = all; default: the scene's)")
