@@ -2,10 +2,10 @@
 // from the world, its end R times heavier and pushed sideways at 1 m/s, swung 20 s: how far its
 // joints come apart (the largest gap between a link's end and the next link's, or the pivot, over
 // every step, read from the bodies' poses the same way for every engine) and the median step time;
-// then the standard chain:100 (falling onto the ground) for step time alone. Ours with the direct
-// solve of joint trees (auto) and with Gauss-Seidel joints (soft); Bullet 3.24 float and double,
-// btPoint2PointConstraint, 10 sequential-impulse iterations. ODE and MuJoCo join in the report's
-// joints section (make report). Usage: bench_joints [seconds] (default 20).
+// then the standard chain:100 (released level, swinging clear of the ground) for step time alone.
+// Ours with the direct solve of joint trees (auto) and with Gauss-Seidel joints (soft); Bullet 3.24
+// float and double, btPoint2PointConstraint, 10 sequential-impulse iterations. ODE and MuJoCo join
+// in the report's joints section (make report). Usage: bench_joints [seconds] (default 20).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
     each_engine([&](SolverKind solver) { return heavy_chain(ratio, solver); }, steps, largest_gap,
                 label);
   }
-  std::printf("chain:100 (standard scene, falling onto the ground), %g s: step time\n", seconds);
+  std::printf("chain:100 (standard scene, released level), %g s: step time\n", seconds);
   each_engine(
       [&](SolverKind solver) {
         SceneDef scene = chain_scene(100);

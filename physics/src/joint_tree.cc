@@ -269,9 +269,11 @@ void JointTree::factor(std::span<const JointRow> rows, std::span<const SolverBod
   }
   for (std::size_t k = 0; k < n; ++k) {
     Node& node = nodes_[k];
+    node.narrow = false;
     if (node.parent == kNone) continue;
     // The joint's Jacobian on the body (the joint is this node or its parent).
     const std::size_t joint = node.is_joint ? k : node.parent;
+    node.narrow = equations_[joint].rows <= 3;
     const std::uint32_t body = node.is_joint ? nodes_[node.parent].index : node.index;
     const JointRow& row = rows[nodes_[joint].index];
     const Mat6& jacobian = row.a == body ? equations_[joint].on_a : equations_[joint].on_b;
@@ -280,13 +282,33 @@ void JointTree::factor(std::span<const JointRow> rows, std::span<const SolverBod
     else
       node.to_parent = jacobian.transpose();
   }
-  // Children eliminated into their parents.
+  // Children eliminated into their parents (each pivot kept as its inverse).
   for (std::size_t k = 0; k < n; ++k) {
     Node& node = nodes_[k];
-    node.pivot = inverse_of_definite(node.pivot);  // kept as its inverse
+    Mat6& parent_pivot = nodes_[node.parent == kNone ? k : node.parent].pivot;
+    if (node.is_joint && equations_[k].rows <= 3) {
+      // diag(A, -1, -1, -1): A's inverse alone (a singular A gives non-finite entries).
+      const Mat3 corner = node.pivot.topLeftCorner<3, 3>().inverse();
+      node.pivot.setZero();
+      node.pivot.topLeftCorner<3, 3>() = corner;
+      node.pivot.bottomRightCorner<3, 3>() = -Mat3::Identity();
+    } else {
+      node.pivot = inverse_of_definite(node.pivot);
+    }
     if (node.parent == kNone) continue;
-    node.reach = node.pivot * node.to_parent;
-    nodes_[node.parent].pivot -= node.to_parent.transpose() * node.reach;
+    if (!node.narrow) {
+      node.reach = node.pivot * node.to_parent;
+      parent_pivot -= node.to_parent.transpose() * node.reach;
+    } else if (node.is_joint) {
+      node.reach.setZero();
+      node.reach.topRows<3>() = node.pivot.topLeftCorner<3, 3>() * node.to_parent.topRows<3>();
+      parent_pivot -= node.to_parent.topRows<3>().transpose() * node.reach.topRows<3>();
+    } else {
+      node.reach.setZero();
+      node.reach.leftCols<3>() = node.pivot * node.to_parent.leftCols<3>();
+      parent_pivot.topLeftCorner<3, 3>() -=
+          node.to_parent.leftCols<3>().transpose() * node.reach.leftCols<3>();
+    }
   }
 }
 
@@ -307,14 +329,32 @@ void JointTree::solve(std::span<const SolverBody> bodies, bool velocities, Targe
   }
   for (std::size_t k = 0; k < n; ++k) {
     const Node& node = nodes_[k];
-    if (node.parent != kNone) nodes_[node.parent].rhs -= node.reach.transpose() * node.rhs;
+    if (node.parent == kNone) continue;
+    Vec6& parent_rhs = nodes_[node.parent].rhs;
+    if (!node.narrow) {
+      parent_rhs -= node.reach.transpose() * node.rhs;
+    } else if (node.is_joint) {
+      parent_rhs -= node.reach.topRows<3>().transpose() * node.rhs.head<3>();
+    } else {
+      parent_rhs.head<3>() -= node.reach.leftCols<3>().transpose() * node.rhs;
+    }
   }
   for (std::size_t k = n; k-- > 0;) {
     Node& node = nodes_[k];
-    if (node.parent == kNone)
+    if (node.parent == kNone) {
       node.rhs = node.pivot * node.rhs;
-    else
-      node.rhs = node.pivot * node.rhs - node.reach * nodes_[node.parent].rhs;
+      continue;
+    }
+    const Vec6& parent_rhs = nodes_[node.parent].rhs;
+    if (!node.narrow) {
+      node.rhs = node.pivot * node.rhs - node.reach * parent_rhs;
+    } else if (node.is_joint) {
+      node.rhs.head<3>() = node.pivot.topLeftCorner<3, 3>() * node.rhs.head<3>() -
+                           node.reach.topRows<3>() * parent_rhs;
+      node.rhs.tail<3>() = -node.rhs.tail<3>();
+    } else {
+      node.rhs = node.pivot * node.rhs - node.reach.leftCols<3>() * parent_rhs.head<3>();
+    }
   }
 }
 

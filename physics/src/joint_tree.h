@@ -59,6 +59,10 @@ class JointTree {
     Mat6 pivot = Mat6::Zero();  // the node's diagonal block once its children are eliminated
     Mat6 reach = Mat6::Zero();  // pivot^-1 to_parent, once factored
     Vec6 rhs = Vec6::Zero();
+    // The edge to the parent carries three rows or fewer (a ball or distance joint's): the
+    // joint's pivot is then its 3x3 corner and -1s, and the blocks' last three rows (a joint's)
+    // or columns (a body's) are zero, so the products take their first three alone.
+    bool narrow = false;
     Mat3 inertia = Mat3::Zero();  // a body's, world axes
     // A body's share of its joints' geometric stiffness, times h^2 (linear, angular), added to
     // its mass in the velocity solve.
