@@ -96,7 +96,7 @@ void write_pose(std::ostream& out, const Vec3& position, const Quat& q) {
 // that holds it there (none: a free body, or the root of a tree of joints).
 struct Placement {
   std::optional<std::size_t> parent, joint;
-  bool placed = false;
+  bool placed = false;  // while the tree grows (place)
 };
 
 // Grows the tree from the world (static bodies are the world) through the joints; a joint whose
@@ -137,8 +137,6 @@ bool place(const SceneDef& scene, std::vector<Placement>* placements, std::strin
         grew = true;
       }
   }
-  for (Placement& p : at)
-    p.placed = true;
   return true;
 }
 

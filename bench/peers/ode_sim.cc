@@ -104,7 +104,6 @@ class OdeSimulation final : public Simulation {
     const Vec3& p = def.anchor;
     const Vec3 axis = def.axis.normalized();
     dJointID made = nullptr;
-    int limit_and_motor_kind = 0;  // 1 hinge, 2 slider
     switch (def.kind) {
       case JointKind::kBall:
         made = dJointCreateBall(world_, nullptr);
@@ -116,13 +115,11 @@ class OdeSimulation final : public Simulation {
         dJointAttach(made, a, b);
         dJointSetHingeAnchor(made, p.x(), p.y(), p.z());
         dJointSetHingeAxis(made, axis.x(), axis.y(), axis.z());
-        limit_and_motor_kind = 1;
         break;
       case JointKind::kSlider:
         made = dJointCreateSlider(world_, nullptr);
         dJointAttach(made, a, b);
         dJointSetSliderAxis(made, axis.x(), axis.y(), axis.z());
-        limit_and_motor_kind = 2;
         break;
       case JointKind::kFixed:
         made = dJointCreateFixed(world_, nullptr);
@@ -139,10 +136,13 @@ class OdeSimulation final : public Simulation {
         break;
       }
     }
-    if (limit_and_motor_kind != 0) {
+    if (def.kind == JointKind::kHinge || def.kind == JointKind::kSlider) {
       auto set = [&](int parameter, double value) {
-        if (limit_and_motor_kind == 1) dJointSetHingeParam(made, parameter, value);
-        if (limit_and_motor_kind == 2) dJointSetSliderParam(made, parameter, value);
+        if (def.kind == JointKind::kHinge) {
+          dJointSetHingeParam(made, parameter, value);
+        } else {
+          dJointSetSliderParam(made, parameter, value);
+        }
       };
       if (def.limit.enabled) {
         set(dParamLoStop, -def.limit.upper);
