@@ -51,6 +51,10 @@ double solve_bound(JointBodies& j, const AxialRow& row, double mass, double gap,
 
 }  // namespace
 
+bool has_axial_rows(const Joint& joint) {
+  return joint.spring.enabled || joint.motor.enabled || joint.limit.enabled || has_cone(joint);
+}
+
 void warm_start_axial(const JointRow& row, JointBodies& j) {
   const Joint& joint = row.joint;
   if (has_cone(joint) && joint.swing_impulse != 0) {

@@ -11,6 +11,9 @@
 
 namespace tumble {
 
+// Whether the joint has any of these rows (a spring, motor, limit or cone).
+bool has_axial_rows(const Joint& joint);
+
 // Applies the free coordinate's rows' impulses from the last step: the warm start.
 void warm_start_axial(const JointRow& row, joint_detail::JointBodies& j);
 

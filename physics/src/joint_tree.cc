@@ -138,6 +138,13 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
   for (std::uint32_t body : bodies_used_)
     node_of_body_[body] = new_index[node_of_body_[body]];
   equations_.resize(n);
+  has_motors_ = false;
+  for (Node& node : nodes_) {
+    if (node.is_joint)
+      has_motors_ = has_motors_ || rows[node.index].joint.motor.enabled;
+    else
+      node.inertia = bodies[node.index].inverse_inertia.inverse();
+  }
   velocities_factored_ = false;
   targets_taken_ = false;
   return true;
@@ -163,7 +170,7 @@ constexpr double kResolvedTurn = 0.5;  // omega h, rad
 // and still be taken (solve_velocities: measured choices there).
 constexpr double kConvergedTakes = 0.03;
 
-void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
+bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
                                         std::span<const Pose> poses, double h) {
   for (Node& node : nodes_) {
@@ -214,6 +221,7 @@ void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
   // Only the part beyond kResolvedTurn: scaled by 1 - rho0 / rho, where rho = (omega h)^2 of the
   // body's stiffest turn or shift (and rho0 = kResolvedTurn^2); continuous in the load.
   const double resolved = kResolvedTurn * kResolvedTurn;
+  bool any = false;
   // rho: the largest eigenvalue of W^1/2 K W^1/2 (W the inverse mass or inertia).
   auto keep_excess = [&](Mat3& stiffness, const Mat3& inverse_mass) {
     // The trace of K W bounds rho from above (both are positive semidefinite): most bodies
@@ -227,6 +235,7 @@ void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     const double rho =
         Eigen::SelfAdjointEigenSolver<Mat3>().computeDirect(relative).eigenvalues()[2];
     stiffness *= rho > resolved ? 1 - resolved / rho : 0.0;
+    any = any || rho > resolved;
   };
   for (Node& node : nodes_) {
     if (node.is_joint) continue;
@@ -241,6 +250,7 @@ void JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
         (r.squaredNorm() * Mat3::Identity() - r * r.transpose()) / body.inverse_mass;
     keep_excess(node.angular_stiffness, turning.inverse());
   }
+  return any;
 }
 
 template <class Equations>
@@ -258,7 +268,6 @@ void JointTree::factor(std::span<const JointRow> rows, std::span<const SolverBod
         node.pivot(r, r) = -1;
     } else {
       const SolverBody& body = bodies[node.index];
-      node.inertia = body.inverse_inertia.inverse();
       node.pivot.topLeftCorner<3, 3>().diagonal().setConstant(1 / body.inverse_mass);
       node.pivot.bottomRightCorner<3, 3>() = node.inertia;
       if (velocities) {
@@ -363,7 +372,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   if (nodes_.empty()) return 0;
   // The poses stay put between moves: one factoring serves every sweep until the next.
   if (!velocities_factored_) {
-    set_geometric_stiffness(rows, bodies, poses, target.substep);
+    stiffened_ = set_geometric_stiffness(rows, bodies, poses, target.substep);
     factor(rows, bodies, true, [&](std::size_t k) {
       JointTarget plain = target;
       plain.h = 0;
@@ -480,12 +489,20 @@ void JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
 }
 
 void JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                                std::span<Pose> poses, bool refactor) {
+                                std::span<Pose> poses, bool refactor, double velocity_substep) {
   if (nodes_.empty()) return;
-  // A move came before: the next sweeps factor again and take their targets afresh.
-  velocities_factored_ = false;
+  // A move came before: the next sweeps take their targets afresh, and factor again unless this
+  // pass or one before it since the move factored for them.
   targets_taken_ = false;
   if (refactor) {
+    // Shared only where no body takes stiffness: a light link's stiffness as mass in the position
+    // passes shifted its corrections onto the heavy end, and a chain of beads under a million
+    // times heavier end tore.
+    const bool for_velocities =
+        velocity_substep > 0 && !has_motors_ &&
+        !set_geometric_stiffness(rows, bodies, poses, velocity_substep);
+    velocities_factored_ = for_velocities;
+    if (for_velocities) stiffened_ = false;
     factor(rows, bodies, false, [&](std::size_t k) {
       equations_[k] = position_equations(rows[nodes_[k].index], bodies, poses);
       return equations_[k];

@@ -30,6 +30,10 @@ class JointTree {
   bool build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
              std::span<const SolverBody> bodies, std::size_t body_count);
 
+  // Whether the velocity system holds any body's stiffness: each solve then also damps the stiff
+  // modes a little (the stiffness is in the masses, not in the velocities' right side), so a
+  // second sweep changes the velocities.
+  bool stiffened() const { return stiffened_; }
   // The rows changed (a motor joins the solve again): the next sweep factors afresh.
   void forget_velocity_factors() { velocities_factored_ = false; }
   // Velocities that hold every joint's rows at the sweep's targets (JointTarget); the impulses
@@ -39,9 +43,13 @@ class JointTree {
   // Moves the bodies onto every joint's rows, to first order (one Newton step; velocities
   // untouched): a position pass. Without `refactor`, with the rows of the pass before (a chord
   // step: the passes after the first correct errors a million times smaller, through rows that
-  // barely turned).
+  // barely turned); the first pass after a move must refactor. With `velocity_substep` > 0 (and
+  // no motor in the tree: its row is a velocity row alone), the pass's factors serve the velocity
+  // sweeps too where no body takes stiffness for a substep of that length (their systems are then
+  // the same: the same rows and masses; the passes after it move the bodies by a millionth of
+  // this one's correction).
   void solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                       std::span<Pose> poses, bool refactor);
+                       std::span<Pose> poses, bool refactor, double velocity_substep = 0);
 
  private:
   using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -63,7 +71,7 @@ class JointTree {
     // joint's pivot is then its 3x3 corner and -1s, and the blocks' last three rows (a joint's)
     // or columns (a body's) are zero, so the products take their first three alone.
     bool narrow = false;
-    Mat3 inertia = Mat3::Zero();  // a body's, world axes
+    Mat3 inertia = Mat3::Zero();  // a body's, world axes (fixed for the step, as its inverse)
     // A body's share of its joints' geometric stiffness, times h^2 (linear, angular), added to
     // its mass in the velocity solve.
     Mat3 linear_stiffness = Mat3::Zero(), angular_stiffness = Mat3::Zero();
@@ -84,8 +92,9 @@ class JointTree {
   template <class Rates>
   void take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                            std::span<const Pose> poses, const JointTarget& target, Rates rates_of);
-  // Sets each body's stiffness (Node) for a substep of h (joint_tree.cc: why and how much).
-  void set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
+  // Sets each body's stiffness (Node) for a substep of h (joint_tree.cc: why and how much);
+  // whether any body has some.
+  bool set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                                std::span<const Pose> poses, double h);
 
   std::vector<Node> nodes_;                  // children before their parents
@@ -97,6 +106,8 @@ class JointTree {
   // The targets of SHAKE's second iterate, and the bodies' velocities it starts from.
   std::vector<Eigen::Matrix<double, 6, 1>> second_targets_, held_velocities_;
   bool velocities_factored_ = false;  // since the last move
+  bool stiffened_ = false;
+  bool has_motors_ = false;           // a joint with a motor: its row joins the velocity system
   bool targets_taken_ = false;        // since the last move
   // For building: each node's neighbours and the visit.
   std::vector<std::uint32_t> first_edge_, next_edge_, edge_to_, pending_, parent_of_, order_;

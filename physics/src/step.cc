@@ -13,6 +13,7 @@
 #include "auto_solver.h"
 #include "exact_solver.h"
 #include "integrate.h"
+#include "joint_axial.h"
 #include "parallel.h"
 #include "physics/world.h"
 #include "step_limits.h"
@@ -96,6 +97,7 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
 // for a fifth less time).
 constexpr int kJointPositionPasses = 3;
 constexpr int kJointRefactoredPasses = 2;
+static_assert(kJointRefactoredPasses >= 1, "the first pass after a move refactors");
 
 // advance_with's parts for one island on one thread (any island: exact, soft, pgs).
 class SerialIsland {
@@ -115,6 +117,12 @@ class SerialIsland {
         report->joint_loop = true;
       }
     }
+    // Only the tree's own rows: its solve is exact, and a second sweep would find it so (unless
+    // it holds stiffness: JointTree::stiffened).
+    one_sweep_solves_ = tree_ != nullptr && c.rows.empty() &&
+                        std::none_of(c.joints.begin(), c.joints.end(), [&](std::uint32_t j) {
+                          return has_axial_rows(c.scratch.joint_rows[j].joint);
+                        });
   }
 
   bool has_rows() const { return !c_.rows.empty() || !c_.joints.empty(); }
@@ -133,8 +141,10 @@ class SerialIsland {
       if (tree_ != nullptr) {
         for (std::uint32_t j : c_.joints)
           correct_joint_bounds(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
+        // The last refactored pass factors the velocity sweeps' system too (joint_tree.h).
         tree_->solve_positions(c_.scratch.joint_rows, bodies_, c_.scratch.poses,
-                               pass < kJointRefactoredPasses);
+                               pass < kJointRefactoredPasses,
+                               pass == kJointRefactoredPasses - 1 ? h : 0.0);
         continue;
       }
       for (std::uint32_t j : c_.joints)
@@ -180,6 +190,7 @@ class SerialIsland {
         change = std::max(change, tree_->solve_velocities(c_.scratch.joint_rows, bodies_,
                                                           c_.scratch.poses, target));
     }
+    if (one_sweep_solves_ && !tree_->stiffened()) return 0;
     if (c_.rows.empty()) return change;
     return std::max(change, solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_,
                                            c_.settings.solver, soft, h, backward));
@@ -217,6 +228,7 @@ class SerialIsland {
   std::span<ContactRowCold> cold_;
   std::span<SolverBody> bodies_;
   JointTree* tree_ = nullptr;  // the island's joints solved directly (joint_tree.h), if so
+  bool one_sweep_solves_ = false;
 };
 
 IslandContext island_context(StepScratch& s, const WorldSettings& settings, std::size_t i) {
