@@ -241,7 +241,7 @@ int main(int argc, char** argv) {
   std::string joint_kind;
   std::uint64_t joint_a = 0, joint_b = 0;
   std::vector<double> anchor, anchor_b, axis, limit, motor, spring;
-  double length = 0, max_swing = 0;
+  double length = 0, max_swing = 0, friction = 0;
   bool collide = false, motor_off = false, spring_off = false;
   joint->add_option("kind", joint_kind, "ball, hinge, fixed, distance or slider")
       ->required()
@@ -267,6 +267,8 @@ int main(int argc, char** argv) {
       ->expected(2);
   joint->add_option("--spring", spring, "target,stiffness,damping")->delimiter(',')->expected(3);
   joint->add_option("--max-swing", max_swing, "a ball's cone (rad)");
+  joint->add_option("--friction", friction,
+                    "the joint's own friction (N m: ball, hinge; N: slider; default 0)");
   joint->add_flag("--collide", collide, "the two bodies still collide");
 
   CLI::App* joints = app.add_subcommand("joints", "joints' definitions and states as JSON lines");
@@ -428,6 +430,7 @@ int main(int argc, char** argv) {
     if (!motor.empty()) put_motor(motor, spec.mutable_motor());
     if (!spring.empty()) put_spring(spring, spec.mutable_spring());
     if (max_swing != 0) spec.set_max_swing(max_swing);
+    spec.set_friction(friction);
     Result<std::vector<std::uint64_t>> made = client.create_joints({spec});
     if (!made) return fail("joint", made.status());
     print_line(std::to_string(made.value()[0]));

@@ -339,6 +339,7 @@ void joint_spec_to_proto(const JointDef& def, std::uint64_t a, std::uint64_t b,
     out->mutable_spring()->set_damping(def.spring.damping);
   }
   if (def.max_swing < std::numbers::pi) out->set_max_swing(def.max_swing);
+  out->set_friction(def.friction);
 }
 
 Vec3 vec_from_proto(const v1::Vec3& v) {

@@ -68,6 +68,7 @@ Result<JointDef> joint_from_proto(const v1::JointSpec& spec) {
   if (spec.has_motor()) def.motor = motor_from_proto(spec.motor());
   if (spec.has_spring()) def.spring = spring_from_proto(spec.spring());
   if (spec.has_max_swing()) def.max_swing = spec.max_swing();
+  def.friction = spec.friction();
   // The checks that need no world, with placeholder bodies (the world checks the real ones).
   JointDef check = def;
   check.a = BodyId{0, 0};

@@ -137,6 +137,7 @@ class FuzzService {
       spec.mutable_spring()->set_damping(h.number(-1, 1e3));
     }
     if (h.chance(0.2)) spec.set_max_swing(h.number(-1, 4));
+    if (h.chance(0.2)) spec.set_friction(h.number(-1, 50));
     return spec;
   }
   // A live id most of the time; else one that names nothing (0, stale, huge).

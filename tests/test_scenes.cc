@@ -134,7 +134,7 @@ TEST(SceneJson, JointsAreReadCheckedAndWrittenBack) {
       {"kind": "hinge", "a": 2, "b": 3, "anchor": [3.5, 0, 2], "axis": [0, 1, 0],
        "spring": {"target": 0.1, "stiffness": 20, "damping": 1}},
       {"kind": "ball", "a": 2, "anchor": [3, 0, 2.5], "axis": [0, 0, -1], "max_swing": 0.4,
-       "limit": [-0.1, 0.1]}
+       "limit": [-0.1, 0.1], "friction": 0.25}
     ]})");
   ASSERT_TRUE(scene.ok()) << scene.error();
   ASSERT_EQ(scene.value().joints.size(), 7u);
@@ -145,6 +145,8 @@ TEST(SceneJson, JointsAreReadCheckedAndWrittenBack) {
   EXPECT_EQ(slider.motor.max_force, 50);
   EXPECT_EQ(scene.value().joints[5].def.spring.stiffness, 20);
   EXPECT_EQ(scene.value().joints[6].def.max_swing, 0.4);
+  EXPECT_EQ(scene.value().joints[6].def.friction, 0.25);
+  EXPECT_EQ(scene.value().joints[0].def.friction, 0);
   EXPECT_EQ(scene.value().joints[0].def.kind, JointKind::kHinge);
   EXPECT_FALSE(scene.value().joints[0].b.has_value());
   EXPECT_EQ(scene.value().joints[2].b, std::optional<std::size_t>(2));
@@ -181,6 +183,9 @@ TEST(SceneJson, JointsAreReadCheckedAndWrittenBack) {
   EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
                          "joints": [{"kind": "hinge", "a": 0, "axis": [0, 0, 0]}]})"),
             "joints[0].axis: must not be zero");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
+                         "joints": [{"kind": "fixed", "a": 0, "friction": 1}]})"),
+            "joints[0].friction: only ball, hinge and slider joints have friction");
   EXPECT_EQ(error_of(R"({"bodies": [{"shape": "sphere"}],
                          "joints": [{"kind": "ball", "a": 0, "anchr": [0, 0, 0]}]})"),
             "joints[0].anchr: unknown field");

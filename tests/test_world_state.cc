@@ -370,10 +370,12 @@ World jointed_world() {
       def.axis = Vec3(1, 0, 0);
       def.limit = {true, -0.05, 0.05};
       def.motor = {true, 0.2, 3};
+      def.friction = 0.5;
     } else if (i == 4) {
       def.axis = Vec3(1, 0, 0);
       def.max_swing = 0.5;
       def.limit = {true, -0.2, 0.2};
+      def.friction = 0.05;
     }
     EXPECT_TRUE(world.create_joint(def));
     last = body;
@@ -405,6 +407,7 @@ TEST(WorldState, JointsAndTheirImpulsesRoundTripBitForBit) {
   for (JointSlot& slot : cold.joints) {
     slot.joint.linear_impulse.setZero();
     slot.joint.limit_impulse = slot.joint.motor_impulse = slot.joint.spring_impulse = 0;
+    slot.joint.friction_impulse.setZero();
   }
   Result<World> without = world_of(original.settings(), cold);
   ASSERT_TRUE(without) << without.error();
@@ -465,6 +468,42 @@ TEST(WorldState, BadJointsAreRefusedNamingTheField) {
   s = good;
   s.joints[4].joint.swing_impulse = std::nan("");
   refused(s, "joints[4].impulses");
+  s = good;
+  s.joints[4].joint.friction_impulse.y() = std::nan("");
+  refused(s, "joints[4].impulses");
+  s = good;
+  s.joints[0].joint.friction = -1;
+  refused(s, "joints[0].friction");
+  s = good;
+  s.joints[2].joint.friction = 1;  // a fixed joint
+  refused(s, "joints[2].friction");
+}
+
+// Joint friction travels in its own part of each joint (flag 4), written only where a joint has
+// some: a world without writes the bytes it wrote before friction existed.
+TEST(StateFormat, JointFrictionIsWrittenOnlyWhereThereIsSome) {
+  const World with = jointed_world();
+  WorldStateData data = data_of(with);
+  for (JointSlot& slot : data.joints) {
+    slot.joint.friction = 0;
+    slot.joint.friction_impulse.setZero();
+  }
+  const World without = world_of(with.settings(), data).value();
+  auto flags = [](const std::string& bytes) {
+    std::uint32_t f = 0;
+    std::memcpy(&f, bytes.data() + 36, sizeof f);
+    return f;
+  };
+  EXPECT_EQ(flags(with.save_state()), 7u);
+  EXPECT_EQ(flags(without.save_state()), 3u);
+  EXPECT_EQ(without.save_state().size() + 32 * with.joint_count(), with.save_state().size());
+  // Friction without drives is no state this engine writes.
+  std::string bytes = with.save_state();
+  const std::uint32_t odd = 1 | 4;
+  std::memcpy(bytes.data() + 36, &odd, sizeof odd);
+  const Result<World> refused = World::from_state(with.settings(), bytes);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().find("flags"), std::string::npos) << refused.error();
 }
 
 TEST(StateFormat, DamagedJointBytesAreRefusedOrStepSafely) {

@@ -97,15 +97,16 @@ class BulletSimulation final : public Simulation {
   // btConeTwistConstraint where it has a cone (its twist limit symmetric); a hinge as
   // btHingeConstraint (its motor as the angular motor with the force bound as the impulse of a
   // step; its limits); a fixed joint as btFixedConstraint. False (with the reason) for what this
-  // adapter does not map: springs, asymmetric twist limits, sliders, distance joints.
+  // adapter does not map: springs, friction, asymmetric twist limits, sliders, distance joints.
   bool join(const SceneJoint& joint, std::string* why_not) {
     const JointDef& def = joint.def;
     const bool cone = def.kind == JointKind::kBall && def.max_swing < 3.14159265358979;
-    if (def.spring.enabled || (def.kind == JointKind::kBall && def.limit.enabled &&
-                               (!cone || def.limit.lower != -def.limit.upper))) {
+    if (def.spring.enabled || def.friction > 0 ||
+        (def.kind == JointKind::kBall && def.limit.enabled &&
+         (!cone || def.limit.lower != -def.limit.upper))) {
       *why_not =
-          "joint springs, and twist limits other than symmetric ones within a cone, are not "
-          "mapped to Bullet";
+          "joint springs and friction, and twist limits other than symmetric ones within a cone, "
+          "are not mapped to Bullet";
       return false;
     }
     btRigidBody& a = *bodies_[joint.a];

@@ -161,10 +161,11 @@ std::unique_ptr<Simulation> make_mujoco(const PeerScene& peer, const PeerOptions
   for (const SceneJoint& joint : scene.joints) {
     const JointDef& def = joint.def;
     if (def.kind == JointKind::kDistance || def.motor.enabled || def.collide_connected ||
-        def.max_swing < 3.14159265358979 || (def.kind == JointKind::kBall && def.limit.enabled)) {
+        def.friction > 0 || def.max_swing < 3.14159265358979 ||
+        (def.kind == JointKind::kBall && def.limit.enabled)) {
       *why_not =
-          "distance joints, motors, cones, twist limits and colliding joined bodies are not "
-          "mapped to MuJoCo";
+          "distance joints, motors, joint friction, cones, twist limits and colliding joined "
+          "bodies are not mapped to MuJoCo";
       return nullptr;
     }
   }

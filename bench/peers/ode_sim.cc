@@ -95,9 +95,10 @@ class OdeSimulation final : public Simulation {
   // speed changes sign.
   bool join(const SceneJoint& joint, std::string* why_not) {
     const JointDef& def = joint.def;
-    if (def.spring.enabled || def.max_swing < 3.14159265358979 ||
+    if (def.spring.enabled || def.friction > 0 || def.max_swing < 3.14159265358979 ||
         (def.limit.enabled && def.kind != JointKind::kHinge && def.kind != JointKind::kSlider)) {
-      *why_not = "joint springs, cones, twist limits and distance ranges are not mapped to ODE";
+      *why_not =
+          "joint springs, friction, cones, twist limits and distance ranges are not mapped to ODE";
       return false;
     }
     dBodyID a = body_of(joint.a), b = joint.b ? body_of(*joint.b) : nullptr;

@@ -281,7 +281,11 @@ std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
   for (const char* spec : specs) {
     SceneDef scene = standard_scene(spec).value();
     scene.duration = options.quick ? 0.5 : 5;
+    // Awake, and without the ragdolls' joint friction (it lets them sleep, and no peer adapter
+    // maps it): every engine steps the same bodies and joints the whole time.
     scene.world.solver.sleeping = false;
+    for (SceneJoint& joint : scene.joints)
+      joint.def.friction = 0;
     for (const Engine& engine : engines) {
       bench::PeerOptions peer_options;
       peer_options.sleeping = false;

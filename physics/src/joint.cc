@@ -89,9 +89,18 @@ Status validate(const JointDef& def) {
     return Status::error("max_swing: only a ball joint has a swing cone");
   if (def.kind == JointKind::kBall && def.limit.enabled && def.max_swing >= std::numbers::pi - 1e-3)
     return Status::error("limit: a ball's twist needs a swing cone (max_swing) below pi");
+  if (Status s = validate_friction(def.kind, def.friction); !s) return s;
   if (Status s = validate(def.kind, def.limit); !s) return s;
   if (Status s = validate(def.kind, def.motor); !s) return s;
   return validate(def.kind, def.spring);
+}
+
+Status validate_friction(JointKind kind, double friction) {
+  if (!(std::isfinite(friction) && friction >= 0 && friction <= kMaxJointForce))
+    return Status::error("friction: must be finite, >= 0 and <= 1e20");
+  if (friction > 0 && (kind == JointKind::kFixed || kind == JointKind::kDistance))
+    return Status::error("friction: only ball, hinge and slider joints have friction");
+  return Status::ok();
 }
 
 }  // namespace tumble

@@ -49,10 +49,40 @@ double solve_bound(JointBodies& j, const AxialRow& row, double mass, double gap,
   return std::abs(applied) * mass;
 }
 
+// A hinge's or slider's friction: along its coordinate. A ball's: against its whole turn.
+bool coordinate_friction(const Joint& joint) {
+  return joint.friction > 0 && joint.kind != JointKind::kBall;
+}
+bool turn_friction(const Joint& joint) {
+  return joint.friction > 0 && joint.kind == JointKind::kBall;
+}
+
+// A ball's friction: the angular impulse that stops b's turn relative to a, its accumulated
+// whole held within the friction torque times the substep (the disc of Coulomb's law about
+// every axis at once, as a contact's friction holds its tangent impulse).
+double solve_turn_friction(JointBodies& j, Joint& joint, double h) {
+  const SolverBody& b = j.body_b();
+  Mat3 mobility = Mat3::Zero();
+  if (j.a->inverse_mass > 0) mobility += j.a->inverse_inertia;
+  if (b.inverse_mass > 0) mobility += b.inverse_inertia;
+  const Eigen::LDLT<Mat3> solver(mobility);
+  if (solver.info() != Eigen::Success || !(mobility.trace() > 0)) return 0;
+  const Vec3 wanted = joint.friction_impulse - solver.solve(b.w - j.a->w);
+  if (!wanted.allFinite()) return 0;
+  const double most = joint.friction * h;
+  const double size = wanted.norm();
+  const Vec3 total = size > most ? Vec3(wanted * (most / size)) : wanted;
+  const Vec3 applied = total - joint.friction_impulse;
+  joint.friction_impulse = total;
+  apply_angular(j, applied);
+  return (mobility * applied).lpNorm<Eigen::Infinity>();
+}
+
 }  // namespace
 
 bool has_axial_rows(const Joint& joint) {
-  return joint.spring.enabled || joint.motor.enabled || joint.limit.enabled || has_cone(joint);
+  return joint.spring.enabled || joint.motor.enabled || joint.limit.enabled || has_cone(joint) ||
+         joint.friction > 0;
 }
 
 void warm_start_axial(const JointRow& row, JointBodies& j) {
@@ -61,7 +91,9 @@ void warm_start_axial(const JointRow& row, JointBodies& j) {
     const Swing swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
     if (swing.exists) apply_row(j, negated(swing.row), joint.swing_impulse);
   }
-  const double along = joint.limit_impulse + joint.motor_impulse + joint.spring_impulse;
+  if (turn_friction(joint)) apply_angular(j, joint.friction_impulse);
+  const double along = joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +
+                       (coordinate_friction(joint) ? joint.friction_impulse.x() : 0.0);
   if (along == 0) return;
   const FreeCoordinate c = free_coordinate(joint, j.pose_a, j.pose_b, j.world_b());
   if (c.exists) apply_row(j, c.row, along);
@@ -72,7 +104,8 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
   const SolverBody& b = j.body_b();
   const double h = target.substep;
   double change = 0;
-  const bool drives = joint.spring.enabled || joint.motor.enabled || joint.limit.enabled;
+  const bool drives = joint.spring.enabled || joint.motor.enabled || joint.limit.enabled ||
+                      coordinate_friction(joint);
   const FreeCoordinate c =
       drives ? free_coordinate(joint, j.pose_a, j.pose_b, j.world_b()) : FreeCoordinate{};
   const double mass = c.exists ? row_mass(c.row, *j.a, b) : 0;
@@ -101,6 +134,16 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
       apply_row(j, c.row, applied);
       change = std::max(change, std::abs(applied) * mass);
     }
+    if (coordinate_friction(joint)) {
+      // A zero-speed motor bounded by the friction (ODE's joint friction; Jolt's).
+      const double most = joint.friction * h;
+      double& held = joint.friction_impulse.x();
+      const double total = std::clamp(held - row_rate(c.row, *j.a, b) / mass, -most, most);
+      const double applied = total - held;
+      held = total;
+      apply_row(j, c.row, applied);
+      change = std::max(change, std::abs(applied) * mass);
+    }
     if (joint.limit.enabled) {
       if (joint.limit.lower == joint.limit.upper) {
         // Locked: an equality, its error closed by the position passes.
@@ -120,6 +163,7 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
       }
     }
   }
+  if (turn_friction(joint)) change = std::max(change, solve_turn_friction(j, joint, h));
   if (has_cone(joint)) {
     const Swing swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
     const double cone_mass = swing.exists ? row_mass(swing.row, *j.a, b) : 0;
@@ -164,7 +208,8 @@ JointReading read_axial(const Joint& joint, const Pose& pose_a, const Pose& pose
   if (joint.impulse_time > 0) {
     const double along = rigid_distance(joint)
                              ? joint.axial_impulse
-                             : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse;
+                             : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +
+                                   (coordinate_friction(joint) ? joint.friction_impulse.x() : 0.0);
     reading.effort = along / joint.impulse_time;
   }
   return reading;

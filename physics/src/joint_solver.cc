@@ -322,9 +322,11 @@ JointReading read_joint(const Joint& joint, const Pose& pose_a, const Pose& pose
   const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
   Vec3 linear = joint.linear_impulse, angular = joint.angular_impulse;
   if (c.exists) {
-    const double along = rigid_distance(joint)
-                             ? joint.axial_impulse
-                             : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse;
+    const double along =
+        rigid_distance(joint)
+            ? joint.axial_impulse
+            : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +
+                  (joint.kind != JointKind::kBall ? joint.friction_impulse.x() : 0);
     linear += along * c.row.linear;
     if (c.row.linear.isZero()) angular += along * c.row.angular_b;
   }
@@ -332,6 +334,7 @@ JointReading read_joint(const Joint& joint, const Pose& pose_a, const Pose& pose
     const Swing swing = swing_of(joint, pose_a.orientation, pose_b.orientation);
     if (swing.exists) angular -= joint.swing_impulse * swing.row.angular_b;
   }
+  if (joint.kind == JointKind::kBall) angular += joint.friction_impulse;  // its turn's friction
   reading.force = linear / joint.impulse_time;
   reading.torque = angular / joint.impulse_time;
   return reading;

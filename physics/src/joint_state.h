@@ -31,6 +31,7 @@ struct Joint {
   JointMotor motor;
   JointSpring spring;
   double max_swing = 3.141592653589793;
+  double friction = 0;  // JointDef::friction
   // Warm start, world: the impulse at the anchors (N s, on b; a takes the opposite), the angular
   // impulse (N m s, on b), and a distance joint's along its rod.
   Vec3 linear_impulse = Vec3::Zero(), angular_impulse = Vec3::Zero();
@@ -38,6 +39,9 @@ struct Joint {
   // Along the free coordinate (N s or N m s): the limit's, the motor's and the spring's; a ball's
   // swing cone's about the lean.
   double limit_impulse = 0, motor_impulse = 0, spring_impulse = 0, swing_impulse = 0;
+  // The friction's (N m s or N s): a ball's angular impulse (world, on b), or along a hinge's or
+  // slider's coordinate in x.
+  Vec3 friction_impulse = Vec3::Zero();
   // What the last step's impulses were spread over (s): a substep, or the step (pgs).
   double impulse_time = 0;
 };

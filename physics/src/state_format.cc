@@ -3,6 +3,7 @@
 #include "joint_geometry.h"
 #include "shape_state.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <memory>
@@ -349,9 +350,11 @@ Status take_joint(Reader& r, Joint* j) {
 
 // Header flags: a joints section follows the contact pairs; each joint carries its drives
 // (limits, motor, spring, their impulses). States written before drives existed have flag 1
-// alone: their joints read with none.
+// alone: their joints read with none. Each joint carries its friction (the bound and its impulse)
+// only where some joint has any (flag 4): the bytes of a world without are as they were.
 constexpr std::uint32_t kStateHasJoints = 1;
 constexpr std::uint32_t kStateJointDrives = 2;
+constexpr std::uint32_t kStateJointFriction = 4;
 constexpr std::size_t kFlagsOffset = 36;  // magic 8, version 4, header 4, length 8, counts 12
 
 // The least bytes of one entry, so that counts are checked against what is left.
@@ -373,7 +376,13 @@ std::string encode_state(const WorldStateData& state) {
   w.put(static_cast<std::uint32_t>(state.slots.size()));
   w.put(static_cast<std::uint32_t>(state.free_slots.size()));
   w.put(static_cast<std::uint32_t>(state.contact_pairs.size()));
-  w.put(state.joints.empty() ? std::uint32_t{0} : kStateHasJoints | kStateJointDrives);
+  const bool friction =
+      std::any_of(state.joints.begin(), state.joints.end(), [](const JointSlot& s) {
+        return s.alive && (s.joint.friction != 0 || !s.joint.friction_impulse.isZero());
+      });
+  w.put(state.joints.empty() ? std::uint32_t{0}
+                             : kStateHasJoints | kStateJointDrives |
+                                   (friction ? kStateJointFriction : std::uint32_t{0}));
   w.put(state.time);
   w.put(state.step);
   for (const BodySlotState& slot : state.slots) {
@@ -394,6 +403,10 @@ std::string encode_state(const WorldStateData& state) {
       if (!slot.alive) continue;
       put_joint(w, slot.joint);
       put_joint_drives(w, slot.joint);
+      if (friction) {
+        w.put(slot.joint.friction);
+        w.put(slot.joint.friction_impulse);
+      }
     }
     for (std::uint32_t slot : state.free_joints)
       w.put(slot);
@@ -425,8 +438,10 @@ Result<StateSizes> read_state_header(std::string_view bytes) {
   if (sizes.bytes != bytes.size())
     return Status::error("length: the header says " + std::to_string(sizes.bytes) +
                          " bytes, there are " + std::to_string(bytes.size()));
-  if ((flags & ~(kStateHasJoints | kStateJointDrives)) != 0 ||
-      (flags & (kStateHasJoints | kStateJointDrives)) == kStateJointDrives)
+  // Drives without joints, or friction without drives, is no state this engine writes.
+  if ((flags & ~(kStateHasJoints | kStateJointDrives | kStateJointFriction)) != 0 ||
+      (flags & (kStateHasJoints | kStateJointDrives)) == kStateJointDrives ||
+      ((flags & kStateJointFriction) != 0 && (flags & kStateJointDrives) == 0))
     return Status::error("flags: unknown flags " + std::to_string(flags));
   // Every entry takes bytes: counts the length cannot hold are refused before anything is made.
   const std::size_t body = bytes.size() - kStateHeaderBytes;
@@ -476,6 +491,11 @@ Result<WorldStateData> decode_state(std::string_view bytes) {
       Status s = slot.alive ? take_joint(r, &slot.joint) : r.status();
       if (s && slot.alive && (flags & kStateJointDrives) != 0) {
         s = take_joint_drives(r, &slot.joint);
+        if (s && (flags & kStateJointFriction) != 0) {
+          slot.joint.friction = r.take<double>("friction");
+          slot.joint.friction_impulse = r.vec3("friction_impulse");
+          s = r.status();
+        }
       } else if (s && slot.alive) {
         // No drives: the angles count from how the joint was made, as they would have.
         Joint& joint = slot.joint;

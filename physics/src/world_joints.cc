@@ -99,6 +99,7 @@ Result<JointId> World::create_joint(const JointDef& def) {
   joint.motor = def.motor;
   joint.spring = def.spring;
   joint.max_swing = def.max_swing;
+  joint.friction = def.friction;
   if (def.kind == JointKind::kDistance && def.limit.enabled && def.limit.lower == def.limit.upper) {
     // A range of one length is a rod of that length.
     joint.length = def.limit.lower;
@@ -229,6 +230,7 @@ Result<JointDef> World::joint_def(JointId id) const {
   def.motor = joint.motor;
   def.spring = joint.spring;
   def.max_swing = joint.max_swing;
+  def.friction = joint.friction;
   return def;
 }
 
@@ -330,6 +332,7 @@ void World::store_joint_impulses() {
     joint.motor_impulse = row.joint.motor_impulse;
     joint.spring_impulse = row.joint.spring_impulse;
     joint.swing_impulse = row.joint.swing_impulse;
+    joint.friction_impulse = row.joint.friction_impulse;
     joint.impulse_time = row.joint.impulse_time;
   }
 }

@@ -120,7 +120,7 @@ Status check_joint(const Joint& joint, std::span<const BodySlotState> slots,
   if (!is_finite(joint.linear_impulse) || !is_finite(joint.angular_impulse) ||
       !std::isfinite(joint.axial_impulse) || !std::isfinite(joint.limit_impulse) ||
       !std::isfinite(joint.motor_impulse) || !std::isfinite(joint.spring_impulse) ||
-      !std::isfinite(joint.swing_impulse))
+      !std::isfinite(joint.swing_impulse) || !is_finite(joint.friction_impulse))
     return Status::error("impulses: must be finite");
   if (!(std::isfinite(joint.impulse_time) && joint.impulse_time >= 0))
     return Status::error("impulse_time: must be finite and >= 0");
@@ -129,6 +129,7 @@ Status check_joint(const Joint& joint, std::span<const BodySlotState> slots,
   if (!(joint.max_swing > 0 && joint.max_swing <= std::numbers::pi) ||
       (joint.kind != JointKind::kBall && joint.max_swing < std::numbers::pi))
     return Status::error("max_swing: must be in (0, pi], below pi for a ball joint alone");
+  if (Status s = validate_friction(joint.kind, joint.friction); !s) return s;
   if (Status s = validate(joint.kind, joint.limit); !s) return s;
   if (Status s = validate(joint.kind, joint.motor); !s) return s;
   if (Status s = validate(joint.kind, joint.spring); !s) return s;

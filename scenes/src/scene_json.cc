@@ -238,6 +238,7 @@ SceneJoint read_joint(const Json& json, const std::string& path, std::size_t bod
     m.reject_unknown();
   }
   joint.def.max_swing = r.number("max_swing", joint.def.max_swing);
+  joint.def.friction = r.number("friction", joint.def.friction);
   r.reject_unknown();
   // The engine's checks of what needs no world, with this path (the ids are filled in later).
   JointDef check = joint.def;
@@ -272,6 +273,7 @@ Json joint_json(const SceneJoint& joint) {
                      {"stiffness", joint.def.spring.stiffness},
                      {"damping", joint.def.spring.damping}};
   if (joint.def.max_swing < std::numbers::pi) out["max_swing"] = joint.def.max_swing;
+  if (joint.def.friction > 0) out["friction"] = joint.def.friction;
   return out;
 }
 

@@ -328,6 +328,11 @@ SceneDef arm_scene() {
 
 namespace {
 
+// Every ragdoll joint's friction (N m): under the lightest limb's weight about its joint (a
+// forearm's, 2.2 N m), so limbs still fall, and enough that a ragdoll at rest comes to a stop and
+// sleeps (without it a head kept rolling on the ground in its neck's cone for minutes).
+constexpr double kRagdollJointFriction = 1.0;
+
 // One ragdoll standing with its feet at `at`, facing +y turned by `yaw` about z.
 void add_ragdoll(SceneDef& scene, const Vec3& at, double yaw) {
   const Quat turn(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
@@ -355,6 +360,7 @@ void add_ragdoll(SceneDef& scene, const Vec3& at, double yaw) {
     joint.def.axis = turn * axis;
     if (kind == JointKind::kBall) joint.def.max_swing = swing;
     joint.def.limit = limit;
+    joint.def.friction = kRagdollJointFriction;
     joint.a = a;
     joint.b = b;
     scene.joints.push_back(joint);

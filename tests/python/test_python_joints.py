@@ -86,3 +86,20 @@ def test_frames_carry_the_joints_states_and_their_catalogue(world, where):
         plain = next(iter(world.frames(count=1)))
         assert plain.joints is None and plain.joints_added == []
     stream.close()
+
+
+@pytest.mark.parametrize("where", ["remote", "local"])
+def test_joint_friction_holds_a_level_bar_and_is_checked(world, where):
+    """A 1 kg bar 1 m long held level on a hinge at its end: friction above its weight's torque
+    (m g L / 2 = 4.905 N m) holds it still, giving that torque; below zero is refused."""
+    world = world if where == "remote" else tumble.World()
+    world.load_scene({"name": "empty", "bodies": []})
+    world.settings(real_time_factor=0)
+    bar = world.spawn_box(size=(1, 0.04, 0.04), mass=1.0, position=(0.5, 0, 5))
+    held = world.hinge(bar, anchor=(0, 0, 5), axis=(0, 1, 0), friction=6.0)
+    world.step(60)
+    state = world.joints([held])[0]
+    assert abs(state["effort"]) == pytest.approx(9.81 / 2, rel=1e-3)
+    assert abs(state["speed"]) < 1e-9
+    with pytest.raises(tumble.Error, match=r"joints\[0\]\.friction: must be finite, >= 0"):
+        world.hinge(bar, anchor=(0, 0, 5), axis=(0, 1, 0), friction=-1.0)

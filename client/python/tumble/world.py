@@ -225,11 +225,12 @@ class WorldCalls:
 
     def joint(self, kind, a, b=0, anchor=(0.0, 0.0, 0.0), *, anchor_b=None, axis=None,
               length=0.0, limits=None, motor=None, spring=None, max_swing=None,
-              collide_connected=False):
+              friction=0.0, collide_connected=False):
         """Joins body `a` to body `b` (0: the world) with a joint of `kind` ("ball", "hinge",
         "fixed", "distance" or "slider") at `anchor` (m, world); returns its id. limits:
         (lower, upper) of the free coordinate (rad or m); motor: (speed, max_force); spring:
-        (target, stiffness, damping); max_swing: a ball's cone (rad)."""
+        (target, stiffness, damping); max_swing: a ball's cone (rad); friction: the joint's own
+        friction against its free motion (N m for a ball or hinge, N for a slider)."""
         kinds = {"ball": pb.JOINT_KIND_BALL, "hinge": pb.JOINT_KIND_HINGE,
                  "fixed": pb.JOINT_KIND_FIXED, "distance": pb.JOINT_KIND_DISTANCE,
                  "slider": pb.JOINT_KIND_SLIDER}
@@ -237,7 +238,7 @@ class WorldCalls:
             raise ArgumentError(f"kind: must be one of {', '.join(kinds)}, got {kind!r}", "joint")
         spec = pb.JointSpec(kind=kinds[kind], a=convert.ids(a, "a")[0],
                             b=convert.ids(b, "b")[0] if b else 0, length=float(length),
-                            collide_connected=bool(collide_connected))
+                            friction=float(friction), collide_connected=bool(collide_connected))
         convert.set_vec3(spec.anchor, anchor, "anchor")
         if anchor_b is not None:
             convert.set_vec3(spec.anchor_b, anchor_b, "anchor_b")

@@ -79,14 +79,19 @@ struct JointDef {
   JointSpring spring;
   // A ball's swing cone: the most b's axis may lean from a's (rad, in (0, pi]; pi: free).
   double max_swing = 3.141592653589793;
+  // The joint's own friction: the most torque (N m: ball, hinge) or force (N: slider) it gives
+  // against its free motion (a ball's whole relative turn, a hinge's angle, a slider's offset),
+  // as a zero-speed motor of that bound would; a joint held below it sticks. 0: none. Fixed and
+  // distance joints have none. Jolt's swing-twist friction torque, MuJoCo's frictionloss.
+  double friction = 0;
 };
 
 // What a joint does at the bodies' present poses: its free coordinate (JointLimit's comment;
 // 0 for fixed joints) and that coordinate's rate, and the reaction the joint gave over the last
 // step, on body b (a took the opposite): force (N) and torque about b's anchor (N m), world.
 // `effort` is the part along the free coordinate (N m or N), positive where it pushes the
-// coordinate up: motor, spring and limit together (a distance joint's: its ends pushed apart, so
-// a hanging rod reads negative).
+// coordinate up: motor, spring, friction and limit together (a distance joint's: its ends pushed
+// apart, so a hanging rod reads negative).
 struct JointReading {
   double position = 0;
   double speed = 0;
@@ -108,5 +113,6 @@ inline constexpr double kMaxJointForce = 1e20;
 Status validate(JointKind kind, const JointLimit& limit);
 Status validate(JointKind kind, const JointMotor& motor);
 Status validate(JointKind kind, const JointSpring& spring);
+Status validate_friction(JointKind kind, double friction);
 
 }  // namespace tumble
