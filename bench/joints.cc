@@ -2,7 +2,8 @@
 // from the world, its end R times heavier and pushed sideways at 1 m/s, swung 20 s: how far its
 // joints come apart (the largest gap between a link's end and the next link's, or the pivot, over
 // every step, read from the bodies' poses the same way for every engine) and the median step time;
-// then the standard chain:100 (released level, swinging clear of the ground) for step time alone.
+// then the standard chain:100 (released level, swinging clear of the ground) and the pile of eight
+// ragdolls (awake, without their joints' friction) for step time alone.
 // Ours with the direct solve of joint trees (auto) and with Gauss-Seidel joints (soft); Bullet 3.24
 // float and double, btPoint2PointConstraint, 10 sequential-impulse iterations. ODE and MuJoCo join
 // in the report's joints section (make report). Usage: bench_joints [seconds] (default 20).
@@ -119,5 +120,18 @@ int main(int argc, char** argv) {
         return scene;
       },
       steps, [](const Simulation&) { return 0.0; }, "chain100");
+  // The ragdoll pile awake, without its joints' friction (no peer adapter maps it).
+  std::printf("ragdolls:8 (standard scene, awake, no joint friction), %g s: step time\n", seconds);
+  each_engine(
+      [&](SolverKind solver) {
+        SceneDef scene = ragdolls_scene(8);
+        scene.world.solver.kind = solver;
+        scene.world.solver.sleeping = false;
+        scene.world.threads = 1;
+        for (SceneJoint& joint : scene.joints)
+          joint.def.friction = 0;
+        return scene;
+      },
+      steps, [](const Simulation&) { return 0.0; }, "ragdoll8");
   return 0;
 }
