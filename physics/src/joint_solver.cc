@@ -399,8 +399,9 @@ void set_rotation_rows(JointEquations& e, int first) {
   e.on_b.block<3, 3>(first, 3) = Mat3::Identity();
 }
 
-// Both: the rows at the present poses; `velocities` asks for the targets of a sweep (else the
-// targets are minus the errors).
+// Both: the rows at the present poses (kRows; else the targets alone); `velocities` asks for the
+// targets of a sweep (else the targets are minus the errors).
+template <bool kRows>
 JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bodies,
                             std::span<const Pose> poses, const JointTarget* velocities) {
   JointEquations e;
@@ -423,26 +424,26 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
   switch (joint.kind) {
     case JointKind::kBall:
       e.rows = 3;
-      set_point_rows(e, 0, anchors);
+      if constexpr (kRows) set_point_rows(e, 0, anchors);
       e.target.head<3>() = point_target();
       break;
     case JointKind::kFixed: {
       e.rows = 6;
-      set_point_rows(e, 0, anchors);
+      if constexpr (kRows) set_point_rows(e, 0, anchors);
       e.target.head<3>() = point_target();
-      set_rotation_rows(e, 3);
+      if constexpr (kRows) set_rotation_rows(e, 3);
       if (velocities == nullptr)
         e.target.tail<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
       break;
     }
     case JointKind::kHinge: {
       e.rows = 5;
-      set_point_rows(e, 0, anchors);
+      if constexpr (kRows) set_point_rows(e, 0, anchors);
       e.target.head<3>() = point_target();
       const HingeRows hinge = hinge_rows(joint, pose_a.orientation,
                                          world_b ? nullptr : &pose_b.orientation, Mat3::Zero());
-      set_row(e, 3, {Vec3::Zero(), -hinge.g1, hinge.g1});
-      set_row(e, 4, {Vec3::Zero(), -hinge.g2, hinge.g2});
+      if constexpr (kRows) set_row(e, 3, {Vec3::Zero(), -hinge.g1, hinge.g1});
+      if constexpr (kRows) set_row(e, 4, {Vec3::Zero(), -hinge.g2, hinge.g2});
       if (velocities == nullptr) {
         e.target.segment<2>(3) = -hinge.error();
       } else if (h > 0) {
@@ -461,10 +462,10 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
     }
     case JointKind::kSlider: {
       e.rows = 5;
-      set_rotation_rows(e, 0);
+      if constexpr (kRows) set_rotation_rows(e, 0);
       const SliderRows across = slider_rows(joint, pose_a, pose_b, world_b, a, b);
-      set_row(e, 3, across.rows[0]);
-      set_row(e, 4, across.rows[1]);
+      if constexpr (kRows) set_row(e, 3, across.rows[0]);
+      if constexpr (kRows) set_row(e, 4, across.rows[1]);
       if (velocities == nullptr) {
         e.target.head<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
         e.target.segment<2>(3) = -across.error;
@@ -478,7 +479,7 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
       if (!(length > 1e-12)) break;
       const Vec3 n = d / length;
       e.rows = 1;
-      set_row(e, 0, {n, -anchors.ra.cross(n), anchors.rb.cross(n)});
+      if constexpr (kRows) set_row(e, 0, {n, -anchors.ra.cross(n), anchors.rb.cross(n)});
       if (velocities == nullptr) {
         e.target[0] = joint.length - length;
       } else if (h > 0) {
@@ -495,7 +496,7 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
 
 JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
                                   std::span<const Pose> poses, const JointTarget& target) {
-  JointEquations e = equations_of(row, bodies, poses, &target);
+  JointEquations e = equations_of<true>(row, bodies, poses, &target);
   if (row.motor_in_tree && e.rows == 5) {
     // The motor's row: the free coordinate's rate is its speed.
     const bool world_b = row.b == kWorldAnchor;
@@ -510,6 +511,17 @@ JointEquations velocity_equations(const JointRow& row, std::span<const SolverBod
   return e;
 }
 
+JointEquations::Vector velocity_targets(const JointRow& row, std::span<const SolverBody> bodies,
+                                        std::span<const Pose> poses, const JointTarget& target) {
+  JointEquations e = equations_of<false>(row, bodies, poses, &target);
+  if (row.motor_in_tree && e.rows == 5) {
+    const bool world_b = row.b == kWorldAnchor;
+    if (free_coordinate(row.joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b).exists)
+      e.target[5] = row.joint.motor.speed;
+  }
+  return e.target;
+}
+
 bool motor_row(const JointRow& row, const JointEquations& equations) {
   return row.motor_in_tree && equations.rows == 6 &&
          (row.joint.kind == JointKind::kHinge || row.joint.kind == JointKind::kSlider);
@@ -517,7 +529,12 @@ bool motor_row(const JointRow& row, const JointEquations& equations) {
 
 JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
                                   std::span<const Pose> poses) {
-  return equations_of(row, bodies, poses, nullptr);
+  return equations_of<true>(row, bodies, poses, nullptr);
+}
+
+JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,
+                                        std::span<const Pose> poses) {
+  return equations_of<false>(row, bodies, poses, nullptr).target;
 }
 
 void add_equation_impulses(JointRow& row, const JointEquations& equations,

@@ -55,6 +55,7 @@ struct JointTarget {
 // or, for positions, minus each row's error. Rows beyond `rows` are zero. For the direct solve of
 // joint trees (joint_tree.h).
 struct JointEquations {
+  using Vector = Eigen::Matrix<double, 6, 1>;
   int rows = 0;
   Eigen::Matrix<double, 6, 6> on_a = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 6> on_b = Eigen::Matrix<double, 6, 6>::Zero();
@@ -63,11 +64,17 @@ struct JointEquations {
 // For velocities, with the sweep's target (a move ahead: the rates that end it on the joint).
 JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
                                   std::span<const Pose> poses, const JointTarget& target);
+// Their targets alone (what velocity_equations(...).target is), without building the rows.
+JointEquations::Vector velocity_targets(const JointRow& row, std::span<const SolverBody> bodies,
+                                        std::span<const Pose> poses, const JointTarget& target);
 // Whether the equations' last row is the joint's motor (JointRow::motor_in_tree).
 bool motor_row(const JointRow& row, const JointEquations& equations);
 // For positions: target = minus the error.
 JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
                                   std::span<const Pose> poses);
+// Their targets alone (position_equations(...).target).
+JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,
+                                        std::span<const Pose> poses);
 // Adds the equations' impulses (one per row, on b; a takes the opposite) to the joint's warm
 // start, in the same terms as the Gauss-Seidel rows keep them.
 void add_equation_impulses(JointRow& row, const JointEquations& equations,

@@ -39,6 +39,22 @@ Eigen::Matrix<double, 6, 6> inverse_of_definite(const Eigen::Matrix<double, 6, 6
 
 bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
                       std::span<const SolverBody> bodies, std::size_t body_count) {
+  // The same joints between the same bodies as the island built last (a steady scene, each step):
+  // the same forest; only what the step changed (the bodies' inertias, the motors) is refreshed.
+  shape_.clear();
+  for (std::uint32_t j : joints) {
+    const JointRow& row = rows[j];
+    shape_.push_back({j, row.a, row.b,
+                      static_cast<std::uint8_t>((holds_rows(row.joint) ? 1 : 0) |
+                                                (moves(bodies, row.a) ? 2 : 0) |
+                                                (moves(bodies, row.b) ? 4 : 0))});
+  }
+  if (built_ && shape_ == built_shape_ && node_of_body_.size() >= body_count) {
+    finish_build(rows, bodies);
+    return true;
+  }
+  built_ = false;
+  built_shape_ = shape_;
   for (std::uint32_t body : bodies_used_)
     node_of_body_[body] = kNone;
   bodies_used_.clear();
@@ -121,6 +137,7 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
     if (!visited_[node]) forest = visit_tree(node);
   if (!forest) {
     nodes_.clear();
+    built_shape_.clear();
     return false;
   }
   // Children before parents: the visit's order reversed. Nodes are renumbered in that order.
@@ -138,6 +155,12 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
   for (std::uint32_t body : bodies_used_)
     node_of_body_[body] = new_index[node_of_body_[body]];
   equations_.resize(n);
+  built_ = true;
+  finish_build(rows, bodies);
+  return true;
+}
+
+void JointTree::finish_build(std::span<const JointRow> rows, std::span<const SolverBody> bodies) {
   has_motors_ = false;
   for (Node& node : nodes_) {
     if (node.is_joint)
@@ -147,7 +170,6 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
   }
   velocities_factored_ = false;
   targets_taken_ = false;
-  return true;
 }
 
 // A chain's tension turns its links back into line, a stiffness (the constraint forces' change
@@ -405,7 +427,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     kept_targets_.resize(nodes_.size());
     for (std::size_t k = 0; k < nodes_.size(); ++k)
       if (nodes_[k].is_joint)
-        kept_targets_[k] = velocity_equations(rows[nodes_[k].index], bodies, poses, target).target;
+        kept_targets_[k] = velocity_targets(rows[nodes_[k].index], bodies, poses, target);
     take_second_targets(rows, bodies, poses, target, rates_of);
     targets_taken_ = true;
   }
@@ -475,7 +497,7 @@ void JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
   double first = 0, change = 0;
   for (std::size_t k = 0; k < n; ++k) {
     if (!nodes_[k].is_joint) continue;
-    second_targets_[k] = velocity_equations(rows[nodes_[k].index], bodies, poses, target).target;
+    second_targets_[k] = velocity_targets(rows[nodes_[k].index], bodies, poses, target);
     first = std::max(first, kept_targets_[k].lpNorm<Eigen::Infinity>());
     change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
   }
@@ -498,20 +520,16 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
     // Shared only where no body takes stiffness: a light link's stiffness as mass in the position
     // passes shifted its corrections onto the heavy end, and a chain of beads under a million
     // times heavier end tore.
-    const bool for_velocities =
-        velocity_substep > 0 && !has_motors_ &&
-        !set_geometric_stiffness(rows, bodies, poses, velocity_substep);
+    const bool for_velocities = velocity_substep > 0 && !has_motors_ &&
+                                !set_geometric_stiffness(rows, bodies, poses, velocity_substep);
     velocities_factored_ = for_velocities;
     if (for_velocities) stiffened_ = false;
-    factor(rows, bodies, false, [&](std::size_t k) {
-      equations_[k] = position_equations(rows[nodes_[k].index], bodies, poses);
-      return equations_[k];
-    });
+    factor(rows, bodies, false,
+           [&](std::size_t k) { return position_equations(rows[nodes_[k].index], bodies, poses); });
     solve(bodies, false, [&](std::size_t k) { return equations_[k].target; });
   } else {
-    solve(bodies, false, [&](std::size_t k) {
-      return position_equations(rows[nodes_[k].index], bodies, poses).target;
-    });
+    solve(bodies, false,
+          [&](std::size_t k) { return position_targets(rows[nodes_[k].index], bodies, poses); });
   }
   for (const Node& node : nodes_)
     if (!node.rhs.allFinite()) return;

@@ -97,6 +97,18 @@ class JointTree {
   bool set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                                std::span<const Pose> poses, double h);
 
+  // What a forest is built from: each joint's row, its bodies, and whether it holds rows and
+  // each body moves.
+  struct JointEnds {
+    std::uint32_t row, a, b;
+    std::uint8_t flags;
+    bool operator==(const JointEnds&) const = default;
+  };
+  // The step's refresh of a forest built (or kept): inertias, motors, factors forgotten.
+  void finish_build(std::span<const JointRow> rows, std::span<const SolverBody> bodies);
+
+  std::vector<JointEnds> shape_, built_shape_;  // this build's, and the forest's in nodes_
+  bool built_ = false;
   std::vector<Node> nodes_;                  // children before their parents
   std::vector<std::uint32_t> node_of_body_;  // by solver index: kNone if none
   std::vector<std::uint32_t> bodies_used_;   // solver indices whose node_of_body_ is set
@@ -107,8 +119,8 @@ class JointTree {
   std::vector<Eigen::Matrix<double, 6, 1>> second_targets_, held_velocities_;
   bool velocities_factored_ = false;  // since the last move
   bool stiffened_ = false;
-  bool has_motors_ = false;           // a joint with a motor: its row joins the velocity system
-  bool targets_taken_ = false;        // since the last move
+  bool has_motors_ = false;     // a joint with a motor: its row joins the velocity system
+  bool targets_taken_ = false;  // since the last move
   // For building: each node's neighbours and the visit.
   std::vector<std::uint32_t> first_edge_, next_edge_, edge_to_, pending_, parent_of_, order_;
   std::vector<std::uint8_t> visited_;
