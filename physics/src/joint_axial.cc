@@ -85,6 +85,12 @@ bool has_axial_rows(const Joint& joint) {
          joint.friction > 0;
 }
 
+double impulse_along(const Joint& joint) {
+  if (rigid_distance(joint)) return joint.axial_impulse;
+  return joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +
+         (coordinate_friction(joint) ? joint.friction_impulse.x() : 0.0);
+}
+
 void warm_start_axial(const JointRow& row, JointBodies& j) {
   const Joint& joint = row.joint;
   if (has_cone(joint) && joint.swing_impulse != 0) {
@@ -92,8 +98,8 @@ void warm_start_axial(const JointRow& row, JointBodies& j) {
     if (swing.exists) apply_row(j, negated(swing.row), joint.swing_impulse);
   }
   if (turn_friction(joint)) apply_angular(j, joint.friction_impulse);
-  const double along = joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +
-                       (coordinate_friction(joint) ? joint.friction_impulse.x() : 0.0);
+  // A rigid rod's own impulse is warm-started with the joint's rows (joint_solver.cc).
+  const double along = rigid_distance(joint) ? 0.0 : impulse_along(joint);
   if (along == 0) return;
   const FreeCoordinate c = free_coordinate(joint, j.pose_a, j.pose_b, j.world_b());
   if (c.exists) apply_row(j, c.row, along);
@@ -206,11 +212,7 @@ JointReading read_axial(const Joint& joint, const Pose& pose_a, const Pose& pose
   reading.position = c.position;
   reading.speed = row_rate(c.row, a, b);
   if (joint.impulse_time > 0) {
-    const double along = rigid_distance(joint)
-                             ? joint.axial_impulse
-                             : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +
-                                   (coordinate_friction(joint) ? joint.friction_impulse.x() : 0.0);
-    reading.effort = along / joint.impulse_time;
+    reading.effort = impulse_along(joint) / joint.impulse_time;
   }
   return reading;
 }

@@ -14,6 +14,10 @@ namespace tumble {
 // Whether the joint has any of these rows (a spring, motor, limit or cone).
 bool has_axial_rows(const Joint& joint);
 
+// The impulse the rows above gave along the free coordinate (limit, motor, spring, a hinge's or
+// slider's friction); a rigid rod's, along it.
+double impulse_along(const Joint& joint);
+
 // Applies the free coordinate's rows' impulses from the last step: the warm start.
 void warm_start_axial(const JointRow& row, joint_detail::JointBodies& j);
 

@@ -322,11 +322,7 @@ JointReading read_joint(const Joint& joint, const Pose& pose_a, const Pose& pose
   const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
   Vec3 linear = joint.linear_impulse, angular = joint.angular_impulse;
   if (c.exists) {
-    const double along =
-        rigid_distance(joint)
-            ? joint.axial_impulse
-            : joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +
-                  (joint.kind != JointKind::kBall ? joint.friction_impulse.x() : 0);
+    const double along = impulse_along(joint);
     linear += along * c.row.linear;
     if (c.row.linear.isZero()) angular += along * c.row.angular_b;
   }
