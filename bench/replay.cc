@@ -10,6 +10,7 @@
 //   STEPS    steps per round from that state (default 10)
 //   ROUNDS   rounds (default 5)
 //   THREADS  step threads (default 1)
+// TUMBLE_SOLVER=exact|pgs|soft|auto in the environment replaces the scene's solver.
 // Sleeping is off, so the whole scene is awake. Each round restores the state, takes two untimed
 // steps (the restored world's buffers warm up) and times STEPS more. Prints the mean time per step
 // of each stage per round, then each stage's minimum and median over the rounds, and the state's
@@ -23,6 +24,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,6 +81,15 @@ int main(int argc, char** argv) {
     return 2;
   }
   scene.value().world.threads = threads;
+  if (const char* solver = std::getenv("TUMBLE_SOLVER")) {
+    const std::optional<SolverKind> kind = solver_from_name(solver);
+    if (!kind) {
+      std::fprintf(stderr, "bench_replay: TUMBLE_SOLVER=%s is no solver (exact, pgs, soft, auto)\n",
+                   solver);
+      return 2;
+    }
+    scene.value().world.solver.kind = *kind;
+  }
   scene.value().world.solver.sleeping = false;
   const double dt = scene.value().dt;
   Result<World> made = make_world(scene.value());

@@ -6,17 +6,10 @@
 #include <vector>
 
 namespace tumble {
-namespace {
+namespace exact_detail {
 
-// One velocity constraint J v on two bodies, with A J^T (A = the inverse mass matrix) beside it.
-struct Jacobian {
-  std::uint32_t body[2];
-  Eigen::Matrix<double, 6, 1> j[2];
-  Eigen::Matrix<double, 6, 1> aj[2];
-};
-
-Jacobian make_jacobian(const ContactRow& row, const ContactRowCold& cold, const Vec3& direction,
-                       std::span<const SolverBody> bodies) {
+Jacobian contact_jacobian(const ContactRow& row, const ContactRowCold& cold, const Vec3& direction,
+                          std::span<const SolverBody> bodies) {
   Jacobian out;
   out.body[0] = row.a;
   out.body[1] = row.b;
@@ -29,175 +22,53 @@ Jacobian make_jacobian(const ContactRow& row, const ContactRowCold& cold, const 
   return out;
 }
 
-double coupling(const Jacobian& r, const Jacobian& c, std::span<const SolverBody> bodies) {
-  double sum = 0;
-  for (int s = 0; s < 2; ++s) {
-    if (bodies[r.body[s]].inverse_mass == 0) continue;
-    for (int t = 0; t < 2; ++t)
-      if (r.body[s] == c.body[t]) sum += r.j[s].dot(c.aj[t]);
-  }
-  return sum;
-}
-
 double velocity_along(const Jacobian& jac, std::span<const SolverBody> bodies) {
   double v = 0;
   for (int s = 0; s < 2; ++s) {
+    if (jac.body[s] == kWorldAnchor) continue;
     const SolverBody& body = bodies[jac.body[s]];
     v += jac.j[s].head<3>().dot(body.v) + jac.j[s].tail<3>().dot(body.w);
   }
   return v;
 }
 
-// The LCP's memory, one per thread (islands are solved on any thread), reused from island to
-// island and step to step.
-struct ExactWorkspace {
-  std::vector<Jacobian> jacobians;
-  std::vector<double> m, q, z, w, diagonal;
-  std::vector<double> push_m, push_q, push_z;
-  std::vector<double> refined_q, refined_z;
-  LemkeWorkspace lemke;
-};
-
-ExactWorkspace& thread_workspace() {
-  thread_local ExactWorkspace workspace;
-  return workspace;
-}
-
-// Moves the island's bodies out of penetration without giving them velocity (split impulse,
-// Catto 2006; Bullet's "split impulse"): the normal rows once more, as their own LCP, with the
-// velocities the solve left and a target separating speed for penetration beyond the slop;
-// the answer is a pseudo-velocity that only the position update sees. Solved exactly, so a
-// 1 kg box is pushed out from under 1000 kg as surely as the velocities are.
-bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
-              std::span<SolverBody> bodies, const Eigen::Ref<const Eigen::MatrixXd>& m,
-              const SolverSettings& settings, double h, ExactWorkspace& workspace,
-              ExactSolveResult* result) {
-  const int points = static_cast<int>(ids.size());
-  workspace.push_q.resize(points);
-  Eigen::Map<Eigen::VectorXd> q(workspace.push_q.data(), points);
-  bool any = false;
-  for (int p = 0; p < points; ++p) {
-    const ContactRow& row = rows[ids[p]];
-    q[p] = velocity_along(workspace.jacobians[p], bodies);
-    if (row.separation > 0) {
-      q[p] += row.separation / h;
-    } else if (row.separation + settings.slop < 0) {
-      q[p] -= std::min(settings.baumgarte * -(row.separation + settings.slop) / h,
-                       settings.max_push_velocity);
-    }
-    any |= q[p] < 0;
-  }
-  if (!any) return true;
-  workspace.push_m.resize(static_cast<std::size_t>(points) * points);
-  workspace.push_z.resize(points);
-  Eigen::Map<Eigen::MatrixXd> mp(workspace.push_m.data(), points, points);
-  Eigen::Map<Eigen::VectorXd> z(workspace.push_z.data(), points);
-  mp = m.topLeftCorner(points, points);
-  const LemkeResult lemke = solve_lcp_lemke(
-      mp, q, std::max(100, settings.lemke_pivots_per_unknown * points), z, &workspace.lemke);
-  result->lemke.pivots += lemke.pivots;
-  if (lemke.outcome != LemkeOutcome::kSolved || !z.allFinite()) return false;
-  const double error =
-      exact_velocity_error(mp, std::span(workspace.diagonal).first(points), q, z, points);
-  if (!(error <= settings.exact_velocity_tolerance)) return false;
-  for (int p = 0; p < points; ++p) {
-    if (z[p] == 0) continue;
-    const Jacobian& jac = workspace.jacobians[p];
-    for (int s = 0; s < 2; ++s) {
-      SolverBody& body = bodies[jac.body[s]];
-      if (body.inverse_mass == 0) continue;
-      body.push_v += z[p] * jac.aj[s].head<3>();
-      body.push_w += z[p] * jac.aj[s].tail<3>();
-    }
-  }
-  return true;
-}
-
-}  // namespace
-
-double exact_velocity_error(const Eigen::Ref<const Eigen::MatrixXd>& m,
-                            std::span<const double> diagonal,
-                            const Eigen::Ref<const Eigen::VectorXd>& q,
-                            const Eigen::Ref<const Eigen::VectorXd>& z, int velocity_rows) {
-  const Eigen::Index n = q.size();
-  double worst = 0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    double w = m.row(i).dot(z) + q[i];
-    if (i < velocity_rows) {
-      // The velocity of the problem without the regularisation: the compliance that keeps the
-      // pivots well defined must not hide a wrong velocity either.
-      w -= (m(i, i) - diagonal[i]) * z[i];
-      worst = std::max({worst, -w, std::min(w, z[i] * diagonal[i])});
-    } else {
-      // A friction-cone row, in N s: mu cn - sum b >= 0 against the sliding speed z[i], m/s. The
-      // impulse is made a velocity by the stiffness of the point's normal row.
-      const Eigen::Index point = (i - velocity_rows);
-      const double stiffness = diagonal[point];
-      worst = std::max({worst, -w * stiffness, std::min(w * stiffness, z[i])});
-    }
-  }
-  return worst;
-}
-
-ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
-                                      std::span<const ContactRowCold> cold,
-                                      std::span<const std::uint32_t> ids,
-                                      std::span<SolverBody> bodies, const SolverSettings& settings,
-                                      double h) {
-  const int points = static_cast<int>(ids.size());
+Layout layout_of(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids, int bounds,
+                 const SolverSettings& settings) {
   bool any_friction = false;
   for (std::uint32_t id : ids)
     any_friction |= rows[id].friction > 0;
+  Layout layout;
+  layout.points = static_cast<int>(ids.size());
+  layout.bounds = bounds;
   // Frictionless islands need no tangent rows at all.
-  const int k = any_friction ? std::clamp(settings.friction_directions, 4, 32) : 0;
-  const int velocity_rows = points * (1 + k);
-  const int n = velocity_rows + (k > 0 ? points : 0);
+  layout.k = any_friction ? std::clamp(settings.friction_directions, 4, 32) : 0;
+  return layout;
+}
 
-  // Velocity rows: the normals first, then each point's k directions.
-  ExactWorkspace& workspace = thread_workspace();
-  std::vector<Jacobian>& jac = workspace.jacobians;
-  jac.clear();
-  for (std::uint32_t id : ids)
-    jac.push_back(make_jacobian(rows[id], cold[id], rows[id].normal, bodies));
-  for (std::uint32_t id : ids) {
-    const ContactRow& row = rows[id];
-    for (int j = 0; j < k; ++j) {
-      const double angle = 2 * std::numbers::pi * j / k;
-      const Vec3 d = std::cos(angle) * row.tangent1 + std::sin(angle) * row.tangent2;
-      jac.push_back(make_jacobian(row, cold[id], d, bodies));
-    }
-  }
+Vec3 friction_direction(const ContactRow& row, int j, int k) {
+  const double angle = 2 * std::numbers::pi * j / k;
+  return std::cos(angle) * row.tangent1 + std::sin(angle) * row.tangent2;
+}
 
-  workspace.m.resize(static_cast<std::size_t>(n) * n);
-  workspace.q.resize(n);
-  workspace.z.resize(n);
-  workspace.w.resize(n);
+Workspace& thread_workspace() {
+  thread_local Workspace workspace;
+  return workspace;
+}
+
+ExactSolveResult solve_problem(const Layout& layout, std::span<const ContactRow> rows,
+                               std::span<const std::uint32_t> ids, const SolverSettings& settings,
+                               Workspace& workspace) {
+  const int n = layout.size(), velocity_rows = layout.velocity_rows(), points = layout.points;
+  const int k = layout.k;
   Eigen::Map<Eigen::MatrixXd> m(workspace.m.data(), n, n);
   Eigen::Map<Eigen::VectorXd> q(workspace.q.data(), n);
   Eigen::Map<Eigen::VectorXd> z(workspace.z.data(), n);
-  Eigen::Map<Eigen::VectorXd> w(workspace.w.data(), n);
-  m.setZero();
-  q.setZero();
-  for (int r = 0; r < velocity_rows; ++r) {
-    for (int c = r; c < velocity_rows; ++c) {
-      const double value = coupling(jac[r], jac[c], bodies);
-      m(r, c) = value;
-      m(c, r) = value;
-    }
-    q[r] = velocity_along(jac[r], bodies);
-  }
-  // A gap may close within the step, no more (the speculative contact). Penetration is not
-  // pushed out here: a push velocity would stay in the bodies (two boxes spawned overlapping
-  // would fly apart); push_out below moves them instead.
-  for (int p = 0; p < points; ++p)
-    if (rows[ids[p]].separation > 0) q[p] += rows[ids[p]].separation / h;
   if (k > 0) {
     const int lambda0 = velocity_rows;
     for (int p = 0; p < points; ++p) {
-      const int first = points + p * k;
       for (int j = 0; j < k; ++j) {
-        m(first + j, lambda0 + p) = 1;
-        m(lambda0 + p, first + j) = -1;
+        m(layout.tangent(p, j), lambda0 + p) = 1;
+        m(lambda0 + p, layout.tangent(p, j)) = -1;
       }
       m(lambda0 + p, p) = rows[ids[p]].friction;
     }
@@ -263,10 +134,156 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
     if (!(result.velocity_error <= settings.exact_velocity_tolerance))
       result.lemke.outcome = LemkeOutcome::kInaccurate;
   }
-  if (!result.solved() || !z.allFinite()) {
-    if (result.solved()) result.lemke.outcome = LemkeOutcome::kNotFinite;
-    return result;
+  if (result.solved() && !z.allFinite()) result.lemke.outcome = LemkeOutcome::kNotFinite;
+  return result;
+}
+
+void store_contact_impulses(const Layout& layout, std::span<ContactRow> rows,
+                            std::span<const std::uint32_t> ids,
+                            const Eigen::Ref<const Eigen::VectorXd>& z) {
+  for (int p = 0; p < layout.points; ++p) {
+    ContactRow& row = rows[ids[p]];
+    row.normal_impulse = z[p];
+    row.max_normal_impulse = z[p];
+    double t1 = 0, t2 = 0;
+    for (int j = 0; j < layout.k; ++j) {
+      const double angle = 2 * std::numbers::pi * j / layout.k;
+      t1 += z[layout.tangent(p, j)] * std::cos(angle);
+      t2 += z[layout.tangent(p, j)] * std::sin(angle);
+    }
+    row.tangent_impulse1 = t1;
+    row.tangent_impulse2 = t2;
   }
+}
+
+// Moves the island's bodies out of penetration without giving them velocity (split impulse,
+// Catto 2006; Bullet's "split impulse"): the normal rows once more, as their own LCP, with the
+// velocities the solve left and a target separating speed for penetration beyond the slop;
+// the answer is a pseudo-velocity that only the position update sees. Solved exactly, so a
+// 1 kg box is pushed out from under 1000 kg as surely as the velocities are.
+bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
+              bool substep_gaps, std::span<const SolverBody> bodies,
+              const SolverSettings& settings, double h, Workspace& workspace,
+              ExactSolveResult* result) {
+  const int points = static_cast<int>(ids.size());
+  const Eigen::Index n = static_cast<Eigen::Index>(workspace.q.size());
+  const Eigen::Map<const Eigen::MatrixXd> m(workspace.m.data(), n, n);
+  workspace.push_q.resize(points);
+  workspace.push_z.assign(points, 0.0);
+  Eigen::Map<Eigen::VectorXd> q(workspace.push_q.data(), points);
+  bool any = false;
+  for (int p = 0; p < points; ++p) {
+    const ContactRow& row = rows[ids[p]];
+    const double separation = substep_gaps ? row.substep_separation : row.separation;
+    q[p] = velocity_along(workspace.jacobians[p], bodies);
+    if (separation > 0) {
+      q[p] += separation / h;
+    } else if (separation + settings.slop < 0) {
+      q[p] -= std::min(settings.baumgarte * -(separation + settings.slop) / h,
+                       settings.max_push_velocity);
+    }
+    any |= q[p] < 0;
+  }
+  if (!any) return true;
+  workspace.push_m.resize(static_cast<std::size_t>(points) * points);
+  Eigen::Map<Eigen::MatrixXd> mp(workspace.push_m.data(), points, points);
+  Eigen::Map<Eigen::VectorXd> z(workspace.push_z.data(), points);
+  mp = m.topLeftCorner(points, points);
+  const LemkeResult lemke = solve_lcp_lemke(
+      mp, q, std::max(100, settings.lemke_pivots_per_unknown * points), z, &workspace.lemke);
+  result->lemke.pivots += lemke.pivots;
+  if (lemke.outcome != LemkeOutcome::kSolved || !z.allFinite()) return false;
+  const double error =
+      exact_velocity_error(mp, std::span(workspace.diagonal).first(points), q, z, points);
+  return error <= settings.exact_velocity_tolerance;
+}
+
+}  // namespace exact_detail
+
+namespace {
+
+using namespace exact_detail;
+
+double coupling(const Jacobian& r, const Jacobian& c, std::span<const SolverBody> bodies) {
+  double sum = 0;
+  for (int s = 0; s < 2; ++s) {
+    if (bodies[r.body[s]].inverse_mass == 0) continue;
+    for (int t = 0; t < 2; ++t)
+      if (r.body[s] == c.body[t]) sum += r.j[s].dot(c.aj[t]);
+  }
+  return sum;
+}
+
+}  // namespace
+
+double exact_velocity_error(const Eigen::Ref<const Eigen::MatrixXd>& m,
+                            std::span<const double> diagonal,
+                            const Eigen::Ref<const Eigen::VectorXd>& q,
+                            const Eigen::Ref<const Eigen::VectorXd>& z, int velocity_rows) {
+  const Eigen::Index n = q.size();
+  double worst = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double w = m.row(i).dot(z) + q[i];
+    if (i < velocity_rows) {
+      // The velocity of the problem without the regularisation: the compliance that keeps the
+      // pivots well defined must not hide a wrong velocity either.
+      w -= (m(i, i) - diagonal[i]) * z[i];
+      worst = std::max({worst, -w, std::min(w, z[i] * diagonal[i])});
+    } else {
+      // A friction-cone row, in N s: mu cn - sum b >= 0 against the sliding speed z[i], m/s. The
+      // impulse is made a velocity by the stiffness of the point's normal row.
+      const Eigen::Index point = (i - velocity_rows);
+      const double stiffness = diagonal[point];
+      worst = std::max({worst, -w * stiffness, std::min(w * stiffness, z[i])});
+    }
+  }
+  return worst;
+}
+
+ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
+                                      std::span<const ContactRowCold> cold,
+                                      std::span<const std::uint32_t> ids,
+                                      std::span<SolverBody> bodies, const SolverSettings& settings,
+                                      double h) {
+  const Layout layout = layout_of(rows, ids, 0, settings);
+  const int points = layout.points, k = layout.k;
+  const int velocity_rows = layout.velocity_rows(), n = layout.size();
+
+  // Velocity rows: the normals first, then each point's k directions.
+  Workspace& workspace = thread_workspace();
+  std::vector<Jacobian>& jac = workspace.jacobians;
+  jac.clear();
+  for (std::uint32_t id : ids)
+    jac.push_back(contact_jacobian(rows[id], cold[id], rows[id].normal, bodies));
+  for (std::uint32_t id : ids)
+    for (int j = 0; j < k; ++j)
+      jac.push_back(contact_jacobian(rows[id], cold[id], friction_direction(rows[id], j, k), bodies));
+
+  workspace.m.resize(static_cast<std::size_t>(n) * n);
+  workspace.q.resize(n);
+  workspace.z.resize(n);
+  workspace.w.resize(n);
+  Eigen::Map<Eigen::MatrixXd> m(workspace.m.data(), n, n);
+  Eigen::Map<Eigen::VectorXd> q(workspace.q.data(), n);
+  Eigen::Map<Eigen::VectorXd> z(workspace.z.data(), n);
+  m.setZero();
+  q.setZero();
+  for (int r = 0; r < velocity_rows; ++r) {
+    for (int c = r; c < velocity_rows; ++c) {
+      const double value = coupling(jac[r], jac[c], bodies);
+      m(r, c) = value;
+      m(c, r) = value;
+    }
+    q[r] = velocity_along(jac[r], bodies);
+  }
+  // A gap may close within the step, no more (the speculative contact). Penetration is not
+  // pushed out here: a push velocity would stay in the bodies (two boxes spawned overlapping
+  // would fly apart); push_out below moves them instead.
+  for (int p = 0; p < points; ++p)
+    if (rows[ids[p]].separation > 0) q[p] += rows[ids[p]].separation / h;
+
+  ExactSolveResult result = solve_problem(layout, rows, ids, settings, workspace);
+  if (!result.solved()) return result;
 
   for (int r = 0; r < velocity_rows; ++r) {
     if (z[r] == 0) continue;
@@ -277,20 +294,19 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
       body.w += z[r] * jac[r].aj[s].tail<3>();
     }
   }
+  store_contact_impulses(layout, rows, ids, z);
+  result.pushed_out = push_out(rows, ids, false, bodies, settings, h, workspace, &result);
+  if (!result.pushed_out) return result;
   for (int p = 0; p < points; ++p) {
-    ContactRow& row = rows[ids[p]];
-    row.normal_impulse = z[p];
-    row.max_normal_impulse = z[p];
-    double t1 = 0, t2 = 0;
-    for (int j = 0; j < k; ++j) {
-      const double angle = 2 * std::numbers::pi * j / k;
-      t1 += z[points + p * k + j] * std::cos(angle);
-      t2 += z[points + p * k + j] * std::sin(angle);
+    const double push = workspace.push_z[p];
+    if (push == 0) continue;
+    for (int s = 0; s < 2; ++s) {
+      SolverBody& body = bodies[jac[p].body[s]];
+      if (body.inverse_mass == 0) continue;
+      body.push_v += push * jac[p].aj[s].head<3>();
+      body.push_w += push * jac[p].aj[s].tail<3>();
     }
-    row.tangent_impulse1 = t1;
-    row.tangent_impulse2 = t2;
   }
-  result.pushed_out = push_out(rows, ids, bodies, m, settings, h, workspace, &result);
   return result;
 }
 

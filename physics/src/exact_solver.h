@@ -12,8 +12,10 @@
 #pragma once
 
 #include <span>
+#include <vector>
 
 #include "contact_solver.h"
+#include "joint_state.h"
 #include "lemke.h"
 
 namespace tumble {
@@ -48,5 +50,68 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
                                       std::span<const std::uint32_t> ids,
                                       std::span<SolverBody> bodies, const SolverSettings& settings,
                                       double h);
+
+// What the exact solve of an island with joints (exact_joints.h) shares with the contacts' own.
+namespace exact_detail {
+
+// One velocity row J v on two bodies (b: kWorldAnchor for a joint's limit against the world),
+// with A J^T beside it (A: the inverse mass matrix).
+struct Jacobian {
+  std::uint32_t body[2];
+  Eigen::Matrix<double, 6, 1> j[2];
+  Eigen::Matrix<double, 6, 1> aj[2];
+};
+Jacobian contact_jacobian(const ContactRow& row, const ContactRowCold& cold, const Vec3& direction,
+                          std::span<const SolverBody> bodies);
+double velocity_along(const Jacobian& jac, std::span<const SolverBody> bodies);
+
+// The unknowns, in order: the velocity rows (each point's normal, then `bounds` one-sided rows of
+// the joints, then each point's k friction directions), then each point's sliding speed.
+struct Layout {
+  int points = 0, bounds = 0, k = 0;
+  int velocity_rows() const { return points + bounds + points * k; }
+  int size() const { return velocity_rows() + (k > 0 ? points : 0); }
+  int tangent(int point, int j) const { return points + bounds + point * k + j; }
+};
+// k: none for a frictionless island, else the settings' count.
+Layout layout_of(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids, int bounds,
+                 const SolverSettings& settings);
+// A point's friction direction j of k (the polygon's vertex directions).
+Vec3 friction_direction(const ContactRow& row, int j, int k);
+
+// The LCP's memory, one per thread (islands are solved on any thread), reused from island to
+// island and step to step.
+struct Workspace {
+  std::vector<Jacobian> jacobians;
+  std::vector<double> m, q, z, w, diagonal;
+  std::vector<double> push_m, push_q, push_z;
+  std::vector<double> refined_q, refined_z;
+  LemkeWorkspace lemke;
+};
+Workspace& thread_workspace();
+
+// With the velocity block of m and q filled (q: the rows' velocities and the gaps' closing): the
+// friction cones' rows, the compliance and perturbation that keep Lemke's pivots well defined,
+// Lemke, the refinement and the check of the answer in velocities. The answer is in
+// workspace.z; solved() says whether it may be used.
+ExactSolveResult solve_problem(const Layout& layout, std::span<const ContactRow> rows,
+                               std::span<const std::uint32_t> ids, const SolverSettings& settings,
+                               Workspace& workspace);
+// The answer's impulses kept in the contact rows (normal and tangent).
+void store_contact_impulses(const Layout& layout, std::span<ContactRow> rows,
+                            std::span<const std::uint32_t> ids,
+                            const Eigen::Ref<const Eigen::VectorXd>& z);
+
+// The push-out LCP over the normal rows (the block of m the solve used), with the bodies'
+// velocities after the solve, each point's gap its separation (at the step's start, or the
+// substep's with `substep_gaps`). Its answer, the normal rows' pseudo-impulses, is left in
+// workspace.push_z (all 0 where nothing needed pushing) for the caller to give the bodies. False
+// when it found none (penetration is then left to position correction).
+bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
+              bool substep_gaps, std::span<const SolverBody> bodies,
+              const SolverSettings& settings, double h, Workspace& workspace,
+              ExactSolveResult* result);
+
+}  // namespace exact_detail
 
 }  // namespace tumble
