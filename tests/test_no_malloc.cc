@@ -9,6 +9,7 @@
 #include <cstddef>
 
 #include "scene_runner.h"
+#include "scenes/standard.h"
 
 extern "C" {
 void* __libc_malloc(std::size_t);
@@ -104,6 +105,22 @@ TEST(NoMalloc, TwoThreadStepsOfALandedPileCallNoAllocator) {
   SceneDef pile = pile_scene(1000);
   pile.world.solver.sleeping = false;
   EXPECT_EQ(allocations_in_steps(pile, 20, 2, 150), 0);
+}
+
+// Jointed islands: the direct solve of a double pendulum and of an arm on its motors (auto),
+// ragdolls in a pile on the ground (auto: the tree with soft contacts), and a ragdoll whose
+// contacts, limits and cones are one LCP (exact, exact_joints.h; Lemke's pivots allocated until
+// its column was taken in two steps).
+TEST(NoMalloc, JointedStepsCallNoAllocator) {
+  for (const char* name : {"double-pendulum", "arm", "ragdolls:4"}) {
+    SceneDef scene = standard_scene(name).value();
+    scene.world.solver.sleeping = false;
+    EXPECT_EQ(allocations_in_steps(scene, 30, 1, 240), 0) << name;
+  }
+  SceneDef ragdoll = standard_scene("ragdolls:1").value();
+  ragdoll.world.solver.sleeping = false;
+  ragdoll.world.solver.kind = SolverKind::kExact;
+  EXPECT_EQ(allocations_in_steps(ragdoll, 30, 1, 240), 0);
 }
 
 }  // namespace

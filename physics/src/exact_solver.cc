@@ -162,9 +162,8 @@ void store_contact_impulses(const Layout& layout, std::span<ContactRow> rows,
 // the answer is a pseudo-velocity that only the position update sees. Solved exactly, so a
 // 1 kg box is pushed out from under 1000 kg as surely as the velocities are.
 bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
-              bool substep_gaps, std::span<const SolverBody> bodies,
-              const SolverSettings& settings, double h, Workspace& workspace,
-              ExactSolveResult* result) {
+              bool substep_gaps, std::span<const SolverBody> bodies, const SolverSettings& settings,
+              double h, Workspace& workspace, ExactSolveResult* result) {
   const int points = static_cast<int>(ids.size());
   const Eigen::Index n = static_cast<Eigen::Index>(workspace.q.size());
   const Eigen::Map<const Eigen::MatrixXd> m(workspace.m.data(), n, n);
@@ -257,7 +256,8 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
     jac.push_back(contact_jacobian(rows[id], cold[id], rows[id].normal, bodies));
   for (std::uint32_t id : ids)
     for (int j = 0; j < k; ++j)
-      jac.push_back(contact_jacobian(rows[id], cold[id], friction_direction(rows[id], j, k), bodies));
+      jac.push_back(
+          contact_jacobian(rows[id], cold[id], friction_direction(rows[id], j, k), bodies));
 
   workspace.m.resize(static_cast<std::size_t>(n) * n);
   workspace.q.resize(n);

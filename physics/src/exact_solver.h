@@ -108,9 +108,8 @@ void store_contact_impulses(const Layout& layout, std::span<ContactRow> rows,
 // workspace.push_z (all 0 where nothing needed pushing) for the caller to give the bodies. False
 // when it found none (penetration is then left to position correction).
 bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
-              bool substep_gaps, std::span<const SolverBody> bodies,
-              const SolverSettings& settings, double h, Workspace& workspace,
-              ExactSolveResult* result);
+              bool substep_gaps, std::span<const SolverBody> bodies, const SolverSettings& settings,
+              double h, Workspace& workspace, ExactSolveResult* result);
 
 }  // namespace exact_detail
 

@@ -105,7 +105,7 @@ void warm_start_axial(const JointRow& row, JointBodies& j) {
   if (c.exists) apply_row(j, c.row, along);
 }
 
-double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
+double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target, bool bounds) {
   Joint& joint = row.joint;
   const SolverBody& b = j.body_b();
   const double h = target.substep;
@@ -151,7 +151,9 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
       change = std::max(change, std::abs(applied) * mass);
     }
     if (joint.limit.enabled) {
-      if (joint.limit.lower == joint.limit.upper) {
+      if (!bounds && joint.limit.lower != joint.limit.upper) {
+        // Held by the exact solver's LCP (bound_rows).
+      } else if (joint.limit.lower == joint.limit.upper) {
         // Locked: an equality, its error closed by the position passes.
         const double impulse = -row_rate(c.row, *j.a, b) / mass;
         joint.limit_impulse += impulse;
@@ -170,7 +172,7 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
     }
   }
   if (turn_friction(joint)) change = std::max(change, solve_turn_friction(j, joint, h));
-  if (has_cone(joint)) {
+  if (bounds && has_cone(joint)) {
     const Swing swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
     const double cone_mass = swing.exists ? row_mass(swing.row, *j.a, b) : 0;
     if (cone_mass > 0)
@@ -179,6 +181,47 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target) {
                                        joint.max_swing - swing.angle, h, &joint.swing_impulse));
   }
   return change;
+}
+
+int bound_row_count(const Joint& joint) {
+  const bool ranged_limit = joint.limit.enabled && joint.limit.lower < joint.limit.upper;
+  return (ranged_limit ? 1 : 0) + (has_cone(joint) ? 1 : 0);
+}
+
+int bound_rows(const Joint& joint, const Pose& pose_a, const Pose& pose_b, bool world_b,
+               BoundRow out[2]) {
+  int count = 0;
+  if (joint.limit.enabled && joint.limit.lower < joint.limit.upper) {
+    const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
+    if (c.exists) {
+      // Nearer the lower bound: the impulse pushes the coordinate up.
+      if (c.position - joint.limit.lower < joint.limit.upper - c.position)
+        out[count++] = {c.row, c.position - joint.limit.lower, BoundRow::Side::kLower};
+      else
+        out[count++] = {negated(c.row), joint.limit.upper - c.position, BoundRow::Side::kUpper};
+    }
+  }
+  if (has_cone(joint)) {
+    const Swing swing =
+        swing_of(joint, pose_a.orientation, world_b ? Quat::Identity() : pose_b.orientation);
+    if (swing.exists)
+      out[count++] = {negated(swing.row), joint.max_swing - swing.angle, BoundRow::Side::kCone};
+  }
+  return count;
+}
+
+void keep_bound_impulse(Joint& joint, BoundRow::Side side, double impulse) {
+  switch (side) {
+    case BoundRow::Side::kLower:
+      joint.limit_impulse = impulse;
+      break;
+    case BoundRow::Side::kUpper:
+      joint.limit_impulse = -impulse;
+      break;
+    case BoundRow::Side::kCone:
+      joint.swing_impulse = impulse;
+      break;
+  }
 }
 
 void correct_axial(const Joint& joint, SolverBody* a, SolverBody* b, Pose* pose_a, Pose* pose_b) {

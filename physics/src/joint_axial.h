@@ -22,8 +22,28 @@ double impulse_along(const Joint& joint);
 void warm_start_axial(const JointRow& row, joint_detail::JointBodies& j);
 
 // One Gauss-Seidel visit of the rows (spring, motor, limit, cone, in that order: the limit has the
-// last word). Returns the largest velocity change it gave.
-double solve_axial(JointRow& row, joint_detail::JointBodies& j, const JointTarget& target);
+// last word). Without `bounds`, a limit that is not locked and the cone are left out (the exact
+// solver holds them: bound_rows). Returns the largest velocity change it gave.
+double solve_axial(JointRow& row, joint_detail::JointBodies& j, const JointTarget& target,
+                   bool bounds = true);
+
+// A joint's one-sided rows as the exact solver's LCP holds them (a limit that is not locked, a
+// ball's cone): the row, whose rate may close the gap over the coming move and no more, the gap
+// (m or rad), and which bound it is. The limit's row is the side the coordinate is nearer, as the
+// Gauss-Seidel visit takes it.
+struct BoundRow {
+  enum class Side : std::uint8_t { kLower, kUpper, kCone };
+  joint_detail::AxialRow row;
+  double gap = 0;
+  Side side = Side::kLower;
+};
+// How many rows a joint may have here (for bounding an island's problem before building it).
+int bound_row_count(const Joint& joint);
+// The rows at the given poses (up to bound_row_count), into `out`; returns how many.
+int bound_rows(const Joint& joint, const Pose& pose_a, const Pose& pose_b, bool world_b,
+               BoundRow out[2]);
+// Keeps the impulse (>= 0, along the row) the LCP found for a row as the joint's own.
+void keep_bound_impulse(Joint& joint, BoundRow::Side side, double impulse);
 
 // One position pass over the limits and the cone: a coordinate beyond its bound is put back on it
 // through the inverse masses (velocities untouched).

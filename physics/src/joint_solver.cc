@@ -553,9 +553,9 @@ void add_equation_impulses(JointRow& row, const JointEquations& equations,
 }
 
 double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
-                          const JointTarget& target) {
+                          const JointTarget& target, bool bounds) {
   JointBodies j = bodies_of(row, bodies, poses);
-  return solve_axial(row, j, target);
+  return solve_axial(row, j, target, bounds);
 }
 
 void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies,

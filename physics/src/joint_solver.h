@@ -81,9 +81,10 @@ void add_equation_impulses(JointRow& row, const JointEquations& equations,
                            const Eigen::Matrix<double, 6, 1>& impulses);
 
 // The joint's springs, motors and limits alone (joint_axial.h): what a sweep does besides the
-// direct solve of the joint's own rows.
+// direct solve of the joint's own rows. Without `bounds`, its one-sided limits and cone are left
+// to the exact solver (joint_axial.h, bound_rows).
 double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
-                          const JointTarget& target);
+                          const JointTarget& target, bool bounds = true);
 // The position pass of the joint's limits and cone alone.
 void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies, std::span<Pose> poses);
 

@@ -145,11 +145,12 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
   new_index.assign(n, kNone);
   for (std::size_t k = 0; k < n; ++k)
     new_index[order_[n - 1 - k]] = static_cast<std::uint32_t>(k);
-  std::vector<Node> ordered(n);
+  std::vector<Node>& ordered = reordered_;
+  ordered.resize(n);
   for (std::size_t old = 0; old < n; ++old) {
-    Node node = nodes_[old];
+    Node& node = ordered[new_index[old]];
+    node = nodes_[old];
     node.parent = parent_of[old] == kNone ? kNone : new_index[parent_of[old]];
-    ordered[new_index[old]] = node;
   }
   nodes_.swap(ordered);
   for (std::uint32_t body : bodies_used_)
@@ -358,6 +359,11 @@ void JointTree::solve(std::span<const SolverBody> bodies, bool velocities, Targe
       node.rhs.setZero();
     }
   }
+  substitute();
+}
+
+void JointTree::substitute() {
+  const std::size_t n = nodes_.size();
   for (std::size_t k = 0; k < n; ++k) {
     const Node& node = nodes_[k];
     if (node.parent == kNone) continue;
@@ -434,8 +440,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   solve(bodies, true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
   // A degenerate joint (its rows dependent) leaves a pivot without an inverse: nothing is
   // applied, and the Gauss-Seidel position passes and next sweeps carry on.
-  for (const Node& node : nodes_)
-    if (!node.rhs.allFinite()) return 0;
+  if (!solution_finite()) return 0;
   double change = 0;
   for (std::size_t k = 0; k < nodes_.size(); ++k) {
     const Node& node = nodes_[k];
@@ -531,12 +536,40 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
     solve(bodies, false,
           [&](std::size_t k) { return position_targets(rows[nodes_[k].index], bodies, poses); });
   }
-  for (const Node& node : nodes_)
-    if (!node.rhs.allFinite()) return;
+  if (!solution_finite()) return;
   for (const Node& node : nodes_)
     if (!node.is_joint)
       joint_detail::move_body(&bodies[node.index], &poses[node.index], node.rhs.head<3>(),
                               node.rhs.tail<3>());
+}
+
+bool JointTree::solution_finite() const {
+  for (const Node& node : nodes_)
+    if (!node.rhs.allFinite()) return false;
+  return true;
+}
+
+bool JointTree::respond(std::span<const BodyImpulse> impulses) {
+  for (Node& node : nodes_)
+    node.rhs.setZero();
+  for (const BodyImpulse& push : impulses)
+    nodes_[node_of_body_[push.body]].rhs += push.impulse;
+  substitute();
+  return solution_finite();
+}
+
+void JointTree::apply_response(std::span<JointRow> rows, std::span<SolverBody> bodies,
+                               bool pseudo) const {
+  for (std::size_t k = 0; k < nodes_.size(); ++k) {
+    const Node& node = nodes_[k];
+    if (node.is_joint) {
+      if (!pseudo) add_equation_impulses(rows[node.index], equations_[k], -node.rhs);
+      continue;
+    }
+    SolverBody& body = bodies[node.index];
+    (pseudo ? body.push_v : body.v) += node.rhs.head<3>();
+    (pseudo ? body.push_w : body.w) += node.rhs.tail<3>();
+  }
 }
 
 }  // namespace tumble

@@ -51,6 +51,27 @@ class JointTree {
   void solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                        std::span<Pose> poses, bool refactor, double velocity_substep = 0);
 
+  // The exact solver's use of the tree (exact_joints.h), with the velocity factors of the last
+  // solve_velocities: whether a body is one of the tree's;
+  bool holds(std::uint32_t body) const {
+    return body < node_of_body_.size() && node_of_body_[body] != kNone;
+  }
+  // the change of the tree's bodies' velocities when the impulses act on some of them (linear,
+  // then angular; world axes) while every joint's rows keep their rates: the response the LCP's
+  // rows see through the joints. False where the factors give none (a degenerate joint).
+  struct BodyImpulse {
+    std::uint32_t body;  // a solver index the tree holds
+    Eigen::Matrix<double, 6, 1> impulse;
+  };
+  bool respond(std::span<const BodyImpulse> impulses);
+  // After respond: a body's velocity change (linear, angular);
+  Eigen::Matrix<double, 6, 1> change_of(std::uint32_t body) const {
+    return nodes_[node_of_body_[body]].rhs;
+  }
+  // and the response given to the bodies (as velocities, or as the push-out's pseudo-velocities)
+  // with, for velocities, the joints' impulses added to their rows.
+  void apply_response(std::span<JointRow> rows, std::span<SolverBody> bodies, bool pseudo) const;
+
  private:
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
@@ -87,6 +108,9 @@ class JointTree {
   // targets(k)) solved, the solution per node in rhs.
   template <class Targets>
   void solve(std::span<const SolverBody> bodies, bool velocities, Targets targets);
+  // The elimination's forward and back passes over the right side in the nodes' rhs.
+  void substitute();
+  bool solution_finite() const;
   // SHAKE's second iterate of the curvature targets in kept_targets_, where it converges
   // (solve_velocities); the bodies' velocities are left as they were.
   template <class Rates>
@@ -110,6 +134,7 @@ class JointTree {
   std::vector<JointEnds> shape_, built_shape_;  // this build's, and the forest's in nodes_
   bool built_ = false;
   std::vector<Node> nodes_;                  // children before their parents
+  std::vector<Node> reordered_;              // the build's renumbering (kept: no allocation)
   std::vector<std::uint32_t> node_of_body_;  // by solver index: kNone if none
   std::vector<std::uint32_t> bodies_used_;   // solver indices whose node_of_body_ is set
   std::vector<JointEquations> equations_;    // by node, for joints

@@ -53,9 +53,11 @@ struct Tableau {
               Eigen::Map<Eigen::VectorXd>& out) const {
     if (variable < n)
       out = basis_inverse.col(variable);
-    else if (variable < 2 * n)
-      out.noalias() = -(basis_inverse * m.col(variable - n));
-    else
+    else if (variable < 2 * n) {
+      // In two steps: Eigen evaluates the negated product into a temporary of the heap.
+      out.noalias() = basis_inverse * m.col(variable - n);
+      out = -out;
+    } else
       out = -basis_inverse.rowwise().sum();
   }
 

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "auto_solver.h"
+#include "exact_joints.h"
 #include "exact_solver.h"
 #include "integrate.h"
 #include "joint_axial.h"
@@ -57,12 +58,24 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
         contact_softness(std::min(hertz, 0.25 / h), solver.contact_damping_ratio, h);
     for (int sub = 0; sub < substeps; ++sub) {
       run.integrate_velocities(h);
-      // From the second substep on, the impulse a row starts from is the last substep's whole.
-      run.warm_start(sub > 0);
-      for (int i = 0; i < solver.soft_iterations; ++i)
-        if (run.sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
+      // Exact with joints: one LCP instead of the sweeps, and no relaxation (it has no bias to
+      // relax); where it finds no answer, the sweeps go on from what it left.
+      bool exact = false, tried = false;
+      if constexpr (Runner::kSolvesExact) {
+        if (report->exact_joints) {
+          tried = true;
+          exact = run.exact_substep(h, sub > 0);
+        }
+      }
+      if (!exact) {
+        // From the second substep on, the impulse a row starts from is the last substep's whole.
+        if (!tried) run.warm_start(sub > 0);
+        for (int i = 0; i < solver.soft_iterations; ++i)
+          if (run.sweep(&soft, h, (sub + i) % 2 == 1) <= solver.velocity_tolerance) break;
+      }
       run.integrate_positions(h);
       run.refresh_separations();  // the relaxation sweeps see where the move left the bodies
+      if (exact) continue;
       for (int i = 0; i < solver.relax_iterations; ++i)
         if (run.sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
     }
@@ -115,6 +128,7 @@ class SerialIsland {
         tree_ = nullptr;
         report->joint_tree = false;
         report->joint_loop = true;
+        report->exact_joints = false;
       }
     }
     // Only the tree's own rows: its solve is exact, and a second sweep would find it so (unless
@@ -195,11 +209,71 @@ class SerialIsland {
     return std::max(change, solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_,
                                            c_.settings.solver, soft, h, backward));
   }
+  // One substep of an exact island with joints (exact_joints.h): the drives swept and the tree
+  // solved as a sweep does them, then the contacts, limits and cones as one LCP. True when its
+  // answer was taken; false leaves the drives' and tree's velocities, the contacts' impulses at 0,
+  // for the substep's sweeps.
+  bool exact_substep(double h, bool keep_last_substep) {
+    // No warm start: the LCP finds each substep's whole impulse (kept for the step's total, as
+    // the warm start keeps it).
+    update_separations(rows_, c_.rows, bodies_);
+    for (std::uint32_t id : c_.rows) {
+      ContactRow& row = rows_[id];
+      if (keep_last_substep) cold_[id].earlier_substeps_impulse += row.normal_impulse;
+      row.normal_impulse = row.tangent_impulse1 = row.tangent_impulse2 = 0;
+    }
+    // The LCP finds its rows' whole impulses (the limits' and cones'); the rest are warm-started
+    // as in the sweeps: the drives (springs, friction, a locked limit) are Gauss-Seidel rows
+    // beside the tree, which converge over the substeps only from where the bodies were held
+    // (from nothing, a bar's friction on its hinge stopped its turn about its centre, the tree
+    // turned its fall back into a turn about the hinge, and it slid at a steady 0.06 rad/s).
+    for (std::uint32_t j : c_.joints) {
+      JointRow& row = c_.scratch.joint_rows[j];
+      Joint& joint = row.joint;
+      joint.swing_impulse = 0;
+      if (joint.limit.enabled && joint.limit.lower < joint.limit.upper) joint.limit_impulse = 0;
+      joint.impulse_time = h;
+      if (joint.motor.enabled) {
+        if (!row.motor_in_tree) tree_->forget_velocity_factors();
+        row.motor_in_tree = true;
+        row.motor_at_bound = false;
+        joint.motor_impulse = 0;
+      }
+      warm_start_joint(row, bodies_, c_.scratch.poses);
+    }
+    // As many visits as a substep's sweeps and relaxation sweeps give them.
+    const JointTarget target{h, c_.settings.solver.max_push_velocity, h};
+    const int visits = c_.settings.solver.soft_iterations + c_.settings.solver.relax_iterations;
+    for (int i = 0; i < visits; ++i) {
+      ++report_->velocity_iterations;
+      double change = 0;
+      for (std::uint32_t j : c_.joints)
+        change = std::max(change, solve_joint_drives(c_.scratch.joint_rows[j], bodies_,
+                                                     c_.scratch.poses, target, false));
+      change = std::max(change, tree_->solve_velocities(c_.scratch.joint_rows, bodies_,
+                                                        c_.scratch.poses, target));
+      // The first visit's change leaves out the tree's first solve of the substep (its targets'
+      // base), so it is never taken as converged.
+      if ((one_sweep_solves_ && !tree_->stiffened()) ||
+          (i > 0 && change <= c_.settings.solver.velocity_tolerance))
+        break;
+    }
+    const ExactSolveResult exact =
+        solve_island_exact(rows_, cold_, c_.rows, c_.scratch.joint_rows, c_.joints, *tree_, bodies_,
+                           c_.scratch.poses, c_.settings.solver, h);
+    report_->lemke_pivots += exact.lemke.pivots;
+    if (!exact.solved()) {
+      report_->exact_failed = true;
+      return false;
+    }
+    report_->needs_position_correction |= !exact.pushed_out;
+    return true;
+  }
   // True when the LCP's answer was taken; false when it was refused (then pgs solves the island).
   bool solve_exact(double dt) {
     const ExactSolveResult exact =
         solve_contacts_exact(rows_, cold_, c_.rows, bodies_, c_.settings.solver, dt);
-    report_->lemke_pivots = exact.lemke.pivots;
+    report_->lemke_pivots += exact.lemke.pivots;
     if (!exact.solved()) {
       report_->exact_failed = true;
       return false;
@@ -667,7 +741,7 @@ void World::solve_islands(double dt) {
   });
   store_joint_impulses();
   for (const IslandReport& report : s.reports) {
-    if (report.solver == IslandSolver::kExact)
+    if (report.solver == IslandSolver::kExact || report.exact_joints)
       ++stats_.exact_islands;
     else
       ++stats_.iterative_islands;

@@ -39,6 +39,9 @@ struct IslandReport {
   // to close a loop (then Gauss-Seidel).
   bool joint_tree = false;
   bool joint_loop = false;
+  // Exact with joints (exact_joints.h): each substep's contacts, limits and cones one LCP, the
+  // joints held through their tree; the soft recipe's substeps and moves around it.
+  bool exact_joints = false;
 };
 
 // An island this large is worth splitting over threads (and is split with one thread too, so the
