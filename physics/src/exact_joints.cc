@@ -219,29 +219,18 @@ ExactSolveResult solve_island_exact(std::span<ContactRow> rows,
     }
   }
 
-  workspace.m.resize(static_cast<std::size_t>(n) * n);
-  workspace.q.resize(n);
-  workspace.z.resize(n);
-  workspace.w.resize(n);
-  Eigen::Map<Eigen::MatrixXd> m(workspace.m.data(), n, n);
+  // m = J S J^T, S the response (symmetric, as S is).
+  set_velocity_block(workspace, n, velocity_rows, bodies, [&](int r, int c) {
+    double value = 0;
+    for (int s = 0; s < 2; ++s) {
+      const std::uint32_t body = jac[r].body[s];
+      if (moving(bodies, body))
+        value += jac[r].j[s].dot(response.col(c).segment<6>(6 * w.place_of[body]));
+    }
+    return value;
+  });
   Eigen::Map<Eigen::VectorXd> q(workspace.q.data(), n);
   Eigen::Map<Eigen::VectorXd> z(workspace.z.data(), n);
-  m.setZero();
-  q.setZero();
-  // m = J S J^T, S the response; symmetric (S is), so one triangle is computed.
-  for (int r = 0; r < velocity_rows; ++r) {
-    for (int c = r; c < velocity_rows; ++c) {
-      double value = 0;
-      for (int s = 0; s < 2; ++s) {
-        const std::uint32_t body = jac[r].body[s];
-        if (!moving(bodies, body)) continue;
-        value += jac[r].j[s].dot(response.col(c).segment<6>(6 * w.place_of[body]));
-      }
-      m(r, c) = value;
-      m(c, r) = value;
-    }
-    q[r] = velocity_along(jac[r], bodies);
-  }
   // A gap may close within the move, no more (the speculative contact, and the limits' margin as
   // their Gauss-Seidel rows keep it); penetration is pushed out below.
   for (int p = 0; p < points; ++p)

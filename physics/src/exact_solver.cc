@@ -144,7 +144,8 @@ void store_contact_impulses(const Layout& layout, std::span<ContactRow> rows,
   for (int p = 0; p < layout.points; ++p) {
     ContactRow& row = rows[ids[p]];
     row.normal_impulse = z[p];
-    row.max_normal_impulse = z[p];
+    // The largest of the step's (its substeps'), as the sweeps keep it: restitution reads it.
+    row.max_normal_impulse = std::max(row.max_normal_impulse, z[p]);
     double t1 = 0, t2 = 0;
     for (int j = 0; j < layout.k; ++j) {
       const double angle = 2 * std::numbers::pi * j / layout.k;
@@ -259,23 +260,10 @@ ExactSolveResult solve_contacts_exact(std::span<ContactRow> rows,
       jac.push_back(
           contact_jacobian(rows[id], cold[id], friction_direction(rows[id], j, k), bodies));
 
-  workspace.m.resize(static_cast<std::size_t>(n) * n);
-  workspace.q.resize(n);
-  workspace.z.resize(n);
-  workspace.w.resize(n);
-  Eigen::Map<Eigen::MatrixXd> m(workspace.m.data(), n, n);
+  set_velocity_block(workspace, n, velocity_rows, bodies,
+                     [&](int r, int c) { return coupling(jac[r], jac[c], bodies); });
   Eigen::Map<Eigen::VectorXd> q(workspace.q.data(), n);
   Eigen::Map<Eigen::VectorXd> z(workspace.z.data(), n);
-  m.setZero();
-  q.setZero();
-  for (int r = 0; r < velocity_rows; ++r) {
-    for (int c = r; c < velocity_rows; ++c) {
-      const double value = coupling(jac[r], jac[c], bodies);
-      m(r, c) = value;
-      m(c, r) = value;
-    }
-    q[r] = velocity_along(jac[r], bodies);
-  }
   // A gap may close within the step, no more (the speculative contact). Penetration is not
   // pushed out here: a push velocity would stay in the bodies (two boxes spawned overlapping
   // would fly apart); push_out below moves them instead.

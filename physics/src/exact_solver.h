@@ -89,6 +89,26 @@ struct Workspace {
   LemkeWorkspace lemke;
 };
 Workspace& thread_workspace();
+// Sizes the workspace for a problem of n unknowns, m and q zero, then fills the velocity block
+// from workspace.jacobians: m(r, c) = coupling(r, c) for r <= c, mirrored (the block is
+// symmetric), and q the rows' velocities now.
+template <class Coupling>
+void set_velocity_block(Workspace& workspace, int n, int velocity_rows,
+                        std::span<const SolverBody> bodies, Coupling coupling) {
+  workspace.m.assign(static_cast<std::size_t>(n) * n, 0.0);
+  workspace.q.assign(n, 0.0);
+  workspace.z.resize(n);
+  workspace.w.resize(n);
+  Eigen::Map<Eigen::MatrixXd> m(workspace.m.data(), n, n);
+  for (int r = 0; r < velocity_rows; ++r) {
+    for (int c = r; c < velocity_rows; ++c) {
+      const double value = coupling(r, c);
+      m(r, c) = value;
+      m(c, r) = value;
+    }
+    workspace.q[r] = velocity_along(workspace.jacobians[r], bodies);
+  }
+}
 
 // With the velocity block of m and q filled (q: the rows' velocities and the gaps' closing): the
 // friction cones' rows, the compliance and perturbation that keep Lemke's pivots well defined,

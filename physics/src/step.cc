@@ -131,6 +131,17 @@ class SerialIsland {
         report->exact_joints = false;
       }
     }
+    // An island with a contact on one of the tree's bodies is solved as auto solves it: contacts
+    // through the tree held a 1000 kg box on a 1 kg hinged bar to 1e-6 m, but a chain of 20
+    // dropped from level gained energy that way once it struck the ground or itself (4x in a
+    // second at dt 1/240, gaps of 1.8 mm) while each LCP's answer checked out against its own
+    // matrix; the cause is not yet found. Limits and cones, and contacts between bodies no joint
+    // holds, are the LCP's.
+    if (tree_ != nullptr && report->exact_joints) {
+      for (std::uint32_t id : c.rows)
+        if (tree_->holds(c.scratch.rows[id].a) || tree_->holds(c.scratch.rows[id].b))
+          report->exact_joints = false;
+    }
     // Only the tree's own rows: its solve is exact, and a second sweep would find it so (unless
     // it holds stiffness: JointTree::stiffened).
     one_sweep_solves_ = tree_ != nullptr && c.rows.empty() &&
@@ -222,14 +233,21 @@ class SerialIsland {
       if (keep_last_substep) cold_[id].earlier_substeps_impulse += row.normal_impulse;
       row.normal_impulse = row.tangent_impulse1 = row.tangent_impulse2 = 0;
     }
-    // The LCP finds its rows' whole impulses (the limits' and cones'); the rest are warm-started
-    // as in the sweeps: the drives (springs, friction, a locked limit) are Gauss-Seidel rows
-    // beside the tree, which converge over the substeps only from where the bodies were held
-    // (from nothing, a bar's friction on its hinge stopped its turn about its centre, the tree
-    // turned its fall back into a turn about the hinge, and it slid at a steady 0.06 rad/s).
+    // The LCP finds its rows' whole impulses (the limits' and cones'), and the tree its own from
+    // any start; the drives (springs, friction, a locked limit) are warm-started, as in the
+    // sweeps: Gauss-Seidel rows beside the tree converge over the substeps only from where the
+    // bodies were held (from nothing, a bar's friction on its hinge stopped its turn about its
+    // centre, the tree turned its fall back into a turn about the hinge, and it slid at a steady
+    // 0.06 rad/s), so a joint with drives keeps its own rows' warm start too. (Warm-started
+    // everywhere, a chain of 20 falling from level opened 5e-5 m at dt 1/30; 2.4e-7 m without.)
     for (std::uint32_t j : c_.joints) {
       JointRow& row = c_.scratch.joint_rows[j];
       Joint& joint = row.joint;
+      if (!has_axial_rows(joint)) {
+        joint.linear_impulse.setZero();
+        joint.angular_impulse.setZero();
+        joint.axial_impulse = 0;
+      }
       joint.swing_impulse = 0;
       if (joint.limit.enabled && joint.limit.lower < joint.limit.upper) joint.limit_impulse = 0;
       joint.impulse_time = h;
