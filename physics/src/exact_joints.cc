@@ -56,18 +56,25 @@ bool moving(std::span<const SolverBody> bodies, std::uint32_t body) {
   return body != kWorldAnchor && bodies[body].inverse_mass > 0;
 }
 
+// The tree's response to the impulses in `totals` on its bodies (through_tree: whether any act
+// on them). False where the tree gives none.
+bool respond_in_tree(JointWorkspace& w, JointTree& tree, bool* through_tree) {
+  w.impulses.clear();
+  for (std::size_t i = 0; i < w.row_bodies.size(); ++i)
+    if (tree.holds(w.row_bodies[i]) && !w.totals[i].isZero())
+      w.impulses.push_back({w.row_bodies[i], w.totals[i]});
+  *through_tree = !w.impulses.empty();
+  return !*through_tree || tree.respond(w.impulses);
+}
+
 // The velocity change of every row body for the impulses (an impulse per row body, in `totals`),
 // through the joints where the tree holds the body, freely where it does not; into `out` (6 a row
 // body). False where the tree gives none.
 bool response_to(JointWorkspace& w, JointTree& tree, std::span<const SolverBody> bodies,
                  double* out) {
-  w.impulses.clear();
   const std::size_t count = w.row_bodies.size();
-  for (std::size_t i = 0; i < count; ++i)
-    if (tree.holds(w.row_bodies[i]) && !w.totals[i].isZero())
-      w.impulses.push_back({w.row_bodies[i], w.totals[i]});
-  const bool through_tree = !w.impulses.empty();
-  if (through_tree && !tree.respond(w.impulses)) return false;
+  bool through_tree = false;
+  if (!respond_in_tree(w, tree, &through_tree)) return false;
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint32_t body = w.row_bodies[i];
     Eigen::Map<Vec6> change(out + 6 * i);
@@ -100,14 +107,9 @@ void gather(JointWorkspace& w, std::span<const Jacobian> jacobians,
 // impulses added, unless `pseudo`), the others freely; as velocities, or as pseudo-velocities.
 bool apply_totals(JointWorkspace& w, JointTree& tree, std::span<JointRow> joint_rows,
                   std::span<SolverBody> bodies, bool pseudo) {
-  w.impulses.clear();
-  for (std::size_t i = 0; i < w.row_bodies.size(); ++i)
-    if (tree.holds(w.row_bodies[i]) && !w.totals[i].isZero())
-      w.impulses.push_back({w.row_bodies[i], w.totals[i]});
-  if (!w.impulses.empty()) {
-    if (!tree.respond(w.impulses)) return false;
-    tree.apply_response(joint_rows, bodies, pseudo);
-  }
+  bool through_tree = false;
+  if (!respond_in_tree(w, tree, &through_tree)) return false;
+  if (through_tree) tree.apply_response(joint_rows, bodies, pseudo);
   for (std::size_t i = 0; i < w.row_bodies.size(); ++i) {
     const std::uint32_t index = w.row_bodies[i];
     if (tree.holds(index)) continue;
