@@ -9,6 +9,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string_view>
 #include <thread>
@@ -54,6 +55,9 @@ struct SpawnOptions {
   double radius = 0.5, half_height = 0.5, mass = 0;
   std::uint32_t colour = 0;
   bool is_static = false;
+  std::optional<double> gravity_scale, linear_damping, angular_damping;
+  std::vector<double> force, torque;
+  std::optional<std::uint32_t> layers, mask;
 
   v1::BodySpec spec() const {
     v1::BodySpec spec;
@@ -71,9 +75,37 @@ struct SpawnOptions {
     set_vec(velocity, spec.mutable_linear_velocity());
     set_vec(spin, spec.mutable_angular_velocity());
     spec.set_color(colour);
+    if (gravity_scale) spec.set_gravity_scale(*gravity_scale);
+    if (linear_damping) spec.set_linear_damping(*linear_damping);
+    if (angular_damping) spec.set_angular_damping(*angular_damping);
+    if (!force.empty()) set_vec(force, spec.mutable_force());
+    if (!torque.empty()) set_vec(torque, spec.mutable_torque());
+    if (layers) spec.set_collision_layers(*layers);
+    if (mask) spec.set_collision_mask(*mask);
     return spec;
   }
 };
+
+// The options spawn and set-state share: what acts on a body beyond gravity and contacts, and
+// its collision filter.
+void add_body_force_options(CLI::App* command, std::optional<double>* gravity_scale,
+                            std::optional<double>* linear_damping,
+                            std::optional<double>* angular_damping, std::vector<double>* force,
+                            std::vector<double>* torque, std::optional<std::uint32_t>* layers,
+                            std::optional<std::uint32_t>* mask) {
+  command->add_option("--gravity-scale", *gravity_scale, "the world's gravity times this acts on it");
+  command->add_option("--linear-damping", *linear_damping, "1/s: v -> v / (1 + c dt) each step");
+  command->add_option("--angular-damping", *angular_damping, "1/s, as --linear-damping");
+  command->add_option("--force", *force, "x,y,z (N, world): held every step until changed")
+      ->delimiter(',')
+      ->expected(3);
+  command->add_option("--torque", *torque, "x,y,z (N m, world): held every step until changed")
+      ->delimiter(',')
+      ->expected(3);
+  command->add_option("--layers", *layers, "collision layers the body is in (bits; default 1)");
+  command->add_option("--mask", *mask,
+                      "collision layers it collides with (bits; default 4294967295, all)");
+}
 
 struct StreamOptions {
   std::string format = "jsonl";
@@ -193,6 +225,8 @@ int main(int argc, char** argv) {
       ->expected(3);
   spawn->add_option("--color", body.colour, "drawing colour 0xRRGGBBAA (0: the viewer's choice)");
   spawn->add_flag("--static", body.is_static, "a body that never moves");
+  add_body_force_options(spawn, &body.gravity_scale, &body.linear_damping, &body.angular_damping,
+                         &body.force, &body.torque, &body.layers, &body.mask);
 
   CLI::App* spawn_scene = app.add_subcommand("spawn-scene", "replace the world with a scene file");
   std::string scene_file;
@@ -220,6 +254,16 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(3);
   set_state->add_option("--angular-velocity,--spin", angular_velocity, "x,y,z (rad/s)")
+      ->delimiter(',')
+      ->expected(3);
+  std::optional<double> gravity_scale, linear_damping, angular_damping;
+  std::vector<double> force, torque, force_point;
+  std::optional<std::uint32_t> layers, mask;
+  add_body_force_options(set_state, &gravity_scale, &linear_damping, &angular_damping, &force,
+                         &torque, &layers, &mask);
+  set_state
+      ->add_option("--force-point", force_point,
+                   "x,y,z (m, world): where --force acts (the torque becomes its moment)")
       ->delimiter(',')
       ->expected(3);
 
@@ -469,16 +513,29 @@ int main(int argc, char** argv) {
   } else if (*bodies) {
     Result<v1::GetBodiesResponse> got = client.bodies(ids);
     if (!got) return fail("bodies", got.status());
-    for (const v1::BodyState& s : got.value().states()) {
+    for (int i = 0; i < got.value().states_size(); ++i) {
+      const v1::BodyState& s = got.value().states(i);
+      const v1::BodyDescription& d = got.value().descriptions(i);
       const auto v = [](const v1::Vec3& x) { return nlohmann::json{x.x(), x.y(), x.z()}; };
       const v1::Quat& q = s.orientation();
-      print_line(nlohmann::json{{"id", s.id()},
-                                {"p", v(s.position())},
-                                {"q", {q.w(), q.x(), q.y(), q.z()}},
-                                {"v", v(s.linear_velocity())},
-                                {"w", v(s.angular_velocity())},
-                                {"asleep", s.asleep()}}
-                     .dump());
+      nlohmann::json line{{"id", s.id()},
+                          {"p", v(s.position())},
+                          {"q", {q.w(), q.x(), q.y(), q.z()}},
+                          {"v", v(s.linear_velocity())},
+                          {"w", v(s.angular_velocity())},
+                          {"asleep", s.asleep()}};
+      // What acts on it beyond gravity and contacts, where anything does.
+      if (d.gravity_scale() != 1) line["gravity_scale"] = d.gravity_scale();
+      if (d.linear_damping() != 0) line["linear_damping"] = d.linear_damping();
+      if (d.angular_damping() != 0) line["angular_damping"] = d.angular_damping();
+      const auto nonzero = [](const v1::Vec3& x) { return x.x() != 0 || x.y() != 0 || x.z() != 0; };
+      if (nonzero(d.force())) line["force"] = v(d.force());
+      if (nonzero(d.torque())) line["torque"] = v(d.torque());
+      if (d.collision_layers() != 1 || d.collision_mask() != 0xFFFFFFFFu) {
+        line["collision_layers"] = d.collision_layers();
+        line["collision_mask"] = d.collision_mask();
+      }
+      print_line(line.dump());
     }
   } else if (*set_state) {
     v1::BodyStateUpdate update;
@@ -493,6 +550,14 @@ int main(int argc, char** argv) {
     }
     if (!linear_velocity.empty()) set_vec(linear_velocity, update.mutable_linear_velocity());
     if (!angular_velocity.empty()) set_vec(angular_velocity, update.mutable_angular_velocity());
+    if (!force.empty()) set_vec(force, update.mutable_force());
+    if (!torque.empty()) set_vec(torque, update.mutable_torque());
+    if (!force_point.empty()) set_vec(force_point, update.mutable_force_point());
+    if (gravity_scale) update.set_gravity_scale(*gravity_scale);
+    if (linear_damping) update.set_linear_damping(*linear_damping);
+    if (angular_damping) update.set_angular_damping(*angular_damping);
+    if (layers) update.set_collision_layers(*layers);
+    if (mask) update.set_collision_mask(*mask);
     if (Status s = client.set_states({update}); !s) return fail("set-state", s);
   } else if (*impulse) {
     v1::Impulse applied;

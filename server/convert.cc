@@ -119,6 +119,15 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
       return Status::error("restitution: must be in [0, 1]");
     def.restitution = spec.restitution();
   }
+  if (spec.has_gravity_scale()) def.gravity_scale = spec.gravity_scale();
+  if (spec.has_linear_damping()) def.linear_damping = spec.linear_damping();
+  if (spec.has_angular_damping()) def.angular_damping = spec.angular_damping();
+  if (Status s = finite(spec.force(), "force"); !s) return s;
+  if (Status s = finite(spec.torque(), "torque"); !s) return s;
+  def.force = vec(spec.force());
+  def.torque = vec(spec.torque());
+  if (spec.has_collision_layers()) def.filter.layers = spec.collision_layers();
+  if (spec.has_collision_mask()) def.filter.mask = spec.collision_mask();
   if (def.type == BodyType::kStatic) def.mass = 0;
   if (Status s = validate(def); !s) return s;  // what only the engine can tell (a flat hull)
   return def;
@@ -151,6 +160,16 @@ void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) 
       shape->mutable_plane();
       break;
   }
+}
+
+void describe_forces(const BodyView& body, v1::BodyDescription* out) {
+  out->set_gravity_scale(body.gravity_scale());
+  out->set_linear_damping(body.linear_damping());
+  out->set_angular_damping(body.angular_damping());
+  vec_to_proto(body.force(), out->mutable_force());
+  vec_to_proto(body.torque(), out->mutable_torque());
+  out->set_collision_layers(body.filter().layers);
+  out->set_collision_mask(body.filter().mask);
 }
 
 void stats_to_proto(const StepStats& s, v1::StepStats* out) {
@@ -350,7 +369,8 @@ void vec_to_proto(const Vec3& v, v1::Vec3* out) {
   set(v, out);
 }
 
-BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
+BodyMotion motion_from_proto(const v1::BodyStateUpdate& update,
+                             const CollisionFilter& current_filter) {
   BodyMotion motion;
   if (update.has_position()) motion.position = vec(update.position());
   if (update.has_orientation()) {
@@ -359,6 +379,18 @@ BodyMotion motion_from_proto(const v1::BodyStateUpdate& update) {
   }
   if (update.has_linear_velocity()) motion.linear_velocity = vec(update.linear_velocity());
   if (update.has_angular_velocity()) motion.angular_velocity = vec(update.angular_velocity());
+  if (update.has_force()) motion.force = vec(update.force());
+  if (update.has_torque()) motion.torque = vec(update.torque());
+  if (update.has_force_point()) motion.force_point = vec(update.force_point());
+  if (update.has_gravity_scale()) motion.gravity_scale = update.gravity_scale();
+  if (update.has_linear_damping()) motion.linear_damping = update.linear_damping();
+  if (update.has_angular_damping()) motion.angular_damping = update.angular_damping();
+  if (update.has_collision_layers() || update.has_collision_mask()) {
+    CollisionFilter filter = current_filter;
+    if (update.has_collision_layers()) filter.layers = update.collision_layers();
+    if (update.has_collision_mask()) filter.mask = update.collision_mask();
+    motion.filter = filter;
+  }
   return motion;
 }
 

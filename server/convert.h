@@ -15,11 +15,15 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec);
 
 Vec3 vec_from_proto(const v1::Vec3& v);
 void vec_to_proto(const Vec3& v, v1::Vec3* out);
-// The fields an update sets (SetBodyState); its own checks are World::check_motion's.
-BodyMotion motion_from_proto(const v1::BodyStateUpdate& update);
+// The fields an update sets (SetBodyState); its own checks are World::check_motion's. A filter
+// field not given keeps the body's (`current_filter`).
+BodyMotion motion_from_proto(const v1::BodyStateUpdate& update,
+                             const CollisionFilter& current_filter);
 
 // What a viewer needs to draw the body with wire id `id`.
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
+// What acts on it beyond gravity and contacts, and its collision filter (GetBodies).
+void describe_forces(const BodyView& body, v1::BodyDescription* out);
 
 struct FrameOptions {
   bool velocities = false, contacts = false, stats = false, joints = false;

@@ -18,10 +18,11 @@ using google::protobuf::io::CodedInputStream;
 constexpr std::size_t kKiB = 1024, kMiB = 1024 * 1024;
 
 // Bytes per entry of the largest sensible entry of each batch, on the wire: an id is at most 11
-// (tag and a 10-byte varint); a state update or an impulse at most an id and four vectors of
-// three or four doubles (about 170); a body spec with every field set and a short name about 300,
-// hull points aside; a scene body in JSON about twice that.
-constexpr std::size_t kIdBytes = 11, kUpdateBytes = 192, kImpulseBytes = 96, kSpecBytes = 512,
+// (tag and a 10-byte varint); an impulse at most an id and two vectors (about 70); a state update
+// with every field set an id, seven vectors of three or four doubles, three doubles and two
+// filter words (about 280); a body spec with every field set and a short name about 420, hull
+// points aside; a scene body in JSON about twice that.
+constexpr std::size_t kIdBytes = 11, kUpdateBytes = 384, kImpulseBytes = 96, kSpecBytes = 512,
                       kSceneBodyBytes = 1024;
 // A joint spec with every field set: two ids, three vectors, ten doubles and their tags (about
 // 230); a drive update: an id, a motor and a spring, two flags (about 70).

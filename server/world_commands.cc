@@ -103,7 +103,9 @@ Status get_bodies(const HostedWorld& hosted, const v1::GetBodiesRequest& request
   for (BodyId id : ids) {
     const BodyView body = world.body(id);
     const std::uint32_t colour = id.index < hosted.colours.size() ? hosted.colours[id.index] : 0;
-    describe(hosted.ids.wire(id), look_of(body, colour), response->add_descriptions());
+    v1::BodyDescription* description = response->add_descriptions();
+    describe(hosted.ids.wire(id), look_of(body, colour), description);
+    describe_forces(body, description);
     v1::BodyState* state = response->add_states();
     state->set_id(hosted.ids.wire(id));
     vec_to_proto(body.position(), state->mutable_position());
@@ -122,11 +124,14 @@ Status get_bodies(const HostedWorld& hosted, const v1::GetBodiesRequest& request
 Status set_body_states(HostedWorld& hosted, const v1::SetBodyStateRequest& request) {
   std::vector<BodyId> ids;
   if (Status found = find_entries(hosted, "updates", request.updates(), &ids); !found) return found;
+  auto motion = [&](int i) {
+    return motion_from_proto(request.updates(i), hosted.world.body(ids[i]).filter());
+  };
   for (int i = 0; i < request.updates_size(); ++i)
-    if (Status s = hosted.world.check_motion(ids[i], motion_from_proto(request.updates(i))); !s)
+    if (Status s = hosted.world.check_motion(ids[i], motion(i)); !s)
       return s.within(entry("updates", i) + ".");
   for (int i = 0; i < request.updates_size(); ++i)
-    hosted.world.set_motion(ids[i], motion_from_proto(request.updates(i)));
+    hosted.world.set_motion(ids[i], motion(i));
   return Status::ok();
 }
 

@@ -213,6 +213,13 @@ class FuzzService {
     if (h.chance(0.2)) spec.set_density(h.number(100, 5000));
     if (h.chance(0.2)) spec.set_friction(h.number(0, 1));
     if (h.chance(0.2)) spec.set_restitution(h.number(0, 1));
+    if (h.chance(0.1)) spec.set_gravity_scale(h.number(-2, 2));
+    if (h.chance(0.1)) spec.set_linear_damping(h.number(0, 10));
+    if (h.chance(0.1)) spec.set_angular_damping(h.number(0, 10));
+    if (h.chance(0.1)) set(h.vector(-100, 100), spec.mutable_force());
+    if (h.chance(0.1)) set(h.vector(-10, 10), spec.mutable_torque());
+    if (h.chance(0.1)) spec.set_collision_layers(h.integer(0, 7));
+    if (h.chance(0.1)) spec.set_collision_mask(h.integer(0, 7));
     spec.set_color(static_cast<std::uint32_t>(h.rng().uniform() * 4294967295.0));
     return spec;
   }
@@ -246,6 +253,14 @@ class FuzzService {
           if (h.chance(0.3)) set(h, u->mutable_orientation());
           if (h.chance(0.4)) set(h.vector(-10, 10), u->mutable_linear_velocity());
           if (h.chance(0.4)) set(h.vector(-10, 10), u->mutable_angular_velocity());
+          if (h.chance(0.2)) set(h.vector(-100, 100), u->mutable_force());
+          if (h.chance(0.1)) set(h.vector(-10, 10), u->mutable_torque());
+          if (h.chance(0.1)) set(h.vector(-5, 5), u->mutable_force_point());
+          if (h.chance(0.1)) u->set_gravity_scale(h.number(-2, 2));
+          if (h.chance(0.1)) u->set_linear_damping(h.number(0, 10));
+          if (h.chance(0.1)) u->set_angular_damping(h.number(0, 10));
+          if (h.chance(0.1)) u->set_collision_layers(h.integer(0, 7));
+          if (h.chance(0.1)) u->set_collision_mask(h.integer(0, 7));
         }
         v1::SetBodyStateResponse response;
         return stub_->SetBodyState(&context, request, &response);

@@ -25,7 +25,7 @@ class JointGaps {
   };
   struct Joint {
     JointKind kind;
-    End a, b;
+    End a = {}, b = {};
     double length = 0;
     Vec3 axis_in_b = Vec3::UnitZ();  // a slider's axis, in b's frame (world when b is fixed)
   };

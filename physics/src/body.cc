@@ -35,6 +35,16 @@ Status validate(const BodyDef& def) {
     return Status::error("friction: must be finite and >= 0");
   if (!is_finite(def.restitution) || def.restitution < 0 || def.restitution > 1)
     return Status::error("restitution: must be in [0, 1]");
+  if (!(std::abs(def.gravity_scale) <= kMaxGravityScale))
+    return Status::error("gravity_scale: must be finite with |x| <= 1000");
+  if (!(def.linear_damping >= 0 && def.linear_damping <= kMaxDamping))
+    return Status::error("linear_damping: must be in [0, 1e6] (1/s)");
+  if (!(def.angular_damping >= 0 && def.angular_damping <= kMaxDamping))
+    return Status::error("angular_damping: must be in [0, 1e6] (1/s)");
+  if (Status s = check_vector(def.force, "force"); !s) return s;
+  if (Status s = check_vector(def.torque, "torque"); !s) return s;
+  if (def.type == BodyType::kStatic && !(def.force.isZero(0) && def.torque.isZero(0)))
+    return Status::error("force: a static body does not move");
   return Status::ok();
 }
 
@@ -50,6 +60,12 @@ Result<Body> make_body(const BodyDef& def) {
   body.angular_velocity = def.angular_velocity;
   body.friction = def.friction;
   body.restitution = def.restitution;
+  body.gravity_scale = def.gravity_scale;
+  body.linear_damping = def.linear_damping;
+  body.angular_damping = def.angular_damping;
+  body.force = def.force;
+  body.torque = def.torque;
+  body.filter = def.filter;
 
   const double density = def.mass > 0 ? def.mass / shape.value().volume() : def.density;
   MassProperties props = shape.value().mass_properties(

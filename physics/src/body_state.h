@@ -3,6 +3,7 @@
 // packed differently without touching anything outside physics/src.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include "physics/body.h"
@@ -28,6 +29,10 @@ struct Body {
   Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
   double friction = 0.5;
   double restitution = 0;
+  double gravity_scale = 1;
+  double linear_damping = 0, angular_damping = 0;  // 1/s
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();  // N, N m; world, held
+  CollisionFilter filter;
   // The inertia is a multiple of the identity (sphere, cube): no gyroscopic torque.
   bool spherical_inertia = false;
   // Sleeping: how long the body has been slower than the sleep thresholds (s), whether it sleeps,
@@ -39,6 +44,18 @@ struct Body {
   bool is_static() const { return type == BodyType::kStatic; }
   bool is_moving() const { return type == BodyType::kDynamic && !asleep; }
   Pose pose() const { return {position, orientation}; }
+  // Anything beyond gravity and contacts: a held force or torque, another gravity, damping.
+  bool has_own_forces() const {
+    return gravity_scale != 1 || linear_damping != 0 || angular_damping != 0 ||
+           !force.isZero(0) || !torque.isZero(0);
+  }
+  // The most the body's velocity can change in a second from what acts on it alone, gravity's
+  // (|gravity| given), the held force and torque's (at the shape's outer radius): m/s^2.
+  double pull(double gravity) const {
+    if (!has_own_forces()) return gravity;
+    return std::abs(gravity_scale) * gravity + inverse_mass * force.norm() +
+           (inverse_inertia_world * torque).norm() * shape.outer_radius();
+  }
   void update_world_inertia() {
     const Mat3 r = orientation.toRotationMatrix();
     inverse_inertia_world = r * inverse_inertia_body * r.transpose();

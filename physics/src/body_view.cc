@@ -44,6 +44,24 @@ double BodyView::friction() const {
 double BodyView::restitution() const {
   return body().restitution;
 }
+double BodyView::gravity_scale() const {
+  return body().gravity_scale;
+}
+double BodyView::linear_damping() const {
+  return body().linear_damping;
+}
+double BodyView::angular_damping() const {
+  return body().angular_damping;
+}
+Vec3 BodyView::force() const {
+  return body().force;
+}
+Vec3 BodyView::torque() const {
+  return body().torque;
+}
+CollisionFilter BodyView::filter() const {
+  return body().filter;
+}
 Vec3 BodyView::position() const {
   return body().position;
 }

@@ -45,7 +45,15 @@ Quat cayley(const Vec3& a) {
 bool integrate_velocity(const Body& body, const Quat& orientation, const Vec3& gravity, double h,
                         SolverBody* state) {
   if (body.is_static()) return true;
-  state->v += h * gravity;
+  if (!body.has_own_forces()) {
+    state->v += h * gravity;
+  } else {
+    // The held torque acts with the world inertia of the step's start (as the contacts see it).
+    state->v += h * (body.gravity_scale * gravity + body.inverse_mass * body.force);
+    state->w += h * (body.inverse_inertia_world * body.torque);
+    state->v /= 1 + h * body.linear_damping;
+    state->w /= 1 + h * body.angular_damping;
+  }
   // Without a gyroscopic torque the body turns about its constant w.
   const auto turn_about_w = [&] {
     state->free_turn = rotation_quaternion(h * state->w);

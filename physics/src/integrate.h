@@ -13,7 +13,8 @@ constexpr int kGyroscopicIterations = 8;
 constexpr double kGyroscopicMaxTurn = 0.5;
 constexpr int kGyroscopicMaxPieces = 1024;
 
-// Velocities over h: gravity, then the free rotation of Euler's equations in body axes by the
+// Velocities over h: gravity (scaled by the body's gravity_scale), its held force and torque and
+// its damping (implicit: v / (1 + c h)), then the free rotation of Euler's equations in body axes by the
 // implicit midpoint rule, which keeps kinetic energy and |L| of a free body exactly (both are
 // quadratic invariants, Hairer-Lubich-Wanner ch. IV). Returns false when Newton hit its bound
 // or the spin needs more pieces than allowed; the body then keeps its body-frame angular

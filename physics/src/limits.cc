@@ -114,6 +114,23 @@ Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,
   return Status::ok();
 }
 
+Status check_held_forces(const Vec3& force, const Vec3& torque, double inverse_mass,
+                         const Mat3& inverse_inertia_world, const WorldLimits& limits) {
+  if (!is_finite(force)) return Status::error("force: must be finite");
+  if (!is_finite(torque)) return Status::error("torque: must be finite");
+  // One longest step of the force alone, from rest, stays within the speed limits (the step
+  // holds speeds at them anyway; this refuses a request that could only mean a mistake).
+  if (const double dv = speed_of(force) * inverse_mass * limits.max_time_step;
+      !(dv <= limits.max_linear_speed))
+    return Status::error("force: it would change the speed by " + std::to_string(dv) +
+                         " m/s in limits.max_time_step, above limits.max_linear_speed");
+  if (const double dw = speed_of(inverse_inertia_world * torque) * limits.max_time_step;
+      !(dw <= limits.max_angular_speed))
+    return Status::error("torque: it would change the spin by " + std::to_string(dw) +
+                         " rad/s in limits.max_time_step, above limits.max_angular_speed");
+  return Status::ok();
+}
+
 namespace {
 
 // Both check_limits read a body through these getters (a Body's fields, or a view's).
@@ -137,6 +154,10 @@ Status check_body_limits(const AnyBody& body, const WorldLimits& limits) {
   const double mass = body.mass();
   if (!(mass >= limits.min_mass)) return below("mass", mass, "kg", "min_mass", limits.min_mass);
   if (!(mass <= limits.max_mass)) return above("mass", mass, "kg", "max_mass", limits.max_mass);
+  if (Status s = check_held_forces(body.force(), body.torque(), body.inverse_mass(),
+                                   body.inverse_inertia_world(), limits);
+      !s)
+    return s;
   return check_speeds(body.linear_velocity(), body.angular_velocity(), limits);
 }
 
@@ -149,6 +170,10 @@ struct BodyFields {
   double mass() const { return body.mass; }
   Vec3 linear_velocity() const { return body.linear_velocity; }
   Vec3 angular_velocity() const { return body.angular_velocity; }
+  Vec3 force() const { return body.force; }
+  Vec3 torque() const { return body.torque; }
+  double inverse_mass() const { return body.inverse_mass; }
+  Mat3 inverse_inertia_world() const { return body.inverse_inertia_world; }
 };
 
 }  // namespace

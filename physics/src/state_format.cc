@@ -190,6 +190,27 @@ void put_body(Writer& w, const Body& b) {
   w.put(b.sleep_island);
 }
 
+// What a body holds beyond contacts and gravity (flag kStateBodyForces).
+void put_body_forces(Writer& w, const Body& b) {
+  w.put(b.gravity_scale);
+  w.put(b.linear_damping);
+  w.put(b.angular_damping);
+  w.put(b.force);
+  w.put(b.torque);
+  w.put(b.filter.layers);
+  w.put(b.filter.mask);
+}
+
+void take_body_forces(Reader& r, Body* b) {
+  b->gravity_scale = r.take<double>("gravity_scale");
+  b->linear_damping = r.take<double>("linear_damping");
+  b->angular_damping = r.take<double>("angular_damping");
+  b->force = r.vec3("force");
+  b->torque = r.vec3("torque");
+  b->filter.layers = r.take<std::uint32_t>("filter.layers");
+  b->filter.mask = r.take<std::uint32_t>("filter.mask");
+}
+
 // A byte that must be 0 or 1.
 bool take_flag(Reader& r, const char* field) {
   const auto value = r.take<std::uint8_t>(field);
@@ -355,6 +376,12 @@ Status take_joint(Reader& r, Joint* j) {
 constexpr std::uint32_t kStateHasJoints = 1;
 constexpr std::uint32_t kStateJointDrives = 2;
 constexpr std::uint32_t kStateJointFriction = 4;
+// Each live body carries its gravity scale, dampings, held force and torque and collision filter,
+// written only where some body differs from the defaults (a world without writes the bytes it
+// did before they existed).
+constexpr std::uint32_t kStateBodyForces = 8;
+constexpr std::uint32_t kStateFlags =
+    kStateHasJoints | kStateJointDrives | kStateJointFriction | kStateBodyForces;
 constexpr std::size_t kFlagsOffset = 36;  // magic 8, version 4, header 4, length 8, counts 12
 
 // The least bytes of one entry, so that counts are checked against what is left.
@@ -380,15 +407,21 @@ std::string encode_state(const WorldStateData& state) {
       std::any_of(state.joints.begin(), state.joints.end(), [](const JointSlot& s) {
         return s.alive && (s.joint.friction != 0 || !s.joint.friction_impulse.isZero());
       });
-  w.put(state.joints.empty() ? std::uint32_t{0}
-                             : kStateHasJoints | kStateJointDrives |
-                                   (friction ? kStateJointFriction : std::uint32_t{0}));
+  const bool body_forces =
+      std::any_of(state.slots.begin(), state.slots.end(), [](const BodySlotState& s) {
+        return s.alive && (s.body.has_own_forces() || s.body.filter != CollisionFilter{});
+      });
+  w.put((state.joints.empty() ? std::uint32_t{0}
+                              : kStateHasJoints | kStateJointDrives |
+                                    (friction ? kStateJointFriction : std::uint32_t{0})) |
+        (body_forces ? kStateBodyForces : std::uint32_t{0}));
   w.put(state.time);
   w.put(state.step);
   for (const BodySlotState& slot : state.slots) {
     w.put(slot.generation);
     w.put(static_cast<std::uint8_t>(slot.alive));
     if (slot.alive) put_body(w, slot.body);
+    if (slot.alive && body_forces) put_body_forces(w, slot.body);
   }
   for (std::uint32_t slot : state.free_slots)
     w.put(slot);
@@ -439,7 +472,7 @@ Result<StateSizes> read_state_header(std::string_view bytes) {
     return Status::error("length: the header says " + std::to_string(sizes.bytes) +
                          " bytes, there are " + std::to_string(bytes.size()));
   // Drives without joints, or friction without drives, is no state this engine writes.
-  if ((flags & ~(kStateHasJoints | kStateJointDrives | kStateJointFriction)) != 0 ||
+  if ((flags & ~kStateFlags) != 0 ||
       (flags & (kStateHasJoints | kStateJointDrives)) == kStateJointDrives ||
       ((flags & kStateJointFriction) != 0 && (flags & kStateJointDrives) == 0))
     return Status::error("flags: unknown flags " + std::to_string(flags));
@@ -462,6 +495,8 @@ Result<WorldStateData> decode_state(std::string_view bytes) {
   if (!sizes) return sizes.status();
   Reader r(bytes.substr(kStateHeaderBytes));
   WorldStateData state;
+  std::uint32_t flags = 0;
+  std::memcpy(&flags, bytes.data() + kFlagsOffset, sizeof flags);
   state.time = r.take<double>("time");
   state.step = r.take<std::uint64_t>("step");
   state.slots.resize(sizes.value().slots);
@@ -470,6 +505,10 @@ Result<WorldStateData> decode_state(std::string_view bytes) {
     slot.generation = r.take<std::uint32_t>("generation");
     slot.alive = take_flag(r, "alive");
     Status s = slot.alive ? take_body(r, &slot.body) : r.status();
+    if (s && slot.alive && (flags & kStateBodyForces) != 0) {
+      take_body_forces(r, &slot.body);
+      s = r.status();
+    }
     if (!s) return s.within("slots[" + std::to_string(i) + "].");
   }
   state.free_slots.resize(sizes.value().free_slots);
@@ -479,8 +518,6 @@ Result<WorldStateData> decode_state(std::string_view bytes) {
   for (std::size_t i = 0; i < state.contact_pairs.size() && r.ok(); ++i)
     if (Status s = take_pair(r, &state.contact_pairs[i]); !s)
       return s.within("contact_pairs[" + std::to_string(i) + "].");
-  std::uint32_t flags = 0;
-  std::memcpy(&flags, bytes.data() + kFlagsOffset, sizeof flags);
   if ((flags & kStateHasJoints) != 0) {
     state.joints.resize(r.count("joints", kLeastJointSlotBytes));
     const std::uint32_t free_count = r.count("free_joints", 4);

@@ -46,7 +46,7 @@ double rest_margin(const Shape& shape, const SolverSettings& solver) {
 // a pair's speculative contacts need that gap, not the sum of each body's own reach. Two boxes
 // falling side by side at 10 m/s are no closer at the end of the step; counted apart, each
 // reached 17 cm and they had contacts all the way down (two thirds of a falling pile's
-// manifolds). Gravity's pull over the step counts once: the solver may hold one of the two and not
+// manifolds). The pull of gravity (and held forces) over the step counts once: the solver may hold one of the two and not
 // the other. Fast bodies keep their own reach (the sweep covers the rest).
 double pair_reach(const Body& a, const Body& b, double reach_a, double reach_b, double gravity,
                   double dt) {
@@ -56,9 +56,24 @@ double pair_reach(const Body& a, const Body& b, double reach_a, double reach_b, 
   const auto turn = [](const Body& body) {
     return body.is_moving() ? body.angular_velocity.norm() * body.shape.outer_radius() : 0.0;
   };
+  const double pull = std::max(a.pull(gravity), b.pull(gravity));
   const double together =
-      ((velocity(a) - velocity(b)).norm() + gravity * dt + turn(a) + turn(b)) * dt;
+      ((velocity(a) - velocity(b)).norm() + pull * dt + turn(a) + turn(b)) * dt;
   return std::min(reach_a + reach_b, together);
+}
+
+// The force and torque a body holds after `motion` (World::set_motion).
+std::pair<Vec3, Vec3> held_forces(const Body& body, const BodyMotion& motion) {
+  const Vec3 force = motion.force.value_or(body.force);
+  Vec3 torque = motion.torque.value_or(body.torque);
+  if (motion.force_point)
+    torque = motion.torque.value_or(Vec3::Zero()) + (*motion.force_point - body.position).cross(force);
+  return {force, torque};
+}
+
+Status check_vector(const std::optional<Vec3>& v, const char* field) {
+  if (v && !is_finite(*v)) return Status::error(std::string(field) + ": must be finite");
+  return Status::ok();
 }
 
 }  // namespace
@@ -277,7 +292,29 @@ Status World::check_motion(BodyId id, const BodyMotion& motion) const {
     if (is_static && !(*velocity)->isZero(0))
       return Status::error(std::string(name) + ": a static body does not move");
   }
-  if (is_static) return Status::ok();
+  if (motion.force_point && !motion.force)
+    return Status::error("force_point: needs a force to act there");
+  if (Status s = check_vector(motion.force_point, "force_point"); !s) return s;
+  if (Status s = check_vector(motion.force, "force"); !s) return s;
+  if (Status s = check_vector(motion.torque, "torque"); !s) return s;
+  if (motion.gravity_scale && !(std::abs(*motion.gravity_scale) <= kMaxGravityScale))
+    return Status::error("gravity_scale: must be finite with |x| <= 1000");
+  for (const auto& [damping, name] : {std::pair{&motion.linear_damping, "linear_damping"},
+                                      {&motion.angular_damping, "angular_damping"}})
+    if (*damping && !(**damping >= 0 && **damping <= kMaxDamping))
+      return Status::error(std::string(name) + ": must be in [0, 1e6] (1/s)");
+  if (is_static) {
+    for (const auto& [v, name] :
+         {std::pair{&motion.force, "force"}, std::pair{&motion.torque, "torque"}})
+      if (*v && !(*v)->isZero(0))
+        return Status::error(std::string(name) + ": a static body does not move");
+    return Status::ok();
+  }
+  const auto [force, torque] = held_forces(body, motion);
+  if (Status s = check_held_forces(force, torque, body.inverse_mass, body.inverse_inertia_world,
+                                   settings_.limits);
+      !s)
+    return s;
   return check_speeds(motion.linear_velocity.value_or(body.linear_velocity),
                       motion.angular_velocity.value_or(body.angular_velocity), settings_.limits);
 }
@@ -291,6 +328,15 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
   if (!body.is_static()) {
     if (motion.linear_velocity) body.linear_velocity = *motion.linear_velocity;
     if (motion.angular_velocity) body.angular_velocity = *motion.angular_velocity;
+    std::tie(body.force, body.torque) = held_forces(body, motion);
+  }
+  if (motion.gravity_scale) body.gravity_scale = *motion.gravity_scale;
+  if (motion.linear_damping) body.linear_damping = *motion.linear_damping;
+  if (motion.angular_damping) body.angular_damping = *motion.angular_damping;
+  // Bodies resting on it may no longer meet it (or may now): they wake, as does the body.
+  if (motion.filter && *motion.filter != body.filter) {
+    body.filter = *motion.filter;
+    wake_around(body);
   }
   body.update_world_inertia();
   if (body.is_static()) resting_changed(id.index);  // (a sleeper wakes below, which counts too)
@@ -577,7 +623,8 @@ void World::compute_bounds(double dt) {
       // What the velocity cannot say, the pull of gravity over the step and the turn, grows it on
       // every side.
       const double unsure =
-          (gravity * dt + body.angular_velocity.norm() * body.shape.outer_radius()) * dt;
+          (body.pull(gravity) * dt + body.angular_velocity.norm() * body.shape.outer_radius()) *
+          dt;
       const Vec3 travel = body.linear_velocity * dt;
       const double motion = travel.norm() + unsure;
       const double swept_beyond = solver.continuous_fraction * body.shape.inner_radius();
@@ -688,8 +735,10 @@ void World::find_contacts(double dt) {
           previous = kNoRecord;  // the slot now holds another body
         s.found_previous[i] = previous;
         s.found_flags[i] = 0;
-        // Bodies a joint holds together do not collide unless it says so.
+        // Bodies a joint holds together do not collide unless it says so, nor bodies their
+        // collision filters keep apart.
         if (!unjoined_pairs_.empty() && unjoined(pairs_[i].a, pairs_[i].b)) return 0u;
+        if (!a.filter.collides_with(b.filter)) return 0u;
         const Pose pose_a = a.pose(), pose_b = b.pose();
         CollisionSettings settings = settings_.collision;
         const bool fast = fast_[pairs_[i].a] || fast_[pairs_[i].b];

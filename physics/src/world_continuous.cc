@@ -20,7 +20,9 @@ void World::sweep_fast_bodies(double /*dt*/) {
   const SolverSettings& solver = settings_.solver;
   s.swept_pairs.clear();
   for (std::uint32_t k = 0; k < pairs_.size(); ++k)
-    if (fast_[pairs_[k].a] || fast_[pairs_[k].b]) s.swept_pairs.push_back(k);
+    if ((fast_[pairs_[k].a] || fast_[pairs_[k].b]) &&
+        bodies_[pairs_[k].a].body.filter.collides_with(bodies_[pairs_[k].b].body.filter))
+      s.swept_pairs.push_back(k);
   s.impacts.resize(s.swept_pairs.size());
 
   // A body that does not move this step may have no solver index: it stays where it is.

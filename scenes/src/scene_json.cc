@@ -1,5 +1,6 @@
 // The JSON scene format. Every field is checked with its path; unknown fields are errors, so a
 // misspelt key never silently falls back to a default.
+#include <cstdint>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -58,6 +59,13 @@ class ObjectReader {
     if (value == nullptr) return fallback;
     if (!value->is_string()) fail(child(key), "must be a string");
     return value->get<std::string>();
+  }
+  std::uint32_t bits(const std::string& key, std::uint32_t fallback) {
+    const Json* value = find(key);
+    if (value == nullptr) return fallback;
+    if (!value->is_number_unsigned() || value->get<unsigned long long>() > UINT32_MAX)
+      fail(child(key), "must be an integer in [0, 4294967295] (32 bits)");
+    return static_cast<std::uint32_t>(value->get<unsigned long long>());
   }
   bool boolean(const std::string& key, bool fallback) {
     const Json* value = find(key);
@@ -172,6 +180,13 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   def.angular_velocity = r.vector("angular_velocity", def.angular_velocity);
   def.friction = r.number("friction", def.friction);
   def.restitution = r.number("restitution", def.restitution);
+  def.gravity_scale = r.number("gravity_scale", def.gravity_scale);
+  def.linear_damping = r.number("linear_damping", def.linear_damping);
+  def.angular_damping = r.number("angular_damping", def.angular_damping);
+  def.force = r.vector("force", def.force);
+  def.torque = r.vector("torque", def.torque);
+  def.filter.layers = r.bits("collision_layers", def.filter.layers);
+  def.filter.mask = r.bits("collision_mask", def.filter.mask);
   r.reject_unknown();
   // The engine's own checks (mass, friction, orientation, hull degeneracy...) with this path.
   if (Status s = check_definition(def, limits); !s) throw FieldError{path + "." + s.message()};
@@ -381,6 +396,15 @@ Json body_json(const BodyDef& def) {
   out["angular_velocity"] = vector_json(def.angular_velocity);
   out["friction"] = def.friction;
   out["restitution"] = def.restitution;
+  // What most bodies leave at its default is written only where it is not.
+  const BodyDef plain;
+  if (def.gravity_scale != plain.gravity_scale) out["gravity_scale"] = def.gravity_scale;
+  if (def.linear_damping != 0) out["linear_damping"] = def.linear_damping;
+  if (def.angular_damping != 0) out["angular_damping"] = def.angular_damping;
+  if (!def.force.isZero(0)) out["force"] = vector_json(def.force);
+  if (!def.torque.isZero(0)) out["torque"] = vector_json(def.torque);
+  if (def.filter.layers != plain.filter.layers) out["collision_layers"] = def.filter.layers;
+  if (def.filter.mask != plain.filter.mask) out["collision_mask"] = def.filter.mask;
   return out;
 }
 

@@ -27,7 +27,14 @@ class BodySpec:
 
     position: m, of the shape's origin; linear_velocity: m/s; angular_velocity: rad/s, world
     frame; orientation: (w, x, y, z); color: 0xRRGGBBAA or (r, g, b[, a]) in [0, 1]. `pos` and
-    `vel` are accepted for position and linear_velocity."""
+    `vel` are accepted for position and linear_velocity.
+
+    What acts on the body beyond gravity and contacts: gravity_scale (the world's gravity times
+    this; default 1), linear_damping and angular_damping (1/s: each step takes v to
+    v / (1 + c dt)), force (N) and torque (N m, about the centre of mass), world frame, held every
+    step until changed (World.set_state). collision_layers and collision_mask (32 bits each;
+    default 1 and every layer): two bodies collide when each one's layers meet the other's
+    mask."""
 
     shape: object
     position: tuple = (0.0, 0.0, 0.0)
@@ -40,10 +47,19 @@ class BodySpec:
     restitution: Optional[float] = None
     color: object = None
     static: bool = False
+    gravity_scale: Optional[float] = None
+    linear_damping: Optional[float] = None
+    angular_damping: Optional[float] = None
+    force: Optional[tuple] = None
+    torque: Optional[tuple] = None
+    collision_layers: Optional[int] = None
+    collision_mask: Optional[int] = None
 
     def __init__(self, shape, position=None, linear_velocity=None, orientation=None,
                  angular_velocity=None, mass=None, density=None, friction=None, restitution=None,
-                 color=None, static=False, *, pos=None, vel=None):
+                 color=None, static=False, *, pos=None, vel=None, gravity_scale=None,
+                 linear_damping=None, angular_damping=None, force=None, torque=None,
+                 collision_layers=None, collision_mask=None):
         self.shape = shape
         self.position = aliased("position", position, "pos", pos, (0.0, 0.0, 0.0))
         self.linear_velocity = aliased("linear_velocity", linear_velocity, "vel", vel,
@@ -56,6 +72,13 @@ class BodySpec:
         self.restitution = restitution
         self.color = color
         self.static = static
+        self.gravity_scale = gravity_scale
+        self.linear_damping = linear_damping
+        self.angular_damping = angular_damping
+        self.force = force
+        self.torque = torque
+        self.collision_layers = collision_layers
+        self.collision_mask = collision_mask
 
     def to_proto(self, name="bodies[0]"):
         if not isinstance(self.shape, shapes.SHAPES):
@@ -72,12 +95,30 @@ class BodySpec:
             spec.orientation.w = 1.0
         if self.angular_velocity is not None:
             convert.set_vec3(spec.angular_velocity, self.angular_velocity, f"{name}.angular_velocity")
-        for field in ("mass", "density", "friction", "restitution"):
+        for field in ("mass", "density", "friction", "restitution", "gravity_scale",
+                      "linear_damping", "angular_damping"):
             value = getattr(self, field)
             if value is not None:
                 setattr(spec, field, convert.number(value, f"{name}.{field}"))
+        for field in ("force", "torque"):
+            value = getattr(self, field)
+            if value is not None:
+                convert.set_vec3(getattr(spec, field), value, f"{name}.{field}")
+        for field in ("collision_layers", "collision_mask"):
+            value = getattr(self, field)
+            if value is not None:
+                setattr(spec, field, bits(value, f"{name}.{field}"))
         spec.color = convert.color(self.color, f"{name}.color")
         return spec
+
+
+def bits(value, name):
+    """A collision filter's 32 bits, refused naming the field when it is not."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not (
+            0 <= int(value) <= 0xFFFFFFFF):
+        raise ArgumentError(f"{name}: must be an integer in [0, 4294967295] (32 bits), "
+                            f"got {value!r}")
+    return int(value)
 
 
 @dataclass
@@ -112,6 +153,14 @@ class Body(Description):
     linear_velocity: np.ndarray = None
     angular_velocity: np.ndarray = None
     asleep: bool = False
+    # What acts on it beyond gravity and contacts (BodySpec), and its collision filter.
+    gravity_scale: float = 1.0
+    linear_damping: float = 0.0
+    angular_damping: float = 0.0
+    force: np.ndarray = None
+    torque: np.ndarray = None
+    collision_layers: int = 1
+    collision_mask: int = 0xFFFFFFFF
 
     @staticmethod
     def from_proto(description, state, step):
@@ -123,4 +172,11 @@ class Body(Description):
             linear_velocity=convert.vec3(state.linear_velocity),
             angular_velocity=convert.vec3(state.angular_velocity),
             asleep=state.asleep,
+            gravity_scale=description.gravity_scale,
+            linear_damping=description.linear_damping,
+            angular_damping=description.angular_damping,
+            force=convert.vec3(description.force),
+            torque=convert.vec3(description.torque),
+            collision_layers=description.collision_layers,
+            collision_mask=description.collision_mask,
         )

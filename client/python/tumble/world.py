@@ -12,7 +12,7 @@ import grpc
 import numpy as np
 
 from tumble import convert
-from tumble.bodies import Body, BodySpec, aliased
+from tumble.bodies import Body, BodySpec, aliased, bits
 from tumble.errors import ArgumentError, Error, from_rpc
 from tumble.frames import FrameStream, plain
 from tumble.shapes import Box, Capsule, Hull, Plane, Sphere
@@ -187,10 +187,26 @@ class WorldCalls:
         self._rpc("RemoveBodies", pb.RemoveBodiesRequest(ids=convert.ids(ids)))
 
     def set_state(self, body_id, position=None, orientation=None, linear_velocity=None,
-                  angular_velocity=None, *, pos=None, vel=None):
-        """Moves a body or sets its velocities; values not given are left as they are (pos and
-        vel: the older names of position and linear_velocity)."""
+                  angular_velocity=None, *, pos=None, vel=None, force=None, torque=None,
+                  force_point=None, gravity_scale=None, linear_damping=None,
+                  angular_damping=None, collision_layers=None, collision_mask=None):
+        """Moves a body, sets its velocities, what acts on it or its collision filter (BodySpec's
+        fields); values not given are left as they are (pos and vel: the older names of position
+        and linear_velocity). force (N) and torque (N m) are held every step until changed; with
+        force_point (m, world) the force acts there and the held torque becomes its moment about
+        the centre of mass plus `torque`. The body wakes."""
         update = pb.BodyStateUpdate(id=convert.ids(body_id, "id")[0])
+        for field, value in (("force", force), ("torque", torque), ("force_point", force_point)):
+            if value is not None:
+                convert.set_vec3(getattr(update, field), value, field)
+        for field, value in (("gravity_scale", gravity_scale), ("linear_damping", linear_damping),
+                             ("angular_damping", angular_damping)):
+            if value is not None:
+                setattr(update, field, convert.number(value, field))
+        for field, value in (("collision_layers", collision_layers),
+                             ("collision_mask", collision_mask)):
+            if value is not None:
+                setattr(update, field, bits(value, field))
         position = aliased("position", position, "pos", pos, None)
         linear_velocity = aliased("linear_velocity", linear_velocity, "vel", vel, None)
         if position is not None:

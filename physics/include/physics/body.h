@@ -26,6 +26,22 @@ enum class BodyType : std::uint8_t {
   kDynamic,  // moved by forces and contacts
 };
 
+// Which bodies collide: two do when each one's layers meet the other's mask (Bullet's group and
+// mask). Bodies the filter keeps apart are never handed to the narrow phase. The default is in
+// layer 1 and meets every layer.
+struct CollisionFilter {
+  std::uint32_t layers = 1;         // the layers the body is in, one bit each
+  std::uint32_t mask = 0xFFFFFFFF;  // the layers it collides with
+  bool collides_with(const CollisionFilter& other) const {
+    return (layers & other.mask) != 0 && (other.layers & mask) != 0;
+  }
+  bool operator==(const CollisionFilter&) const = default;
+};
+
+// The most |gravity_scale|, and the most damping (1/s), a body takes.
+inline constexpr double kMaxGravityScale = 1e3;
+inline constexpr double kMaxDamping = 1e6;
+
 struct BodyDef {
   ShapeDef shape = BoxDef{};
   BodyType type = BodyType::kDynamic;
@@ -40,6 +56,17 @@ struct BodyDef {
   double density = 1000;
   double friction = 0.5;   // Coulomb coefficient, >= 0
   double restitution = 0;  // in [0, 1]
+  // The world's gravity times this acts on the body (0 floats, -1 falls up); |x| <= 1e3.
+  double gravity_scale = 1;
+  // Damping, 1/s, in [0, 1e6]: each step takes v to v / (1 + c h) (implicit Euler of dv/dt = -c v:
+  // a velocity decays as e^-ct to first order and never reverses, however stiff).
+  double linear_damping = 0, angular_damping = 0;
+  // A force (N, world) and torque (N m, world, about the centre of mass) held on the body every
+  // step until changed (World::set_motion). Dynamic bodies only; bounded so that one longest step
+  // (limits.max_time_step) from rest stays within the speed limits.
+  Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();
+  CollisionFilter filter = {};
 };
 
 // Checks a definition without creating anything; the message names the field.

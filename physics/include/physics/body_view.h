@@ -38,6 +38,12 @@ class BodyView {
   Mat3 inverse_inertia_world() const;
   double friction() const;
   double restitution() const;
+  double gravity_scale() const;
+  double linear_damping() const;   // 1/s
+  double angular_damping() const;  // 1/s
+  Vec3 force() const;               // N, world, held
+  Vec3 torque() const;              // N m, world, about the centre of mass, held
+  CollisionFilter filter() const;
 
   Vec3 position() const;  // m, centre of mass
   Quat orientation() const;

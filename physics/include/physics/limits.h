@@ -62,4 +62,8 @@ double speed_of(const Vec3& velocity);
 Status check_speeds(const Vec3& linear_velocity, const Vec3& angular_velocity,
                     const WorldLimits& limits);
 
+// Checks a held force and torque on a body of that inverse mass and world inverse inertia.
+Status check_held_forces(const Vec3& force, const Vec3& torque, double inverse_mass,
+                         const Mat3& inverse_inertia_world, const WorldLimits& limits);
+
 }  // namespace tumble

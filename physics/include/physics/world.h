@@ -50,11 +50,21 @@ struct Contact {
 };
 
 // A change of a body's pose or velocities; absent fields stay as they are.
+// What World::set_motion changes of a body: the fields given, the rest as they were.
 struct BodyMotion {
   std::optional<Vec3> position;  // m, centre of mass
   std::optional<Quat> orientation;
   std::optional<Vec3> linear_velocity;   // m/s
   std::optional<Vec3> angular_velocity;  // rad/s, world
+  // The held force (N, world) and torque (N m, world, about the centre of mass: BodyDef). With
+  // `force_point` (m, world, where the body is now) the force acts there: the held torque becomes
+  // (point - centre) x force plus `torque` (0 when not given). A point needs a force.
+  std::optional<Vec3> force;
+  std::optional<Vec3> torque;
+  std::optional<Vec3> force_point;
+  std::optional<double> gravity_scale;
+  std::optional<double> linear_damping, angular_damping;  // 1/s
+  std::optional<CollisionFilter> filter;  // wakes what the body touches
 };
 
 // One impulse of a batch (World::apply_impulses).
