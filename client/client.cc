@@ -98,6 +98,10 @@ Result<v1::GetBodiesResponse> Client::bodies(const std::vector<std::uint64_t>& i
   return call<v1::GetBodiesResponse>(&v1::World::Stub::GetBodies, request);
 }
 
+Result<v1::QueryResponse> Client::query(const v1::QueryRequest& request) {
+  return call<v1::QueryResponse>(&v1::World::Stub::Query, request);
+}
+
 Status Client::set_states(const std::vector<v1::BodyStateUpdate>& updates) {
   v1::SetBodyStateRequest request;
   request.mutable_updates()->Add(updates.begin(), updates.end());

@@ -53,6 +53,8 @@ class Client {
   Result<std::vector<std::uint64_t>> spawn(const std::vector<v1::BodySpec>& bodies);
   Status remove(const std::vector<std::uint64_t>& ids);
   Result<v1::GetBodiesResponse> bodies(const std::vector<std::uint64_t>& ids = {});
+  // Ray casts between two steps (QueryRequest: flat arrays of origins and directions).
+  Result<v1::QueryResponse> query(const v1::QueryRequest& request);
   // All or nothing: one refused update or impulse leaves every body as it was.
   Status set_states(const std::vector<v1::BodyStateUpdate>& updates);
   Status apply_impulses(const std::vector<v1::Impulse>& impulses);

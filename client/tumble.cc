@@ -267,6 +267,23 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(3);
 
+  CLI::App* ray = app.add_subcommand("ray", "cast a ray: the bodies it meets, as JSON lines");
+  std::vector<double> ray_origin, ray_direction;
+  double ray_max_distance = 1000;
+  std::optional<std::uint32_t> ray_mask;
+  std::uint32_t ray_hits = 0;
+  ray->add_option("--origin,--from", ray_origin, "x,y,z (m, world)")
+      ->required()
+      ->delimiter(',')
+      ->expected(3);
+  ray->add_option("--direction,--dir", ray_direction, "x,y,z (any length but zero)")
+      ->required()
+      ->delimiter(',')
+      ->expected(3);
+  ray->add_option("--max-distance", ray_max_distance, "m (default 1000)");
+  ray->add_option("--mask", ray_mask, "meet only bodies in these collision layers (bits)");
+  ray->add_option("--hits", ray_hits, "up to this many hits, nearest first (default: the nearest)");
+
   CLI::App* impulse = app.add_subcommand("impulse", "apply an impulse to a body (it wakes)");
   std::vector<double> impulse_value, impulse_point;
   impulse->add_option("id", body_id, "the body's id")->required();
@@ -559,6 +576,28 @@ int main(int argc, char** argv) {
     if (layers) update.set_collision_layers(*layers);
     if (mask) update.set_collision_mask(*mask);
     if (Status s = client.set_states({update}); !s) return fail("set-state", s);
+  } else if (*ray) {
+    v1::QueryRequest request;
+    request.mutable_ray_origins()->Add(ray_origin.begin(), ray_origin.end());
+    request.mutable_ray_directions()->Add(ray_direction.begin(), ray_direction.end());
+    request.add_ray_max_distances(ray_max_distance);
+    if (ray_mask) request.set_ray_mask(*ray_mask);
+    request.set_hits_per_ray(ray_hits);
+    Result<v1::QueryResponse> found = client.query(request);
+    if (!found) return fail("ray", found.status());
+    const v1::QueryResponse& r = found.value();
+    for (int k = 0; k < r.hit_ids_size(); ++k) {
+      const auto triple = [k](const auto& values) {
+        return nlohmann::json{values[3 * k], values[3 * k + 1], values[3 * k + 2]};
+      };
+      print_line(nlohmann::json{{"id", r.hit_ids(k)},
+                                {"distance", r.hit_distances(k)},
+                                {"fraction", r.hit_fractions(k)},
+                                {"point", triple(r.hit_points())},
+                                {"normal", triple(r.hit_normals())}}
+                     .dump());
+    }
+    if (r.hits_left_out()) std::fprintf(stderr, "ray: more hits were left out (--hits)\n");
   } else if (*impulse) {
     v1::Impulse applied;
     applied.set_id(body_id);

@@ -27,6 +27,8 @@ constexpr std::size_t kIdBytes = 11, kUpdateBytes = 384, kImpulseBytes = 96, kSp
 // A joint spec with every field set: two ids, three vectors, ten doubles and their tags (about
 // 230); a drive update: an id, a motor and a spring, two flags (about 70).
 constexpr std::size_t kJointSpecBytes = 320, kDriveBytes = 96;
+// A ray of a query: seven doubles in packed arrays.
+constexpr std::size_t kRayBytes = 56;
 // Room beyond the per-entry bytes: a few hulls of the most points a hull may have (1024 points
 // of three doubles, 24 KiB each) in a batch, the fields of a request that are not entries.
 constexpr std::size_t kSlack = kMiB;
@@ -175,6 +177,8 @@ MethodBounds RequestBounds::of(std::string_view method) const {
     return {capped(kIdBytes * n + kKiB), n};
   if (method == "SetBodyState") return {capped(kUpdateBytes * n + kKiB), n};
   if (method == "ApplyImpulse") return {capped(kImpulseBytes * n + kKiB), n};
+  // Six numbers and a distance a ray, in packed arrays (world_commands.h, kMaxQueryRays).
+  if (method == "Query") return {capped(kRayBytes * kMaxQueryRays + kKiB), 0};
   // A world holds at most two joints a body (scenes/scene.h, kJointsPerBody).
   const std::size_t joints = 2 * n;
   if (method == "CreateJoints") return {capped(kJointSpecBytes * joints + kKiB), joints};
@@ -191,7 +195,7 @@ std::size_t RequestBounds::largest() const {
   std::size_t largest = 0;
   for (const char* method :
        {"SpawnBodies", "GetBodies", "SetBodyState", "ApplyImpulse", "CreateJoints", "RemoveJoints",
-        "SetJointDrives", "GetJoints", "LoadScene", "Restore", "Control"})
+        "SetJointDrives", "GetJoints", "LoadScene", "Restore", "Control", "Query"})
     largest = std::max(largest, of(method).bytes);
   return largest;
 }

@@ -76,6 +76,7 @@ CallGate WorldService::make_gate() {
       {"SetBodyState", unary(&WorldService::set_body_state)},
       {"ApplyImpulse", unary(&WorldService::apply_impulse)},
       {"GetBodies", unary(&WorldService::get_bodies)},
+      {"Query", unary(&WorldService::query)},
       {"CreateJoints", unary(&WorldService::create_joints)},
       {"RemoveJoints", unary(&WorldService::remove_joints)},
       {"SetJointDrives", unary(&WorldService::set_joint_drives)},
@@ -180,6 +181,14 @@ grpc::Status WorldService::get_bodies(const v1::GetBodiesRequest& request,
   Status read = Status::ok();
   host_.inspect(
       [&](const HostedWorld& hosted) { read = server::get_bodies(hosted, request, response); });
+  return to_grpc(read);
+}
+
+grpc::Status WorldService::query(const v1::QueryRequest& request, v1::QueryResponse* response) {
+  // Between two steps, on the world's thread: a query's cost is bounded by its size (at most
+  // 262144 rays or hits; docs/SERVICE.md, "Queries").
+  Status read = Status::ok();
+  host_.inspect([&](const HostedWorld& hosted) { read = server::query(hosted, request, response); });
   return to_grpc(read);
 }
 

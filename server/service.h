@@ -37,6 +37,7 @@ struct ServiceLimits {
 using GatedWorldService = v1::World::WithGenericMethod_SpawnBodies<
     v1::World::WithGenericMethod_RemoveBodies<v1::World::WithGenericMethod_SetBodyState<
         v1::World::WithGenericMethod_ApplyImpulse<v1::World::WithGenericMethod_GetBodies<
+            v1::World::WithGenericMethod_Query<
             v1::World::WithGenericMethod_CreateJoints<v1::World::WithGenericMethod_RemoveJoints<
                 v1::World::WithGenericMethod_SetJointDrives<
                     v1::World::WithGenericMethod_GetJoints<v1::World::WithGenericMethod_LoadScene<
@@ -44,7 +45,7 @@ using GatedWorldService = v1::World::WithGenericMethod_SpawnBodies<
                             v1::World::WithGenericMethod_StreamFrames<
                                 v1::World::WithGenericMethod_Snapshot<
                                     v1::World::WithGenericMethod_Restore<
-                                        v1::World::Service>>>>>>>>>>>>>>>;
+                                        v1::World::Service>>>>>>>>>>>>>>>>;
 
 class WorldService final : public GatedWorldService {
  public:
@@ -64,6 +65,7 @@ class WorldService final : public GatedWorldService {
   grpc::Status spawn_bodies(const v1::SpawnBodiesRequest&, v1::SpawnBodiesResponse*);
   grpc::Status remove_bodies(const v1::RemoveBodiesRequest&, v1::RemoveBodiesResponse*);
   grpc::Status get_bodies(const v1::GetBodiesRequest&, v1::GetBodiesResponse*);
+  grpc::Status query(const v1::QueryRequest&, v1::QueryResponse*);
   grpc::Status create_joints(const v1::CreateJointsRequest&, v1::CreateJointsResponse*);
   grpc::Status remove_joints(const v1::RemoveJointsRequest&, v1::RemoveJointsResponse*);
   grpc::Status set_joint_drives(const v1::SetJointDrivesRequest&, v1::SetJointDrivesResponse*);

@@ -1,5 +1,6 @@
 #include "world_commands.h"
 
+#include <algorithm>
 #include <unordered_set>
 
 #include "convert.h"
@@ -117,6 +118,75 @@ Status get_bodies(const HostedWorld& hosted, const v1::GetBodiesRequest& request
     vec_to_proto(body.linear_velocity(), state->mutable_linear_velocity());
     vec_to_proto(body.angular_velocity(), state->mutable_angular_velocity());
     state->set_asleep(body.asleep());
+  }
+  return Status::ok();
+}
+
+Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
+             v1::QueryResponse* response) {
+  const std::size_t numbers = static_cast<std::size_t>(request.ray_origins_size());
+  if (numbers % 3 != 0)
+    return Status::error("ray_origins: must be x y z triples (" + std::to_string(numbers) +
+                         " numbers)");
+  const std::size_t n = numbers / 3;
+  if (static_cast<std::size_t>(request.ray_directions_size()) != numbers)
+    return Status::error("ray_directions: must hold as many numbers as ray_origins (" +
+                         std::to_string(numbers) + ")");
+  const std::size_t distances = static_cast<std::size_t>(request.ray_max_distances_size());
+  if (distances > 1 && distances != n)
+    return Status::error("ray_max_distances: one for every ray, or one per ray (" +
+                         std::to_string(n) + ")");
+  if (n > kMaxQueryRays)
+    return Status::error("ray_origins: " + std::to_string(n) +
+                             " rays, above the 262144 a query may cast",
+                         StatusCode::kResourceExhausted);
+  const std::size_t per_ray = request.hits_per_ray();
+  if (per_ray > kMaxHitsPerRay)
+    return Status::error("hits_per_ray: must be in [0, 64]");
+  if (n * std::max<std::size_t>(per_ray, 1) > kMaxQueryHits)
+    return Status::error("hits_per_ray: " + std::to_string(n) + " rays x " +
+                             std::to_string(per_ray) +
+                             " hits is above the 262144 hits a query may answer",
+                         StatusCode::kResourceExhausted);
+  std::vector<RayCast> rays(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    RayCast& ray = rays[i];
+    ray.origin = Vec3(request.ray_origins(3 * i), request.ray_origins(3 * i + 1),
+                      request.ray_origins(3 * i + 2));
+    ray.direction = Vec3(request.ray_directions(3 * i), request.ray_directions(3 * i + 1),
+                         request.ray_directions(3 * i + 2));
+    if (distances > 0) ray.max_distance = request.ray_max_distances(distances == 1 ? 0 : i);
+    if (request.has_ray_mask()) ray.mask = request.ray_mask();
+    if (Status s = validate(ray); !s) return s.within("rays[" + std::to_string(i) + "].");
+  }
+  const World& world = hosted.world;
+  response->set_step(world.step_count());
+  auto add_hit = [&](const RayHit& hit) {
+    response->add_hit_ids(hosted.ids.wire(hit.body));
+    response->add_hit_distances(hit.distance);
+    response->add_hit_fractions(hit.fraction);
+    for (int k = 0; k < 3; ++k)
+      response->add_hit_points(hit.point[k]);
+    for (int k = 0; k < 3; ++k)
+      response->add_hit_normals(hit.normal[k]);
+  };
+  if (per_ray == 0) {
+    std::vector<RayHit> hits(n);
+    if (Status s = world.cast_rays(rays, hits); !s) return s;
+    for (const RayHit& hit : hits) {
+      response->add_hit_counts(hit.hit() ? 1 : 0);
+      if (hit.hit()) add_hit(hit);
+    }
+    return Status::ok();
+  }
+  std::vector<RayHit> hits;
+  for (const RayCast& ray : rays) {
+    Result<bool> left_out = world.cast_ray_all(ray, per_ray, &hits);
+    if (!left_out) return left_out.status();
+    response->set_hits_left_out(response->hits_left_out() || left_out.value());
+    response->add_hit_counts(static_cast<std::uint32_t>(hits.size()));
+    for (const RayHit& hit : hits)
+      add_hit(hit);
   }
   return Status::ok();
 }

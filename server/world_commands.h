@@ -33,6 +33,10 @@ Status spawn_bodies(HostedWorld& hosted, const std::vector<BodyDef>& defs,
 Status remove_bodies(HostedWorld& hosted, const WireIds& wire_ids);
 Status get_bodies(const HostedWorld& hosted, const v1::GetBodiesRequest& request,
                   v1::GetBodiesResponse* response);
+// A batch of ray casts (QueryRequest, bounded by request_bounds.h's kMaxQueryRays), refused
+// whole naming the field.
+Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
+             v1::QueryResponse* response);
 Status set_body_states(HostedWorld& hosted, const v1::SetBodyStateRequest& request);
 Status apply_impulses(HostedWorld& hosted, const v1::ApplyImpulseRequest& request);
 

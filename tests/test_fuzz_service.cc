@@ -49,7 +49,7 @@ class FuzzService {
     refresh_ids();
     for (int i = 0; i < count; ++i) {
       bool read_only = false;
-      const int rpc = h.integer(0, 13);
+      const int rpc = h.integer(0, 14);
       const grpc::Status status = send(h, rpc, &read_only);
       ++tally.tried;
       (status.ok() ? tally.accepted : tally.refused)++;
@@ -382,6 +382,21 @@ class FuzzService {
           request.add_ids(joint_id(h));
         v1::GetJointsResponse response;
         return stub_->GetJoints(&context, request, &response);
+      }
+      case 14: {
+        *read_only = true;
+        v1::QueryRequest request;
+        const int rays = h.chance(0.05) ? 300000 : h.integer(0, 5);
+        for (int n = 3 * rays + (h.chance(0.05) ? 1 : 0); n > 0; --n)
+          request.add_ray_origins(h.number(-10, 10));
+        for (int n = 3 * rays + (h.chance(0.05) ? 2 : 0); n > 0; --n)
+          request.add_ray_directions(h.number(-1, 1));
+        for (int n = h.integer(0, 2); n > 0; --n)
+          request.add_ray_max_distances(h.number(0, 100));
+        if (h.chance(0.3)) request.set_ray_mask(h.integer(0, 7));
+        if (h.chance(0.3)) request.set_hits_per_ray(h.chance(0.1) ? 1000 : h.integer(0, 8));
+        v1::QueryResponse response;
+        return stub_->Query(&context, request, &response);
       }
       default: {
         *read_only = true;

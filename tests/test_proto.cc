@@ -65,7 +65,7 @@ TEST(Proto, ServiceHasEveryMethodOfTheApi) {
   ASSERT_NE(service, nullptr);
   for (const char* method :
        {"SpawnBodies", "RemoveBodies", "SetBodyState", "ApplyImpulse", "GetBodies", "LoadScene",
-        "Control", "GetInfo", "StreamFrames", "Snapshot", "Restore"})
+        "Control", "GetInfo", "StreamFrames", "Snapshot", "Restore", "Query"})
     EXPECT_NE(service->FindMethodByName(method), nullptr) << method;
   EXPECT_TRUE(service->FindMethodByName("StreamFrames")->server_streaming());
   // The generated server base class links.

@@ -66,6 +66,7 @@ Result<Body> make_body(const BodyDef& def) {
   body.force = def.force;
   body.torque = def.torque;
   body.filter = def.filter;
+  body.refresh_own_forces();
 
   const double density = def.mass > 0 ? def.mass / shape.value().volume() : def.density;
   MassProperties props = shape.value().mass_properties(

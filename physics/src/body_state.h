@@ -44,10 +44,14 @@ struct Body {
   bool is_static() const { return type == BodyType::kStatic; }
   bool is_moving() const { return type == BodyType::kDynamic && !asleep; }
   Pose pose() const { return {position, orientation}; }
-  // Anything beyond gravity and contacts: a held force or torque, another gravity, damping.
-  bool has_own_forces() const {
-    return gravity_scale != 1 || linear_damping != 0 || angular_damping != 0 ||
-           !force.isZero(0) || !torque.isZero(0);
+  // Anything beyond gravity and contacts: a held force or torque, another gravity, damping. Kept
+  // as a flag (refresh_own_forces after any of them changes): the step asks it of every body in
+  // every substep, and a world without pays one byte's test.
+  bool own_forces = false;
+  bool has_own_forces() const { return own_forces; }
+  void refresh_own_forces() {
+    own_forces = gravity_scale != 1 || linear_damping != 0 || angular_damping != 0 ||
+                 !force.isZero(0) || !torque.isZero(0);
   }
   // The most the body's velocity can change in a second from what acts on it alone, gravity's
   // (|gravity| given), the held force and torque's (at the shape's outer radius): m/s^2.

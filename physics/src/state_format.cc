@@ -209,6 +209,7 @@ void take_body_forces(Reader& r, Body* b) {
   b->torque = r.vec3("torque");
   b->filter.layers = r.take<std::uint32_t>("filter.layers");
   b->filter.mask = r.take<std::uint32_t>("filter.mask");
+  b->refresh_own_forces();
 }
 
 // A byte that must be 0 or 1.

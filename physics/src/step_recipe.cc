@@ -14,6 +14,7 @@ namespace tumble {
 Status World::step(double dt) {
   if (Status s = check_time_step(dt, settings_.limits); !s) return s;
   const auto start = std::chrono::steady_clock::now();
+  ++query_version_;  // the bodies move
   const std::uint64_t step_index = stats_.step + 1;
   stats_ = StepStats{};
   stats_.step = step_index;

@@ -13,6 +13,7 @@
 #include "broad_phase.h"
 #include "buffer_growth.h"
 #include "parallel.h"
+#include "query_index.h"
 #include "step_scratch.h"
 
 namespace tumble {
@@ -79,7 +80,9 @@ Status check_vector(const std::optional<Vec3>& v, const char* field) {
 }  // namespace
 
 World::World(const WorldSettings& settings)
-    : settings_(settings), scratch_(std::make_unique<StepScratch>()) {}
+    : settings_(settings),
+      scratch_(std::make_unique<StepScratch>()),
+      query_index_(std::make_unique<QueryIndex>()) {}
 World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
@@ -185,11 +188,13 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     if (!status) return status.within("bodies[" + std::to_string(i) + "].");
     made.push_back(std::move(body).value());
   }
+  ++query_version_;
   std::vector<BodyId> ids;
   ids.reserve(made.size());
   // The resting log's bound (resting_changed), so that steps never grow it.
   resting_log_.reserve(256 + (bodies_.size() + made.size()) / 4);
   for (Body& body : made) {
+    filters_used_ = filters_used_ || body.filter != CollisionFilter{};
     std::uint32_t index;
     if (!free_slots_.empty()) {
       index = free_slots_.back();
@@ -218,6 +223,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
 
 Status World::remove_body(BodyId id) {
   if (!contains(id)) return Status::not_found("body: no body with this id");
+  ++query_version_;
   remove_joints_of(id.index);
   Slot& slot = bodies_[id.index];
   wake_around(slot.body);                                     // whatever rested on it must fall
@@ -321,6 +327,7 @@ Status World::check_motion(BodyId id, const BodyMotion& motion) const {
 
 Status World::set_motion(BodyId id, const BodyMotion& motion) {
   if (Status s = check_motion(id, motion); !s) return s;
+  ++query_version_;
   Body& body = bodies_[id.index].body;
   if (body.is_static()) wake_around(body);  // what rested on it where it was
   if (motion.position) body.position = *motion.position;
@@ -333,9 +340,11 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
   if (motion.gravity_scale) body.gravity_scale = *motion.gravity_scale;
   if (motion.linear_damping) body.linear_damping = *motion.linear_damping;
   if (motion.angular_damping) body.angular_damping = *motion.angular_damping;
+  body.refresh_own_forces();
   // Bodies resting on it may no longer meet it (or may now): they wake, as does the body.
   if (motion.filter && *motion.filter != body.filter) {
     body.filter = *motion.filter;
+    filters_used_ = filters_used_ || body.filter != CollisionFilter{};
     wake_around(body);
   }
   body.update_world_inertia();
@@ -738,7 +747,7 @@ void World::find_contacts(double dt) {
         // Bodies a joint holds together do not collide unless it says so, nor bodies their
         // collision filters keep apart.
         if (!unjoined_pairs_.empty() && unjoined(pairs_[i].a, pairs_[i].b)) return 0u;
-        if (!a.filter.collides_with(b.filter)) return 0u;
+        if (filters_used_ && !a.filter.collides_with(b.filter)) return 0u;
         const Pose pose_a = a.pose(), pose_b = b.pose();
         CollisionSettings settings = settings_.collision;
         const bool fast = fast_[pairs_[i].a] || fast_[pairs_[i].b];

@@ -21,7 +21,8 @@ void World::sweep_fast_bodies(double /*dt*/) {
   s.swept_pairs.clear();
   for (std::uint32_t k = 0; k < pairs_.size(); ++k)
     if ((fast_[pairs_[k].a] || fast_[pairs_[k].b]) &&
-        bodies_[pairs_[k].a].body.filter.collides_with(bodies_[pairs_[k].b].body.filter))
+        (!filters_used_ ||
+         bodies_[pairs_[k].a].body.filter.collides_with(bodies_[pairs_[k].b].body.filter)))
       s.swept_pairs.push_back(k);
   s.impacts.resize(s.swept_pairs.size());
 

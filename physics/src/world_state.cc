@@ -239,6 +239,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     if (!world.bodies_[i].alive) continue;
     if (world.bodies_[i].body.asleep) world.link_sleeper(i, world.bodies_[i].body.sleep_island);
     if (world.bodies_[i].body.is_moving()) world.awake_.push_back(i);
+    world.filters_used_ = world.filters_used_ || world.bodies_[i].body.filter != CollisionFilter{};
   }
   world.live_count_ = live;
   world.time_ = state.time;

@@ -61,6 +61,9 @@ Result<std::string> LocalWorld::call(std::string_view method, std::string_view b
   } else if (method == "GetBodies") {
     answer = served<v1::GetBodiesRequest, v1::GetBodiesResponse>(
         bytes, [&](auto& r, auto* a) { return get_bodies(hosted_, r, a); });
+  } else if (method == "Query") {
+    answer = served<v1::QueryRequest, v1::QueryResponse>(
+        bytes, [&](auto& r, auto* a) { return query(hosted_, r, a); });
   } else if (method == "SetBodyState") {
     answer = served<v1::SetBodyStateRequest, v1::SetBodyStateResponse>(
         bytes, [&](auto& r, auto*) { return set_body_states(hosted_, r); });

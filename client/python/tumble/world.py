@@ -237,6 +237,66 @@ class WorldCalls:
     def body(self, body_id):
         return self.bodies([body_id])[0]
 
+    # --- queries ------------------------------------------------------------------------------
+
+    def cast_rays(self, origins, directions, max_distance=1000.0, *, mask=None, hits_per_ray=0):
+        """Casts N rays between two steps: origins and directions are (N, 3) arrays (m, world;
+        directions of any length but zero), max_distance one number or N (m). A ray meets the
+        bodies whose collision layers share a bit with `mask` (default every layer).
+
+        hits_per_ray=0 returns each ray's nearest hit as arrays of N rows: `hit` (bool), `body`
+        (ids, 0 for no hit), `distance` (m) and `fraction` (of max_distance; NaN for no hit),
+        `point` and `normal` ((N, 3), world; NaN for no hit). hits_per_ray=k (1 to 64) returns
+        each ray's first k hits, nearest first, as arrays over the hits with `ray` (which ray
+        each belongs to) and `counts` (hits per ray), and `left_out` (some ray met more)."""
+        origins = convert.points(origins, "origins")
+        directions = convert.points(directions, "directions")
+        if directions.shape != origins.shape:
+            raise ArgumentError(f"directions: expected shape {origins.shape}, got "
+                                f"{directions.shape}", "cast_rays")
+        request = pb.QueryRequest(ray_origins=origins.ravel().tolist(),
+                                  ray_directions=directions.ravel().tolist())
+        distances = np.asarray(max_distance, dtype=float).ravel()
+        request.ray_max_distances.extend(distances.tolist())
+        if mask is not None:
+            request.ray_mask = bits(mask, "mask")
+        if isinstance(hits_per_ray, bool) or not isinstance(hits_per_ray, int) or hits_per_ray < 0:
+            raise ArgumentError(f"hits_per_ray: expected an integer >= 0, got {hits_per_ray!r}",
+                                "cast_rays")
+        request.hits_per_ray = hits_per_ray
+        response = self._rpc("Query", request)
+        counts = np.array(response.hit_counts, dtype=np.int64)
+        ids = np.array(response.hit_ids, dtype=np.uint64)
+        distance = np.array(response.hit_distances)
+        fraction = np.array(response.hit_fractions)
+        point = np.array(response.hit_points).reshape(-1, 3)
+        normal = np.array(response.hit_normals).reshape(-1, 3)
+        if hits_per_ray > 0:
+            return SimpleNamespace(counts=counts, ray=np.repeat(np.arange(len(counts)), counts),
+                                   body=ids, distance=distance, fraction=fraction, point=point,
+                                   normal=normal, left_out=response.hits_left_out,
+                                   step=response.step)
+        hit = counts > 0
+        n = len(counts)
+        out = SimpleNamespace(hit=hit, body=np.zeros(n, dtype=np.uint64),
+                              distance=np.full(n, np.nan), fraction=np.full(n, np.nan),
+                              point=np.full((n, 3), np.nan), normal=np.full((n, 3), np.nan),
+                              step=response.step)
+        out.body[hit], out.distance[hit], out.fraction[hit] = ids, distance, fraction
+        out.point[hit], out.normal[hit] = point, normal
+        return out
+
+    def cast_ray(self, origin, direction, max_distance=1000.0, *, mask=None):
+        """One ray's nearest hit as a dict (body, distance, fraction, point, normal), or None."""
+        found = self.cast_rays([convert.array(origin, 3, "origin")],
+                               [convert.array(direction, 3, "direction")], max_distance,
+                               mask=mask)
+        if not found.hit[0]:
+            return None
+        return {"body": int(found.body[0]), "distance": float(found.distance[0]),
+                "fraction": float(found.fraction[0]), "point": found.point[0],
+                "normal": found.normal[0]}
+
     # --- joints -------------------------------------------------------------------------------
 
     def joint(self, kind, a, b=0, anchor=(0.0, 0.0, 0.0), *, anchor_b=None, axis=None,

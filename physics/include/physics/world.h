@@ -13,6 +13,7 @@
 #include "physics/body_view.h"
 #include "physics/collision.h"
 #include "physics/joint.h"
+#include "physics/query.h"
 #include "physics/limits.h"
 #include "physics/math.h"
 #include "physics/status.h"
@@ -76,6 +77,7 @@ struct ImpulseAt {
 
 struct StepScratch;
 struct Joint;
+class QueryIndex;
 struct JointSlot;
 
 // What happened to a body since the world's events were last cleared (World::body_events): the
@@ -227,6 +229,17 @@ class World {
 
   // Broad phase: pairs of bodies whose world bounds (grown by the contact margin) overlap, at
   // least one of them dynamic, sorted, unique.
+  // Ray casts (physics/query.h), between steps (not during one); they read the world and may run
+  // from several threads at once. The nearest body each ray meets (RayHit::hit() false for none),
+  // one ray or a batch spread over the world's threads (the same answers for any thread count);
+  // a ray refused names its entry ("rays[3].direction: must not be zero") and nothing is cast.
+  Result<RayHit> cast_ray(const RayCast& ray) const;
+  Status cast_rays(std::span<const RayCast> rays, std::span<RayHit> hits) const;
+  // Every body the ray meets, nearest first (ties by slot), at most max_hits of them: true when
+  // some were left out.
+  Result<bool> cast_ray_all(const RayCast& ray, std::size_t max_hits,
+                            std::vector<RayHit>* hits) const;
+
   std::span<const BodyPair> find_pairs();
   // Broad and narrow phase: every touching pair's manifold, in pair order.
   std::span<const Contact> find_contacts();
@@ -345,6 +358,14 @@ class World {
   std::uint32_t fast_count_ = 0;
   std::vector<double> impulses_;
   std::unique_ptr<StepScratch> scratch_;
+  // Queries' tree of the bodies' bounds (physics/src/query_index.h), rebuilt when the version
+  // it was built for is not query_version_ (every step and change of bodies moves it on).
+  std::unique_ptr<QueryIndex> query_index_;
+  std::uint64_t query_version_ = 0;
+  // Whether any body ever had a collision filter other than the default: until one does, pairs
+  // are not asked (a world without filters pays nothing for them).
+  bool filters_used_ = false;
+  const QueryIndex& query_index() const;
   StepStats stats_;
   double time_ = 0;
 };

@@ -1,0 +1,38 @@
+// Asking the world what is there, between steps: ray casts (World::cast_ray, cast_rays,
+// cast_ray_all). A query reads the world and changes nothing; batches spread over the world's
+// threads and give the same answers for any thread count.
+#pragma once
+
+#include <cstdint>
+
+#include "physics/body.h"
+#include "physics/math.h"
+#include "physics/status.h"
+
+namespace tumble {
+
+// m: the longest ray a query may ask for (a ray across the whole world of limits.max_coordinate).
+inline constexpr double kMaxRayLength = 1e10;
+
+struct RayCast {
+  Vec3 origin = Vec3::Zero();     // m, world
+  Vec3 direction = Vec3::UnitX(); // world; any length but zero (it is normalised)
+  double max_distance = 1e3;      // m along the direction, > 0 and <= kMaxRayLength
+  // The layers it meets: a body is hit when its collision layers share a bit with this mask
+  // (CollisionFilter::layers).
+  std::uint32_t mask = 0xFFFFFFFF;
+};
+
+struct RayHit {
+  BodyId body;             // invalid: no hit
+  double distance = 0;     // m from the origin along the (normalised) direction
+  double fraction = 0;     // distance / max_distance, in [0, 1]
+  Vec3 point = Vec3::Zero();   // m, world
+  Vec3 normal = Vec3::Zero();  // unit, world, the surface's outward normal at the point
+  bool hit() const { return body.is_valid(); }
+};
+
+// Checks a ray; the message names the field ("direction: must not be zero").
+Status validate(const RayCast& ray);
+
+}  // namespace tumble

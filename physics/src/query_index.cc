@@ -1,0 +1,71 @@
+#include "query_index.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace tumble {
+
+void QueryIndex::build(std::span<const Entry> entries) {
+  entries_.clear();
+  unbounded_.clear();
+  nodes_.clear();
+  for (const Entry& entry : entries) {
+    if (entry.bounds.is_bounded())
+      entries_.push_back(entry);
+    else
+      unbounded_.push_back(entry.slot);
+  }
+  if (entries_.empty()) return;
+  nodes_.reserve(2 * entries_.size() / kLeafSize + 2);
+  build_node(0, static_cast<std::uint32_t>(entries_.size()));
+}
+
+std::uint32_t QueryIndex::build_node(std::uint32_t begin, std::uint32_t end) {
+  const std::uint32_t index = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.push_back({});
+  Aabb bounds, centres;
+  for (std::uint32_t k = begin; k < end; ++k) {
+    bounds.grow(entries_[k].bounds.min);
+    bounds.grow(entries_[k].bounds.max);
+    centres.grow(0.5 * (entries_[k].bounds.min + entries_[k].bounds.max));
+  }
+  nodes_[index].bounds = bounds;
+  if (end - begin <= kLeafSize) {
+    nodes_[index].first = begin;
+    nodes_[index].count = end - begin;
+    return index;
+  }
+  int axis = 0;
+  centres.extent().maxCoeff(&axis);
+  const std::uint32_t middle = begin + (end - begin) / 2;
+  // Ties broken by slot: the same tree for the same bodies, whatever order they came in.
+  std::nth_element(entries_.begin() + begin, entries_.begin() + middle, entries_.begin() + end,
+                   [axis](const Entry& a, const Entry& b) {
+                     const double ca = a.bounds.min[axis] + a.bounds.max[axis];
+                     const double cb = b.bounds.min[axis] + b.bounds.max[axis];
+                     return ca < cb || (ca == cb && a.slot < b.slot);
+                   });
+  build_node(begin, middle);  // index + 1
+  const std::uint32_t second = build_node(middle, end);
+  nodes_[index].first = second;
+  nodes_[index].count = 0;
+  return index;
+}
+
+double QueryIndex::enter(const Aabb& box, const Vec3& origin, const Vec3& inverse, double t_max) {
+  double near = 0, far = t_max;
+  for (int k = 0; k < 3; ++k) {
+    // With inverse = +-inf (a ray parallel to the slab) the products are +-inf, or NaN when the
+    // origin lies on the slab's plane; std::min/max with NaN second keep the first, so such an
+    // axis is treated as inside, conservatively.
+    double a = (box.min[k] - origin[k]) * inverse[k];
+    double b = (box.max[k] - origin[k]) * inverse[k];
+    if (a > b) std::swap(a, b);
+    near = std::max(near, a);
+    far = std::min(far, b);
+    if (near > far) return std::numeric_limits<double>::infinity();
+  }
+  return near;
+}
+
+}  // namespace tumble

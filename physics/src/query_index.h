@@ -1,0 +1,87 @@
+// The bodies' bounds in a tree for queries (World::cast_ray and kin): a bounding-volume
+// hierarchy built on demand, top down by median splits along the widest axis of the boxes'
+// centres (O(n log n); a few leaves of at most kLeafSize bodies), and kept until a step or a
+// change of bodies makes it stale. A ray visits the nearer child first and skips boxes it enters
+// beyond the nearest hit so far. Bodies without bounds (half-spaces) are kept aside and tried by
+// every ray.
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <span>
+#include <vector>
+
+#include "physics/math.h"
+
+namespace tumble {
+
+class QueryIndex {
+ public:
+  struct Entry {
+    std::uint32_t slot;
+    Aabb bounds;
+  };
+  // Replaces the tree with one over `entries` (bounded or not).
+  void build(std::span<const Entry> entries);
+
+  // Calls visit(slot, t_max) for every body whose box the ray origin + t direction (unit),
+  // t in [0, t_max], meets, nearer boxes first; visit returns the new t_max (the ray shortened to
+  // the nearest hit so far, or as it was).
+  template <class Visit>
+  void visit_ray(const Vec3& origin, const Vec3& direction, double t_max, Visit&& visit) const;
+
+  // The version of the world this tree was built for (World's query version), and the lock that
+  // lets one thread build it while queries from others wait.
+  std::uint64_t version = ~std::uint64_t{0};
+  std::mutex building;
+
+ private:
+  static constexpr int kLeafSize = 4;
+  struct Node {
+    Aabb bounds;
+    std::uint32_t first = 0;  // leaf: its first entry; inner: its second child (the first is next)
+    std::uint32_t count = 0;  // leaf: entries; inner: 0
+  };
+  std::uint32_t build_node(std::uint32_t begin, std::uint32_t end);
+  // Where the ray enters the box (t in [0, t_max]), or +infinity if it misses it.
+  static double enter(const Aabb& box, const Vec3& origin, const Vec3& inverse, double t_max);
+
+  std::vector<Node> nodes_;
+  std::vector<Entry> entries_;        // bounded, in the tree's order
+  std::vector<std::uint32_t> unbounded_;  // slots of bodies without bounds
+};
+
+template <class Visit>
+void QueryIndex::visit_ray(const Vec3& origin, const Vec3& direction, double t_max,
+                           Visit&& visit) const {
+  for (std::uint32_t slot : unbounded_)
+    t_max = visit(slot, t_max);
+  if (nodes_.empty()) return;
+  const Vec3 inverse = direction.cwiseInverse();  // +-inf along an axis the ray does not move on
+  // Depth is O(log n) (median splits): 64 entries hold any tree of up to 2^60 bodies.
+  std::uint32_t stack[64];
+  int depth = 0;
+  if (enter(nodes_[0].bounds, origin, inverse, t_max) > t_max) return;
+  stack[depth++] = 0;
+  while (depth > 0) {
+    const std::uint32_t index = stack[--depth];
+    const Node& node = nodes_[index];
+    if (node.count > 0) {
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+        if (enter(entries_[k].bounds, origin, inverse, t_max) <= t_max)
+          t_max = visit(entries_[k].slot, t_max);
+      continue;
+    }
+    const std::uint32_t near = index + 1, far = node.first;
+    const double t_near = enter(nodes_[near].bounds, origin, inverse, t_max);
+    const double t_far = enter(nodes_[far].bounds, origin, inverse, t_max);
+    // The nearer child is popped first; each is pushed only if the ray reaches it.
+    const bool swap = t_far < t_near;
+    const std::uint32_t first = swap ? far : near, second = swap ? near : far;
+    const double t_first = swap ? t_far : t_near, t_second = swap ? t_near : t_far;
+    if (t_second <= t_max) stack[depth++] = second;
+    if (t_first <= t_max) stack[depth++] = first;
+  }
+}
+
+}  // namespace tumble

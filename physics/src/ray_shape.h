@@ -1,0 +1,22 @@
+// A ray against one shape, in the shape's frame: the exact entry point of each shape kind
+// (closed forms for spheres, capsules, boxes and half-spaces; Cyrus and Beck's clipping against a
+// hull's face planes, 1978).
+#pragma once
+
+#include "physics/math.h"
+#include "physics/shape.h"
+
+namespace tumble {
+
+struct ShapeRayHit {
+  double t = 0;                // along the unit direction
+  Vec3 normal = Vec3::Zero();  // unit, outward, shape frame
+};
+
+// Where the ray origin + t direction (direction of unit length) first enters the shape with t in
+// [0, max_t]; false if it does not. A ray that starts inside the shape hits at t = 0 with the
+// normal against the direction (as Jolt reports it: the query is already touching).
+bool ray_shape(const Shape& shape, const Vec3& origin, const Vec3& direction, double max_t,
+               ShapeRayHit* hit);
+
+}  // namespace tumble

@@ -1,0 +1,286 @@
+// Ray casts (physics/query.h) against closed forms for every shape, against a brute-force pass
+// over every body (the query tree must change nothing but the cost), with filters, every hit
+// along a ray, any thread count, a world that moved since the last query, and refusals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "physics/world.h"
+#include "test_support.h"
+
+namespace tumble {
+namespace {
+
+BodyId add(World* world, ShapeDef shape, const Vec3& position,
+           const Quat& orientation = Quat::Identity(), BodyType type = BodyType::kStatic) {
+  BodyDef def;
+  def.shape = std::move(shape);
+  def.position = position;
+  def.orientation = orientation;
+  def.type = type;
+  return world->create_body(def).value();
+}
+
+RayCast ray_from(const Vec3& origin, const Vec3& direction, double max_distance = 100) {
+  RayCast ray;
+  ray.origin = origin;
+  ray.direction = direction;
+  ray.max_distance = max_distance;
+  return ray;
+}
+
+TEST(RayCasts, EveryShapeAgainstClosedForms) {
+  World world;
+  const BodyId sphere = add(&world, SphereDef{1}, Vec3(0, 0, 5));
+  // A box turned 45 degrees about z: its corner edge faces -x.
+  const Quat turned(Eigen::AngleAxisd(std::numbers::pi / 4, Vec3::UnitZ()));
+  const BodyId box = add(&world, BoxDef{Vec3(1, 1, 1)}, Vec3(10, 0, 0), turned);
+  // A capsule lying along x (its axis is the body's z).
+  const Quat lying(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()));
+  const BodyId capsule = add(&world, CapsuleDef{0.5, 2}, Vec3(0, 10, 0), lying);
+
+  RayHit hit = world.cast_ray(ray_from(Vec3(0, 0, 0), Vec3(0, 0, 2))).value();
+  ASSERT_TRUE(hit.hit());
+  EXPECT_EQ(hit.body, sphere);
+  EXPECT_NEAR(hit.distance, 4, 1e-12);
+  EXPECT_NEAR(hit.fraction, 0.04, 1e-14);
+  EXPECT_TRUE(hit.point.isApprox(Vec3(0, 0, 4), 1e-12));
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(0, 0, -1), 1e-12));
+
+  // Along +x at y = 0.5 the turned box's face x - y = -sqrt(2) (+10) is met at x = 10 - sqrt 2 + 0.5.
+  hit = world.cast_ray(ray_from(Vec3(0, 0.5, 0), Vec3(1, 0, 0))).value();
+  ASSERT_TRUE(hit.hit());
+  EXPECT_EQ(hit.body, box);
+  EXPECT_NEAR(hit.point.x(), 10 - std::sqrt(2.0) + 0.5, 1e-12);
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(-1, 1, 0).normalized(), 1e-12));
+
+  // Down onto the lying capsule's side at x = 1 (within its core), and onto its end cap.
+  hit = world.cast_ray(ray_from(Vec3(1, 10, 5), Vec3(0, 0, -1))).value();
+  ASSERT_TRUE(hit.hit());
+  EXPECT_EQ(hit.body, capsule);
+  EXPECT_NEAR(hit.distance, 4.5, 1e-12);
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(0, 0, 1), 1e-12));
+  hit = world.cast_ray(ray_from(Vec3(-9, 10, 0), Vec3(1, 0, 0))).value();
+  ASSERT_TRUE(hit.hit());
+  EXPECT_NEAR(hit.point.x(), -2.5, 1e-12);
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(-1, 0, 0), 1e-12));
+
+  // Misses: past the sphere's side, short of the box, away from everything.
+  EXPECT_FALSE(world.cast_ray(ray_from(Vec3(1.01, 0, 0), Vec3(0, 0, 1))).value().hit());
+  EXPECT_FALSE(world.cast_ray(ray_from(Vec3(0, 0.5, 0), Vec3(1, 0, 0), 8)).value().hit());
+  EXPECT_FALSE(world.cast_ray(ray_from(Vec3(0, 0, 0), Vec3(0, 0, -1))).value().hit());
+
+  // From inside: distance 0, the normal against the ray.
+  hit = world.cast_ray(ray_from(Vec3(0, 0, 5.5), Vec3(1, 0, 0))).value();
+  EXPECT_EQ(hit.body, sphere);
+  EXPECT_EQ(hit.distance, 0);
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(-1, 0, 0), 1e-12));
+}
+
+TEST(RayCasts, AHullAndAPlane) {
+  World world;
+  add(&world, HalfSpaceDef{}, Vec3(0, 0, 0));
+  // A tetrahedron with a face on z = 1: (0,0,1), (2,0,1), (0,2,1) and an apex at (0,0,3).
+  HullDef tetra{{Vec3(0, 0, 1), Vec3(2, 0, 1), Vec3(0, 2, 1), Vec3(0, 0, 3)}};
+  const BodyId hull = add(&world, tetra, Vec3::Zero());
+  // Straight up from below its base: the ground first (the ray starts in it, at 0)...
+  RayHit hit = world.cast_ray(ray_from(Vec3(0.5, 0.5, -1), Vec3(0, 0, 1))).value();
+  EXPECT_EQ(hit.distance, 0);
+  // ... and from above the ground, its base at z = 1.
+  hit = world.cast_ray(ray_from(Vec3(0.5, 0.5, 0.5), Vec3(0, 0, 1))).value();
+  ASSERT_TRUE(hit.hit());
+  EXPECT_EQ(hit.body, hull);
+  EXPECT_NEAR(hit.distance, 0.5, 1e-12);
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(0, 0, -1), 1e-12));
+  // Down from above: the slanted face x + y + z = 3 (normal (1,1,1)/sqrt 3) at z = 2.
+  hit = world.cast_ray(ray_from(Vec3(0.5, 0.5, 5), Vec3(0, 0, -1))).value();
+  EXPECT_EQ(hit.body, hull);
+  EXPECT_NEAR(hit.point.z(), 2, 1e-12);
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(1, 1, 1).normalized(), 1e-12));
+  // Beside it, down to the ground.
+  hit = world.cast_ray(ray_from(Vec3(3, 3, 5), Vec3(0, 0, -1))).value();
+  EXPECT_NE(hit.body, hull);
+  EXPECT_NEAR(hit.distance, 5, 1e-12);
+  EXPECT_TRUE(hit.normal.isApprox(Vec3(0, 0, 1), 1e-15));
+}
+
+// Random bodies of every kind, and a brute-force pass over all of them with each body's own test.
+struct Crowd {
+  World world;
+  std::vector<BodyId> ids;
+};
+
+void make_crowd(Crowd* c, int count, std::uint64_t seed) {
+  testing::Random random(seed);
+  for (int i = 0; i < count; ++i) {
+    const Vec3 position = random.vector(-10, 10);
+    const Quat orientation = random.rotation();
+    ShapeDef shape;
+    switch (i % 4) {
+      case 0: shape = SphereDef{0.2 + random.uniform()}; break;
+      case 1: shape = BoxDef{Vec3(0.2, 0.2, 0.2) + random.vector(0, 1)}; break;
+      case 2: shape = CapsuleDef{0.2 + 0.5 * random.uniform(), 0.2 + random.uniform()}; break;
+      default: {
+        HullDef hull;
+        for (int k = 0; k < 12; ++k)
+          hull.points.push_back(random.vector(-1, 1));
+        shape = hull;
+      }
+    }
+    c->ids.push_back(add(&c->world, shape, position, orientation, BodyType::kDynamic));
+  }
+}
+
+std::vector<RayCast> random_rays(int count, std::uint64_t seed) {
+  testing::Random random(seed);
+  std::vector<RayCast> rays;
+  for (int i = 0; i < count; ++i) {
+    RayCast ray = ray_from(random.vector(-15, 15), random.vector(-1, 1), 5 + 40 * random.uniform());
+    if (i % 7 == 0) ray.direction = Vec3::UnitX();  // rays along an axis: the tree's edge case
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
+TEST(RayCasts, TheTreeFindsWhatEveryBodyTestedFindsAndOnAnyThreadCount) {
+  Crowd crowd;
+  make_crowd(&crowd, 400, 7);
+  const std::vector<RayCast> rays = random_rays(3000, 11);
+  std::vector<RayHit> hits(rays.size());
+  ASSERT_TRUE(crowd.world.cast_rays(rays, hits).is_ok());
+  int found = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    // Brute force: every body alone, as a one-body ray of every hit (cast_ray_all with no tree
+    // pruning); the nearest of them.
+    std::vector<RayHit> all;
+    ASSERT_TRUE(crowd.world.cast_ray_all(rays[i], 1000, &all).ok());
+    if (all.empty()) {
+      EXPECT_FALSE(hits[i].hit()) << i;
+      continue;
+    }
+    ++found;
+    ASSERT_TRUE(hits[i].hit()) << i;
+    EXPECT_EQ(hits[i].body, all[0].body) << i;
+    EXPECT_EQ(hits[i].distance, all[0].distance) << i;
+    EXPECT_EQ(hits[i].point, all[0].point) << i;
+    // The point is where the ray says, and inside or on no body before it.
+    EXPECT_NEAR((hits[i].point - rays[i].origin).norm(), hits[i].distance, 1e-9);
+  }
+  // The test means something: hundreds of hits and of misses (776 and 2224 with these seeds).
+  EXPECT_GT(found, 500);
+  EXPECT_GT(static_cast<int>(rays.size()) - found, 500);
+  // Two threads: the same bits.
+  WorldSettings two = crowd.world.settings();
+  two.threads = 2;
+  ASSERT_TRUE(crowd.world.set_settings(two).is_ok());
+  std::vector<RayHit> again(rays.size());
+  ASSERT_TRUE(crowd.world.cast_rays(rays, again).is_ok());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    EXPECT_EQ(again[i].body, hits[i].body);
+    EXPECT_EQ(again[i].distance, hits[i].distance);
+    EXPECT_EQ(again[i].normal, hits[i].normal);
+  }
+}
+
+TEST(RayCasts, BruteForceOverEveryBodyAgrees) {
+  // The brute force above shares the tree's walk; this one does not: every body is removed but
+  // one, in turn, and the ray cast against that one alone.
+  Crowd crowd;
+  make_crowd(&crowd, 24, 3);
+  const std::vector<RayCast> rays = random_rays(400, 5);
+  std::vector<RayHit> hits(rays.size());
+  ASSERT_TRUE(crowd.world.cast_rays(rays, hits).is_ok());
+  std::vector<RayHit> nearest(rays.size());
+  const std::string state = crowd.world.save_state();
+  for (std::size_t b = 0; b < crowd.ids.size(); ++b) {
+    World alone = World::from_state(crowd.world.settings(), state).value();
+    for (std::size_t other = 0; other < crowd.ids.size(); ++other)
+      if (other != b) ASSERT_TRUE(alone.remove_body(crowd.ids[other]).is_ok());
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const RayHit hit = alone.cast_ray(rays[i]).value();
+      if (hit.hit() && (!nearest[i].hit() || hit.distance < nearest[i].distance)) nearest[i] = hit;
+    }
+  }
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    ASSERT_EQ(hits[i].hit(), nearest[i].hit()) << i;
+    if (!hits[i].hit()) continue;
+    EXPECT_EQ(hits[i].body, nearest[i].body) << i;
+    EXPECT_NEAR(hits[i].distance, nearest[i].distance, 1e-9) << i;
+  }
+}
+
+TEST(RayCasts, FiltersEveryHitAndAWorldThatMoved) {
+  World world;
+  std::vector<BodyId> row;
+  for (int k = 0; k < 5; ++k)
+    row.push_back(add(&world, BoxDef{Vec3(0.25, 0.25, 0.25)}, Vec3(2.0 * (k + 1), 0, 0)));
+  BodyDef ghost_def;
+  ghost_def.shape = SphereDef{0.5};
+  ghost_def.type = BodyType::kStatic;
+  ghost_def.position = Vec3(1, 0, 0);
+  ghost_def.filter.layers = 2;
+  const BodyId ghost = world.create_body(ghost_def).value();
+
+  RayCast ray = ray_from(Vec3(0, 0, 0), Vec3(1, 0, 0));
+  EXPECT_EQ(world.cast_ray(ray).value().body, ghost);
+  ray.mask = ~std::uint32_t{2};  // not layer 2: through the ghost to the first box
+  EXPECT_EQ(world.cast_ray(ray).value().body, row[0]);
+
+  std::vector<RayHit> all;
+  Result<bool> more = world.cast_ray_all(ray, 3, &all);
+  ASSERT_TRUE(more.ok());
+  EXPECT_TRUE(more.value());
+  ASSERT_EQ(all.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(all[k].body, row[k]);
+    EXPECT_NEAR(all[k].distance, 2.0 * (k + 1) - 0.25, 1e-12);
+  }
+  ASSERT_TRUE(world.cast_ray_all(ray, 10, &all).ok());
+  EXPECT_EQ(all.size(), 5u);
+
+  // The first box moved away, the second removed: the next query sees the third.
+  BodyMotion away;
+  away.position = Vec3(0, 50, 0);
+  ASSERT_TRUE(world.set_motion(row[0], away).is_ok());
+  ASSERT_TRUE(world.remove_body(row[1]).is_ok());
+  EXPECT_EQ(world.cast_ray(ray).value().body, row[2]);
+  // A falling sphere is found where the step left it.
+  const BodyId ball = add(&world, SphereDef{0.5}, Vec3(20, 0, 10), Quat::Identity(),
+                          BodyType::kDynamic);
+  const RayCast down = ray_from(Vec3(20, 0, 20), Vec3(0, 0, -1));
+  EXPECT_NEAR(world.cast_ray(down).value().distance, 9.5, 1e-12);
+  ASSERT_TRUE(world.step(0.5).is_ok());
+  const RayHit after = world.cast_ray(down).value();
+  EXPECT_EQ(after.body, ball);
+  EXPECT_LT(world.body(ball)->position().z(), 9);
+  EXPECT_NEAR(after.point.z(), world.body(ball)->position().z() + 0.5, 1e-12);
+}
+
+TEST(RayCasts, BadRaysAreRefusedNamingTheField) {
+  World world;
+  add(&world, SphereDef{1}, Vec3(0, 0, 5));
+  auto refused = [&](const RayCast& ray, const std::string& field) {
+    Result<RayHit> hit = world.cast_ray(ray);
+    ASSERT_FALSE(hit.ok()) << field;
+    EXPECT_EQ(hit.error().rfind(field + ":", 0), 0u) << hit.error();
+  };
+  refused(ray_from(Vec3(0, 0, 0), Vec3::Zero()), "direction");
+  refused(ray_from(Vec3(0, 0, 0), Vec3(NAN, 0, 1)), "direction");
+  refused(ray_from(Vec3(INFINITY, 0, 0), Vec3(0, 0, 1)), "origin");
+  refused(ray_from(Vec3(0, 0, 0), Vec3(0, 0, 1), 0), "max_distance");
+  refused(ray_from(Vec3(0, 0, 0), Vec3(0, 0, 1), INFINITY), "max_distance");
+  refused(ray_from(Vec3(0, 0, 0), Vec3(0, 0, 1), 2e10), "max_distance");
+  std::vector<RayCast> rays(3, ray_from(Vec3(0, 0, 0), Vec3(0, 0, 1)));
+  rays[2].direction = Vec3::Zero();
+  std::vector<RayHit> hits(3);
+  const Status s = world.cast_rays(rays, hits);
+  ASSERT_FALSE(s.is_ok());
+  EXPECT_EQ(s.message().rfind("rays[2].direction:", 0), 0u) << s.message();
+  EXPECT_FALSE(hits[0].hit());  // nothing was cast
+}
+
+}  // namespace
+}  // namespace tumble
