@@ -86,6 +86,18 @@ struct SpawnOptions {
   }
 };
 
+// The shape's options spawn and overlap share.
+void add_shape_options(CLI::App* command, SpawnOptions* options) {
+  command->add_option("shape", options->shape, "box, sphere or capsule")
+      ->required()
+      ->check(CLI::IsMember({"box", "sphere", "capsule"}));
+  command->add_option("--size", options->size, "box: full extents x,y,z (m)")
+      ->delimiter(',')
+      ->expected(3);
+  command->add_option("--radius", options->radius, "sphere, capsule: radius (m)");
+  command->add_option("--half-height", options->half_height, "capsule: half the core length (m)");
+}
+
 // The options spawn and set-state share: what acts on a body beyond gravity and contacts, and
 // its collision filter.
 void add_body_force_options(CLI::App* command, std::optional<double>* gravity_scale,
@@ -207,14 +219,7 @@ int main(int argc, char** argv) {
 
   CLI::App* spawn = app.add_subcommand("spawn", "add one body; prints its id");
   SpawnOptions body;
-  spawn->add_option("shape", body.shape, "box, sphere or capsule")
-      ->required()
-      ->check(CLI::IsMember({"box", "sphere", "capsule"}));
-  spawn->add_option("--size", body.size, "box: full extents x,y,z (m)")
-      ->delimiter(',')
-      ->expected(3);
-  spawn->add_option("--radius", body.radius, "sphere, capsule: radius (m)");
-  spawn->add_option("--half-height", body.half_height, "capsule: half the core length (m)");
+  add_shape_options(spawn, &body);
   spawn->add_option("--mass", body.mass, "kg (default: from a density of 1000 kg/m^3)");
   spawn->add_option("--position,--pos", body.position, "x,y,z (m)")->delimiter(',')->expected(3);
   spawn->add_option("--linear-velocity,--vel", body.velocity, "x,y,z (m/s)")
@@ -283,6 +288,16 @@ int main(int argc, char** argv) {
   ray->add_option("--max-distance", ray_max_distance, "m (default 1000)");
   ray->add_option("--mask", ray_mask, "meet only bodies in these collision layers (bits)");
   ray->add_option("--hits", ray_hits, "up to this many hits, nearest first (default: the nearest)");
+
+  CLI::App* overlap =
+      app.add_subcommand("overlap", "the bodies a shape placed in the world overlaps, as JSON");
+  SpawnOptions probe;
+  add_shape_options(overlap, &probe);
+  overlap->add_option("--position,--pos", probe.position, "x,y,z (m)")
+      ->delimiter(',')
+      ->expected(3);
+  std::optional<std::uint32_t> overlap_mask;
+  overlap->add_option("--mask", overlap_mask, "meet only bodies in these collision layers (bits)");
 
   CLI::App* impulse = app.add_subcommand("impulse", "apply an impulse to a body (it wakes)");
   std::vector<double> impulse_value, impulse_point;
@@ -598,6 +613,16 @@ int main(int argc, char** argv) {
                      .dump());
     }
     if (r.hits_left_out()) std::fprintf(stderr, "ray: more hits were left out (--hits)\n");
+  } else if (*overlap) {
+    v1::QueryRequest request;
+    v1::OverlapQuery* query = request.add_overlaps();
+    const v1::BodySpec spec = probe.spec();
+    *query->mutable_shape() = spec.shape();
+    *query->mutable_position() = spec.position();
+    if (overlap_mask) query->set_mask(*overlap_mask);
+    Result<v1::QueryResponse> found = client.query(request);
+    if (!found) return fail("overlap", found.status());
+    print_line(nlohmann::json{{"ids", found.value().overlap_ids()}}.dump());
   } else if (*impulse) {
     v1::Impulse applied;
     applied.set_id(body_id);

@@ -70,6 +70,10 @@ Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
 
 }  // namespace
 
+Result<ShapeDef> shape_def_from_proto(const v1::Shape& shape) {
+  return shape_from_proto(shape);
+}
+
 Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   BodyDef def;
   Result<ShapeDef> shape = shape_from_proto(spec.shape());

@@ -20,6 +20,9 @@ void vec_to_proto(const Vec3& v, v1::Vec3* out);
 BodyMotion motion_from_proto(const v1::BodyStateUpdate& update,
                              const CollisionFilter& current_filter);
 
+// A shape as the engine defines it, or why the message is not one ("shape: required ...").
+Result<ShapeDef> shape_def_from_proto(const v1::Shape& shape);
+
 // What a viewer needs to draw the body with wire id `id`.
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
 // What acts on it beyond gravity and contacts, and its collision filter (GetBodies).

@@ -177,8 +177,9 @@ MethodBounds RequestBounds::of(std::string_view method) const {
     return {capped(kIdBytes * n + kKiB), n};
   if (method == "SetBodyState") return {capped(kUpdateBytes * n + kKiB), n};
   if (method == "ApplyImpulse") return {capped(kImpulseBytes * n + kKiB), n};
-  // Six numbers and a distance a ray, in packed arrays (world_commands.h, kMaxQueryRays).
-  if (method == "Query") return {capped(kRayBytes * kMaxQueryRays + kKiB), 0};
+  // Six numbers and a distance a ray, in packed arrays (kMaxQueryRays).
+  // Overlaps' shapes: a few hulls of the most points, as SpawnBodies' slack allows.
+  if (method == "Query") return {capped(kRayBytes * kMaxQueryRays + kSlack), 0};
   // A world holds at most two joints a body (scenes/scene.h, kJointsPerBody).
   const std::size_t joints = 2 * n;
   if (method == "CreateJoints") return {capped(kJointSpecBytes * joints + kKiB), joints};

@@ -19,6 +19,8 @@ namespace tumble::server {
 // A query casts at most this many rays and answers at most this many hits (a ray's nearest, or
 // up to kMaxHitsPerRay each): its cost and its answer's size are bounded before it runs.
 inline constexpr std::size_t kMaxQueryRays = 262144, kMaxQueryHits = 262144, kMaxHitsPerRay = 64;
+// Overlap queries a request may hold; their bodies count against kMaxQueryHits.
+inline constexpr std::size_t kMaxQueryOverlaps = 256;
 
 // The largest request of each method, in bytes on the wire (after decompression).
 struct MethodBounds {

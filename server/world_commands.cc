@@ -148,6 +148,24 @@ Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
                              std::to_string(per_ray) +
                              " hits is above the 262144 hits a query may answer",
                          StatusCode::kResourceExhausted);
+  if (static_cast<std::size_t>(request.overlaps_size()) > kMaxQueryOverlaps)
+    return Status::error("overlaps: " + std::to_string(request.overlaps_size()) +
+                             " queries, above the 256 a request may hold",
+                         StatusCode::kResourceExhausted);
+  std::vector<OverlapQuery> overlaps(request.overlaps_size());
+  for (int i = 0; i < request.overlaps_size(); ++i) {
+    const v1::OverlapQuery& asked = request.overlaps(i);
+    const std::string at = "overlaps[" + std::to_string(i) + "].";
+    Result<ShapeDef> shape = shape_def_from_proto(asked.shape());
+    if (!shape) return shape.status().within(at);
+    overlaps[i].shape = std::move(shape).value();
+    overlaps[i].pose.position = vec_from_proto(asked.position());
+    if (asked.has_orientation()) {
+      const v1::Quat& q = asked.orientation();
+      overlaps[i].pose.orientation = Quat(q.w(), q.x(), q.y(), q.z());
+    }
+    if (asked.has_mask()) overlaps[i].mask = asked.mask();
+  }
   std::vector<RayCast> rays(n);
   for (std::size_t i = 0; i < n; ++i) {
     RayCast& ray = rays[i];
@@ -161,6 +179,19 @@ Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
   }
   const World& world = hosted.world;
   response->set_step(world.step_count());
+  // Overlaps first (each refused before any answer is kept), the rays after: a refused overlap
+  // leaves no half-written answer.
+  std::vector<BodyId> bodies;
+  std::size_t room = kMaxQueryHits;
+  for (std::size_t i = 0; i < overlaps.size(); ++i) {
+    Result<bool> left_out = world.overlap(overlaps[i], room, &bodies);
+    if (!left_out) return left_out.status().within("overlaps[" + std::to_string(i) + "].");
+    response->set_overlaps_left_out(response->overlaps_left_out() || left_out.value());
+    response->add_overlap_counts(static_cast<std::uint32_t>(bodies.size()));
+    for (BodyId id : bodies)
+      response->add_overlap_ids(hosted.ids.wire(id));
+    room -= bodies.size();
+  }
   auto add_hit = [&](const RayHit& hit) {
     response->add_hit_ids(hosted.ids.wire(hit.body));
     response->add_hit_distances(hit.distance);

@@ -395,6 +395,14 @@ class FuzzService {
           request.add_ray_max_distances(h.number(0, 100));
         if (h.chance(0.3)) request.set_ray_mask(h.integer(0, 7));
         if (h.chance(0.3)) request.set_hits_per_ray(h.chance(0.1) ? 1000 : h.integer(0, 8));
+        for (int n = h.chance(0.02) ? 300 : h.integer(0, 2); n > 0; --n) {
+          v1::OverlapQuery* overlap = request.add_overlaps();
+          const v1::BodySpec spec = body(h);  // its shape, position and orientation
+          *overlap->mutable_shape() = spec.shape();
+          *overlap->mutable_position() = spec.position();
+          if (spec.has_orientation()) *overlap->mutable_orientation() = spec.orientation();
+          if (h.chance(0.2)) overlap->set_mask(h.integer(0, 7));
+        }
         v1::QueryResponse response;
         return stub_->Query(&context, request, &response);
       }

@@ -282,5 +282,66 @@ TEST(RayCasts, BadRaysAreRefusedNamingTheField) {
   EXPECT_FALSE(hits[0].hit());  // nothing was cast
 }
 
+TEST(Overlaps, TheBodiesAShapeMeetsAndNoOthers) {
+  World world;
+  const BodyId ground = add(&world, HalfSpaceDef{}, Vec3::Zero());
+  std::vector<BodyId> row;
+  for (int k = 0; k < 6; ++k)  // 1 m cubes centred at x = 0, 2, ..., 10, resting on the ground
+    row.push_back(add(&world, BoxDef{Vec3(0.5, 0.5, 0.5)}, Vec3(2.0 * k, 0, 0.5)));
+  const BodyId ball = add(&world, SphereDef{0.5}, Vec3(4, 3, 0.5));
+
+  OverlapQuery query;
+  query.shape = SphereDef{1.6};
+  query.pose.position = Vec3(3, 0, 2.0);  // reaches the cubes at x = 2 and 4 (corners 1.18 away)
+  std::vector<BodyId> found;
+  ASSERT_TRUE(world.overlap(query, 100, &found).ok());
+  EXPECT_EQ(found, (std::vector<BodyId>{row[1], row[2]}));
+  // Lowered, it meets the ground too (slot 0: first).
+  query.pose.position.z() = 1.0;
+  ASSERT_TRUE(world.overlap(query, 100, &found).ok());
+  EXPECT_EQ(found, (std::vector<BodyId>{ground, row[1], row[2]}));
+  // Exactly touching counts: a box whose face lies on the ball's (y = 2.5).
+  OverlapQuery slab;
+  slab.shape = BoxDef{Vec3(0.5, 0.5, 0.25)};
+  slab.pose.position = Vec3(4, 2, 0.75);
+  ASSERT_TRUE(world.overlap(slab, 100, &found).ok());
+  EXPECT_EQ(found, (std::vector<BodyId>{ball}));
+  slab.pose.position.y() = 1.99;  // 1 cm short of the ball
+  ASSERT_TRUE(world.overlap(slab, 100, &found).ok());
+  EXPECT_TRUE(found.empty());
+  // A long box over the whole row, turned: every cube; a mask without layer 1 finds nothing; a
+  // bound of 3 keeps the first three.
+  OverlapQuery bar;
+  bar.shape = BoxDef{Vec3(6, 0.2, 0.2)};
+  bar.pose = Pose{Vec3(5, 0, 0.5), Quat(Eigen::AngleAxisd(0.05, Vec3::UnitZ()))};
+  ASSERT_TRUE(world.overlap(bar, 100, &found).ok());
+  EXPECT_EQ(found, row);
+  Result<bool> more = world.overlap(bar, 3, &found);
+  ASSERT_TRUE(more.ok());
+  EXPECT_TRUE(more.value());
+  EXPECT_EQ(found, (std::vector<BodyId>{row[0], row[1], row[2]}));
+  bar.mask = ~std::uint32_t{1};
+  ASSERT_TRUE(world.overlap(bar, 100, &found).ok());
+  EXPECT_TRUE(found.empty());
+}
+
+TEST(Overlaps, BadShapesAreRefusedNamingTheField) {
+  World world;
+  std::vector<BodyId> found;
+  OverlapQuery query;
+  query.shape = SphereDef{-1};
+  Result<bool> refused = world.overlap(query, 10, &found);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().rfind("shape.radius", 0), 0u) << refused.error();
+  query.shape = HalfSpaceDef{};
+  EXPECT_EQ(world.overlap(query, 10, &found).error().rfind("shape:", 0), 0u);
+  query.shape = SphereDef{1};
+  query.pose.position = Vec3(NAN, 0, 0);
+  EXPECT_EQ(world.overlap(query, 10, &found).error().rfind("position:", 0), 0u);
+  query.pose.position = Vec3::Zero();
+  query.pose.orientation = Quat(2, 0, 0, 0);
+  EXPECT_EQ(world.overlap(query, 10, &found).error().rfind("orientation:", 0), 0u);
+}
+
 }  // namespace
 }  // namespace tumble

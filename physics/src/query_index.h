@@ -30,6 +30,10 @@ class QueryIndex {
   template <class Visit>
   void visit_ray(const Vec3& origin, const Vec3& direction, double t_max, Visit&& visit) const;
 
+  // Calls visit(slot) for every body whose box overlaps `box` (and every unbounded one).
+  template <class Visit>
+  void visit_box(const Aabb& box, Visit&& visit) const;
+
   // The version of the world this tree was built for (World's query version), and the lock that
   // lets one thread build it while queries from others wait.
   std::uint64_t version = ~std::uint64_t{0};
@@ -81,6 +85,27 @@ void QueryIndex::visit_ray(const Vec3& origin, const Vec3& direction, double t_m
     const double t_first = swap ? t_far : t_near, t_second = swap ? t_near : t_far;
     if (t_second <= t_max) stack[depth++] = second;
     if (t_first <= t_max) stack[depth++] = first;
+  }
+}
+
+template <class Visit>
+void QueryIndex::visit_box(const Aabb& box, Visit&& visit) const {
+  for (std::uint32_t slot : unbounded_)
+    visit(slot);
+  if (nodes_.empty()) return;
+  std::uint32_t stack[64];
+  int depth = 0;
+  stack[depth++] = 0;
+  while (depth > 0) {
+    const Node& node = nodes_[stack[--depth]];
+    if (!node.bounds.overlaps(box)) continue;
+    if (node.count > 0) {
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+        if (entries_[k].bounds.overlaps(box)) visit(entries_[k].slot);
+      continue;
+    }
+    stack[depth++] = node.first;
+    stack[depth++] = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
   }
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "parallel.h"
+#include "physics/collision.h"
 #include "physics/world.h"
 #include "query_index.h"
 #include "ray_shape.h"
@@ -126,6 +127,38 @@ Result<bool> World::cast_ray_all(const RayCast& ray, std::size_t max_hits,
   for (const auto& [hit, slot] : found)
     hits->push_back(
         world_hit(bodies_[slot].body, BodyId{slot, bodies_[slot].generation}, ray, direction, hit));
+  return left_out;
+}
+
+Result<bool> World::overlap(const OverlapQuery& query, std::size_t max_bodies,
+                            std::vector<BodyId>* bodies) const {
+  bodies->clear();
+  if (std::holds_alternative<HalfSpaceDef>(query.shape))
+    return Status::error("shape: a half-space holds half the world; ask a large box");
+  Result<Shape> shape = Shape::create(query.shape);
+  if (!shape) return shape.status().within("shape.");
+  if (!is_finite(query.pose.position)) return Status::error("position: must be finite");
+  const double norm = query.pose.orientation.norm();
+  if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
+    return Status::error("orientation: must be a unit quaternion");
+  const Pose pose{query.pose.position, query.pose.orientation.normalized()};
+  const Aabb box = transform_aabb(shape.value().local_bounds(), pose);
+  std::vector<std::uint32_t> found;
+  const QueryIndex& index = query_index();
+  CollisionSettings touching;  // margin 0: overlapping or touching
+  index.visit_box(box, [&](std::uint32_t slot) {
+    const Body& body = bodies_[slot].body;
+    if ((body.filter.layers & query.mask) == 0) return;
+    ContactManifold manifold;
+    // An iteration bound hit keeps GJK's and EPA's best answer, as the step does.
+    (void)collide(shape.value(), pose, body.shape, body.pose(), touching, &manifold);
+    if (manifold.count > 0) found.push_back(slot);
+  });
+  std::sort(found.begin(), found.end());
+  const bool left_out = found.size() > max_bodies;
+  if (left_out) found.resize(max_bodies);
+  for (std::uint32_t slot : found)
+    bodies->push_back({slot, bodies_[slot].generation});
   return left_out;
 }
 

@@ -76,3 +76,19 @@ def test_bad_rays_are_refused_naming_the_field(world):
     assert refused.value.code.name == "RESOURCE_EXHAUSTED"
     with pytest.raises(tumble.ArgumentError, match=r"directions: expected shape"):
         world.cast_rays([[0, 0, 5]], [[0, 0, -1], [0, 0, 1]])
+
+
+@pytest.mark.parametrize("where", ["remote", "local"])
+def test_overlap_finds_the_bodies_a_shape_meets(world, where):
+    world = world if where == "remote" else tumble.World()
+    ground, cube = boxes_on_the_ground(world)
+    assert world.overlap(tumble.Sphere(0.6), (0, 0, 1.5)) == [cube]
+    assert world.overlap(tumble.Sphere(0.6), (0, 0, 0.3)) == [ground, cube]
+    assert world.overlap(tumble.Box((1, 1, 1)), (5, 5, 5)) == []
+    # Turned 45 degrees about z, a flat box's corner reaches the cube's side at x = 0.5.
+    turned = (np.cos(np.pi / 8), 0, 0, np.sin(np.pi / 8))
+    assert world.overlap(tumble.Box((1, 1, 0.2)), (1.2, 0, 0.5), turned) == [cube]
+    assert world.overlap(tumble.Box((1, 1, 0.2)), (1.2, 0, 0.5)) == []
+    assert world.overlap(tumble.Sphere(0.6), (0, 0, 0.3), mask=0) == []
+    with pytest.raises(tumble.Error, match=r"overlaps\[0\]\.shape: a half-space"):
+        world.overlap(tumble.Plane(), (0, 0, 0))

@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import grpc
 import numpy as np
 
-from tumble import convert
+from tumble import convert, shapes
 from tumble.bodies import Body, BodySpec, aliased, bits
 from tumble.errors import ArgumentError, Error, from_rpc
 from tumble.frames import FrameStream, plain
@@ -285,6 +285,23 @@ class WorldCalls:
         out.body[hit], out.distance[hit], out.fraction[hit] = ids, distance, fraction
         out.point[hit], out.normal[hit] = point, normal
         return out
+
+    def overlap(self, shape, position, orientation=None, *, mask=None):
+        """The ids of the bodies that `shape` (Box, Sphere, Capsule or Hull) placed at `position`
+        (m, world) and `orientation` (w, x, y, z) overlaps or touches, in the order of their
+        slots; `mask`: the collision layers it meets (default every layer)."""
+        query = pb.OverlapQuery()
+        if not isinstance(shape, shapes.SHAPES):
+            raise ArgumentError(f"shape: expected a Box, Sphere, Capsule or Hull, got {shape!r}",
+                                "overlap")
+        query.shape.CopyFrom(shape.to_proto())
+        convert.set_vec3(query.position, position, "position")
+        if orientation is not None:
+            convert.set_quat(query.orientation, orientation, "orientation")
+        if mask is not None:
+            query.mask = bits(mask, "mask")
+        response = self._rpc("Query", pb.QueryRequest(overlaps=[query]))
+        return [int(body) for body in response.overlap_ids]
 
     def cast_ray(self, origin, direction, max_distance=1000.0, *, mask=None):
         """One ray's nearest hit as a dict (body, distance, fraction, point, normal), or None."""

@@ -7,6 +7,7 @@
 
 #include "physics/body.h"
 #include "physics/math.h"
+#include "physics/shape.h"
 #include "physics/status.h"
 
 namespace tumble {
@@ -34,5 +35,13 @@ struct RayHit {
 
 // Checks a ray; the message names the field ("direction: must not be zero").
 Status validate(const RayCast& ray);
+
+// A shape placed in the world, to find the bodies it overlaps (World::overlap): a trigger volume,
+// a gripper's reach.
+struct OverlapQuery {
+  ShapeDef shape = SphereDef{};  // any shape a body may have but a half-space
+  Pose pose;                      // of the shape's frame, world
+  std::uint32_t mask = 0xFFFFFFFF;  // as RayCast::mask
+};
 
 }  // namespace tumble

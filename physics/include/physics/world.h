@@ -239,6 +239,11 @@ class World {
   // some were left out.
   Result<bool> cast_ray_all(const RayCast& ray, std::size_t max_hits,
                             std::vector<RayHit>* hits) const;
+  // The bodies the query's shape overlaps or touches (the narrow phase's exact test), in slot
+  // order, at most max_bodies of them: true when some were left out. A shape refused names its
+  // field ("shape.radius: must be > 0").
+  Result<bool> overlap(const OverlapQuery& query, std::size_t max_bodies,
+                       std::vector<BodyId>* bodies) const;
 
   std::span<const BodyPair> find_pairs();
   // Broad and narrow phase: every touching pair's manifold, in pair order.
