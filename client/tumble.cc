@@ -299,6 +299,18 @@ int main(int argc, char** argv) {
   std::optional<std::uint32_t> overlap_mask;
   overlap->add_option("--mask", overlap_mask, "meet only bodies in these collision layers (bits)");
 
+  CLI::App* closest =
+      app.add_subcommand("closest", "the point of a body's surface nearest to a point, as JSON");
+  std::uint64_t closest_id = 0;
+  std::vector<double> closest_to;
+  double closest_max = 1000;
+  closest->add_option("id", closest_id, "the body's id")->required();
+  closest->add_option("--point", closest_to, "x,y,z (m, world)")
+      ->required()
+      ->delimiter(',')
+      ->expected(3);
+  closest->add_option("--max-distance", closest_max, "m: farther, nothing is found (default 1000)");
+
   CLI::App* impulse = app.add_subcommand("impulse", "apply an impulse to a body (it wakes)");
   std::vector<double> impulse_value, impulse_point;
   impulse->add_option("id", body_id, "the body's id")->required();
@@ -623,6 +635,25 @@ int main(int argc, char** argv) {
     Result<v1::QueryResponse> found = client.query(request);
     if (!found) return fail("overlap", found.status());
     print_line(nlohmann::json{{"ids", found.value().overlap_ids()}}.dump());
+  } else if (*closest) {
+    v1::QueryRequest request;
+    v1::ClosestPointQuery* query = request.add_closest_points();
+    query->set_id(closest_id);
+    set_vec(closest_to, query->mutable_point());
+    query->set_max_distance(closest_max);
+    Result<v1::QueryResponse> found = client.query(request);
+    if (!found) return fail("closest", found.status());
+    const v1::QueryResponse& r = found.value();
+    if (!r.closest_found(0)) {
+      print_line(nlohmann::json{{"found", false}}.dump());
+    } else {
+      const auto triple = [](const auto& v) { return nlohmann::json{v[0], v[1], v[2]}; };
+      print_line(nlohmann::json{{"found", true},
+                                {"distance", r.closest_distances(0)},
+                                {"point", triple(r.closest_surface_points())},
+                                {"normal", triple(r.closest_normals())}}
+                     .dump());
+    }
   } else if (*impulse) {
     v1::Impulse applied;
     applied.set_id(body_id);

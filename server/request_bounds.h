@@ -21,6 +21,8 @@ namespace tumble::server {
 inline constexpr std::size_t kMaxQueryRays = 262144, kMaxQueryHits = 262144, kMaxHitsPerRay = 64;
 // Overlap queries a request may hold; their bodies count against kMaxQueryHits.
 inline constexpr std::size_t kMaxQueryOverlaps = 256;
+// Closest-point queries a request may hold.
+inline constexpr std::size_t kMaxQueryClosest = 65536;
 
 // The largest request of each method, in bytes on the wire (after decompression).
 struct MethodBounds {

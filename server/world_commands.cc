@@ -166,6 +166,15 @@ Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
     }
     if (asked.has_mask()) overlaps[i].mask = asked.mask();
   }
+  if (static_cast<std::size_t>(request.closest_points_size()) > kMaxQueryClosest)
+    return Status::error("closest_points: " + std::to_string(request.closest_points_size()) +
+                             " queries, above the 65536 a request may hold",
+                         StatusCode::kResourceExhausted);
+  std::vector<BodyId> closest_bodies;
+  if (Status found = find_entries(hosted, "closest_points", request.closest_points(),
+                                  &closest_bodies);
+      !found)
+    return found;
   std::vector<RayCast> rays(n);
   for (std::size_t i = 0; i < n; ++i) {
     RayCast& ray = rays[i];
@@ -191,6 +200,20 @@ Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
     for (BodyId id : bodies)
       response->add_overlap_ids(hosted.ids.wire(id));
     room -= bodies.size();
+  }
+  for (int i = 0; i < request.closest_points_size(); ++i) {
+    const v1::ClosestPointQuery& asked = request.closest_points(i);
+    Result<ClosestPoint> found =
+        world.closest_point(closest_bodies[i], vec_from_proto(asked.point()),
+                            asked.has_max_distance() ? asked.max_distance() : 1000.0);
+    if (!found) return found.status().within("closest_points[" + std::to_string(i) + "].");
+    const ClosestPoint& c = found.value();
+    response->add_closest_found(c.found);
+    response->add_closest_distances(c.distance);
+    for (int k = 0; k < 3; ++k)
+      response->add_closest_surface_points(c.point[k]);
+    for (int k = 0; k < 3; ++k)
+      response->add_closest_normals(c.normal[k]);
   }
   auto add_hit = [&](const RayHit& hit) {
     response->add_hit_ids(hosted.ids.wire(hit.body));

@@ -403,6 +403,12 @@ class FuzzService {
           if (spec.has_orientation()) *overlap->mutable_orientation() = spec.orientation();
           if (h.chance(0.2)) overlap->set_mask(h.integer(0, 7));
         }
+        for (int n = h.chance(0.02) ? 70000 : h.integer(0, 2); n > 0; --n) {
+          v1::ClosestPointQuery* closest = request.add_closest_points();
+          closest->set_id(id(h));
+          set(h.vector(-10, 10), closest->mutable_point());
+          if (h.chance(0.5)) closest->set_max_distance(h.number(0, 100));
+        }
         v1::QueryResponse response;
         return stub_->Query(&context, request, &response);
       }

@@ -325,6 +325,50 @@ TEST(Overlaps, TheBodiesAShapeMeetsAndNoOthers) {
   EXPECT_TRUE(found.empty());
 }
 
+TEST(ClosestPoints, OnEveryShapeAgainstClosedForms) {
+  World world;
+  const BodyId ball = add(&world, SphereDef{1}, Vec3::Zero());
+  const BodyId box = add(&world, BoxDef{Vec3(1, 1, 1)}, Vec3(10, 0, 0));
+  const BodyId capsule = add(&world, CapsuleDef{0.5, 2}, Vec3(0, 10, 0));  // along z
+  const BodyId ground = add(&world, HalfSpaceDef{}, Vec3(0, 0, -5));
+  auto near = [&](BodyId body, const Vec3& point, double max_distance = 100) {
+    return world.closest_point(body, point, max_distance).value();
+  };
+  ClosestPoint c = near(ball, Vec3(0, 3, 4));
+  ASSERT_TRUE(c.found);
+  EXPECT_NEAR(c.distance, 4, 1e-9);
+  EXPECT_TRUE(c.point.isApprox(Vec3(0, 0.6, 0.8), 1e-9));
+  EXPECT_TRUE(c.normal.isApprox(Vec3(0, 0.6, 0.8), 1e-9));
+  // A box: off a face, off an edge, inside near a face.
+  c = near(box, Vec3(13, 0.5, 0));
+  EXPECT_NEAR(c.distance, 2, 1e-9);
+  EXPECT_TRUE(c.point.isApprox(Vec3(11, 0.5, 0), 1e-9));
+  EXPECT_TRUE(c.normal.isApprox(Vec3(1, 0, 0), 1e-9));
+  c = near(box, Vec3(13, 3, 0));
+  EXPECT_NEAR(c.distance, std::sqrt(8.0), 1e-9);
+  EXPECT_TRUE(c.point.isApprox(Vec3(11, 1, 0), 1e-9));
+  c = near(box, Vec3(10.9, 0, 0.2));
+  EXPECT_NEAR(c.distance, -0.1, 1e-9);
+  EXPECT_TRUE(c.point.isApprox(Vec3(11, 0, 0.2), 1e-9));
+  EXPECT_TRUE(c.normal.isApprox(Vec3(1, 0, 0), 1e-9));
+  // A capsule's side and cap; the ground.
+  c = near(capsule, Vec3(3, 10, 1));
+  EXPECT_NEAR(c.distance, 2.5, 1e-9);
+  c = near(capsule, Vec3(0, 10, 5));
+  EXPECT_NEAR(c.distance, 2.5, 1e-9);
+  EXPECT_TRUE(c.point.isApprox(Vec3(0, 10, 2.5), 1e-9));
+  c = near(ground, Vec3(7, 7, 2));
+  EXPECT_NEAR(c.distance, 7, 1e-9);
+  EXPECT_TRUE(c.normal.isApprox(Vec3(0, 0, 1), 1e-12));
+  // Beyond max_distance: not found.
+  EXPECT_FALSE(near(ball, Vec3(0, 0, 3), 1.5).found);
+  EXPECT_TRUE(near(ball, Vec3(0, 0, 3), 2.5).found);
+  // Refusals.
+  EXPECT_EQ(world.closest_point(BodyId{99, 0}, Vec3::Zero(), 1).error().rfind("body:", 0), 0u);
+  EXPECT_EQ(world.closest_point(ball, Vec3(NAN, 0, 0), 1).error().rfind("point:", 0), 0u);
+  EXPECT_EQ(world.closest_point(ball, Vec3::Zero(), 0).error().rfind("max_distance:", 0), 0u);
+}
+
 TEST(Overlaps, BadShapesAreRefusedNamingTheField) {
   World world;
   std::vector<BodyId> found;

@@ -130,6 +130,33 @@ Result<bool> World::cast_ray_all(const RayCast& ray, std::size_t max_hits,
   return left_out;
 }
 
+Result<ClosestPoint> World::closest_point(BodyId id, const Vec3& point,
+                                          double max_distance) const {
+  if (!contains(id)) return Status::not_found("body: no body with this id");
+  if (!is_finite(point)) return Status::error("point: must be finite");
+  if (!(max_distance > 0 && max_distance <= kMaxRayLength))
+    return Status::error("max_distance: must be in (0, 1e10] m");
+  // A sphere of a nanometre about the point, met with the narrow phase's speculative reach of
+  // max_distance: its contact's point on the body is the nearest, and its depth is the probe's
+  // radius less the distance (the closed forms for round shapes against every shape kind).
+  constexpr double kProbe = 1e-9;
+  static const Shape probe = Shape::create(SphereDef{kProbe}).value();
+  const Body& body = bodies_[id.index].body;
+  CollisionSettings reach;
+  reach.margin = max_distance;
+  ContactManifold manifold;
+  (void)collide(probe, Pose{point, Quat::Identity()}, body.shape, body.pose(), reach, &manifold);
+  ClosestPoint out;
+  if (manifold.count == 0) return out;
+  const ContactPoint& contact = manifold.points[0];
+  out.found = true;
+  out.point = contact.point_b;
+  out.normal = -manifold.normal;  // the manifold's runs from the probe to the body
+  out.distance = kProbe - contact.depth;
+  if (out.distance > max_distance) out.found = false;
+  return out;
+}
+
 Result<bool> World::overlap(const OverlapQuery& query, std::size_t max_bodies,
                             std::vector<BodyId>* bodies) const {
   bodies->clear();

@@ -92,3 +92,18 @@ def test_overlap_finds_the_bodies_a_shape_meets(world, where):
     assert world.overlap(tumble.Sphere(0.6), (0, 0, 0.3), mask=0) == []
     with pytest.raises(tumble.Error, match=r"overlaps\[0\]\.shape: a half-space"):
         world.overlap(tumble.Plane(), (0, 0, 0))
+
+
+def test_closest_point_of_a_body(world):
+    ground, cube = boxes_on_the_ground(world)
+    near = world.closest_point(cube, (3, 0.2, 0.5))
+    assert near["distance"] == pytest.approx(2.5, abs=1e-9)
+    np.testing.assert_allclose(near["point"], [0.5, 0.2, 0.5], atol=1e-9)
+    np.testing.assert_allclose(near["normal"], [1, 0, 0], atol=1e-9)
+    inside = world.closest_point(cube, (0, 0, 0.9))
+    assert inside["distance"] == pytest.approx(-0.1, abs=1e-9)
+    assert world.closest_point(cube, (30, 0, 0.5), max_distance=10) is None
+    with pytest.raises(tumble.Error, match=r"closest_points\[0\]\.id: no body"):
+        world.closest_point(987654, (0, 0, 0))
+    with pytest.raises(tumble.Error, match=r"closest_points\[0\]\.max_distance: must be in"):
+        world.closest_point(cube, (0, 0, 0), max_distance=-1)

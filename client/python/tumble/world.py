@@ -303,6 +303,20 @@ class WorldCalls:
         response = self._rpc("Query", pb.QueryRequest(overlaps=[query]))
         return [int(body) for body in response.overlap_ids]
 
+    def closest_point(self, body_id, point, max_distance=1000.0):
+        """The point of the body's surface nearest to `point` (m, world), as a dict (distance,
+        negative inside the body; point; normal, outward), or None when the body is farther
+        than max_distance (m)."""
+        query = pb.ClosestPointQuery(id=convert.ids(body_id, "id")[0],
+                                     max_distance=convert.number(max_distance, "max_distance"))
+        convert.set_vec3(query.point, point, "point")
+        response = self._rpc("Query", pb.QueryRequest(closest_points=[query]))
+        if not response.closest_found[0]:
+            return None
+        return {"distance": response.closest_distances[0],
+                "point": np.array(response.closest_surface_points[:3]),
+                "normal": np.array(response.closest_normals[:3])}
+
     def cast_ray(self, origin, direction, max_distance=1000.0, *, mask=None):
         """One ray's nearest hit as a dict (body, distance, fraction, point, normal), or None."""
         found = self.cast_rays([convert.array(origin, 3, "origin")],

@@ -36,6 +36,14 @@ struct RayHit {
 // Checks a ray; the message names the field ("direction: must not be zero").
 Status validate(const RayCast& ray);
 
+// The point of a body's surface nearest to a point (World::closest_point).
+struct ClosestPoint {
+  bool found = false;          // false: the body is farther than the query's max_distance
+  Vec3 point = Vec3::Zero();   // m, world, on the body's surface
+  Vec3 normal = Vec3::Zero();  // unit, world, the surface's outward normal there
+  double distance = 0;         // m from the query point; negative when it is inside the body
+};
+
 // A shape placed in the world, to find the bodies it overlaps (World::overlap): a trigger volume,
 // a gripper's reach.
 struct OverlapQuery {

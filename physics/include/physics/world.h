@@ -244,6 +244,9 @@ class World {
   // field ("shape.radius: must be > 0").
   Result<bool> overlap(const OverlapQuery& query, std::size_t max_bodies,
                        std::vector<BodyId>* bodies) const;
+  // The point of the body's surface nearest to `point` (m, world), if within max_distance (m,
+  // > 0 and <= 1e10; a point inside always is); the narrow phase's exact distance.
+  Result<ClosestPoint> closest_point(BodyId body, const Vec3& point, double max_distance) const;
 
   std::span<const BodyPair> find_pairs();
   // Broad and narrow phase: every touching pair's manifold, in pair order.
