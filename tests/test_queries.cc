@@ -166,7 +166,7 @@ TEST(RayCasts, TheTreeFindsWhatEveryBodyTestedFindsAndOnAnyThreadCount) {
     EXPECT_EQ(hits[i].body, all[0].body) << i;
     EXPECT_EQ(hits[i].distance, all[0].distance) << i;
     EXPECT_EQ(hits[i].point, all[0].point) << i;
-    // The point is where the ray says, and inside or on no body before it.
+    // The point lies where the distance says along the ray.
     EXPECT_NEAR((hits[i].point - rays[i].origin).norm(), hits[i].distance, 1e-9);
   }
   // The test means something: hundreds of hits and of misses (776 and 2224 with these seeds).

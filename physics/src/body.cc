@@ -35,16 +35,22 @@ Status validate(const BodyDef& def) {
     return Status::error("friction: must be finite and >= 0");
   if (!is_finite(def.restitution) || def.restitution < 0 || def.restitution > 1)
     return Status::error("restitution: must be in [0, 1]");
-  if (!(std::abs(def.gravity_scale) <= kMaxGravityScale))
-    return Status::error("gravity_scale: must be finite with |x| <= 1000");
-  if (!(def.linear_damping >= 0 && def.linear_damping <= kMaxDamping))
-    return Status::error("linear_damping: must be in [0, 1e6] (1/s)");
-  if (!(def.angular_damping >= 0 && def.angular_damping <= kMaxDamping))
-    return Status::error("angular_damping: must be in [0, 1e6] (1/s)");
+  if (Status s = check_own_forces(def.gravity_scale, def.linear_damping, def.angular_damping); !s)
+    return s;
   if (Status s = check_vector(def.force, "force"); !s) return s;
   if (Status s = check_vector(def.torque, "torque"); !s) return s;
   if (def.type == BodyType::kStatic && !(def.force.isZero(0) && def.torque.isZero(0)))
     return Status::error("force: a static body does not move");
+  return Status::ok();
+}
+
+Status check_own_forces(double gravity_scale, double linear_damping, double angular_damping) {
+  if (!(std::abs(gravity_scale) <= kMaxGravityScale))
+    return Status::error("gravity_scale: must be finite with |x| <= 1000");
+  if (!(linear_damping >= 0 && linear_damping <= kMaxDamping))
+    return Status::error("linear_damping: must be in [0, 1e6] (1/s)");
+  if (!(angular_damping >= 0 && angular_damping <= kMaxDamping))
+    return Status::error("angular_damping: must be in [0, 1e6] (1/s)");
   return Status::ok();
 }
 

@@ -66,6 +66,10 @@ struct Body {
   }
 };
 
+// The gravity scale and dampings a body may take; the message names the field. BodyDef's
+// validation, World::check_motion and a restored state's check all ask this.
+Status check_own_forces(double gravity_scale, double linear_damping, double angular_damping);
+
 // Builds a body from a validated definition.
 Result<Body> make_body(const BodyDef& def);
 

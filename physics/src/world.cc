@@ -303,12 +303,11 @@ Status World::check_motion(BodyId id, const BodyMotion& motion) const {
   if (Status s = check_vector(motion.force_point, "force_point"); !s) return s;
   if (Status s = check_vector(motion.force, "force"); !s) return s;
   if (Status s = check_vector(motion.torque, "torque"); !s) return s;
-  if (motion.gravity_scale && !(std::abs(*motion.gravity_scale) <= kMaxGravityScale))
-    return Status::error("gravity_scale: must be finite with |x| <= 1000");
-  for (const auto& [damping, name] : {std::pair{&motion.linear_damping, "linear_damping"},
-                                      {&motion.angular_damping, "angular_damping"}})
-    if (*damping && !(**damping >= 0 && **damping <= kMaxDamping))
-      return Status::error(std::string(name) + ": must be in [0, 1e6] (1/s)");
+  if (Status s = check_own_forces(motion.gravity_scale.value_or(body.gravity_scale),
+                                  motion.linear_damping.value_or(body.linear_damping),
+                                  motion.angular_damping.value_or(body.angular_damping));
+      !s)
+    return s;
   if (is_static) {
     for (const auto& [v, name] :
          {std::pair{&motion.force, "force"}, std::pair{&motion.torque, "torque"}})

@@ -54,11 +54,9 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
     return Status::error("friction: must be finite and >= 0");
   if (!(body.restitution >= 0 && body.restitution <= 1))
     return Status::error("restitution: must be in [0, 1]");
-  if (!(std::abs(body.gravity_scale) <= kMaxGravityScale))
-    return Status::error("gravity_scale: must be finite with |x| <= 1000");
-  if (!(body.linear_damping >= 0 && body.linear_damping <= kMaxDamping) ||
-      !(body.angular_damping >= 0 && body.angular_damping <= kMaxDamping))
-    return Status::error("linear_damping, angular_damping: must be in [0, 1e6]");
+  if (Status s = check_own_forces(body.gravity_scale, body.linear_damping, body.angular_damping);
+      !s)
+    return s;
   if (!is_finite(body.force) || !is_finite(body.torque))
     return Status::error("force, torque: must be finite");
   if (body.is_static() && !(body.force.isZero(0) && body.torque.isZero(0)))
