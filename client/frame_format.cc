@@ -131,12 +131,14 @@ std::string frame_to_json_line(const v1::Frame& frame) {
   }
   if (frame.added_size() > 0) {
     Json added = Json::array();
-    for (const v1::BodyDescription& d : frame.added())
+    for (const v1::BodyDescription& d : frame.added()) {
       added.push_back({{"id", d.id()},
                        {"shape", shape_json(d.shape())},
                        {"static", d.type() == v1::BODY_TYPE_STATIC},
                        {"mass", d.mass()},
                        {"color", d.color()}});
+      if (d.type() == v1::BODY_TYPE_KINEMATIC) added.back()["kinematic"] = true;
+    }
     line["added"] = std::move(added);
   }
   if (frame.removed_size() > 0) line["removed"] = slice(frame.removed(), 0, frame.removed_size());

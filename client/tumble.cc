@@ -55,6 +55,7 @@ struct SpawnOptions {
   double radius = 0.5, half_height = 0.5, mass = 0;
   std::uint32_t colour = 0;
   bool is_static = false;
+  bool is_kinematic = false;
   std::optional<double> gravity_scale, linear_damping, angular_damping;
   std::vector<double> force, torque;
   std::optional<std::uint32_t> layers, mask;
@@ -71,6 +72,7 @@ struct SpawnOptions {
     }
     if (mass > 0) spec.set_mass(mass);
     if (is_static) spec.set_type(v1::BODY_TYPE_STATIC);
+    if (is_kinematic) spec.set_type(v1::BODY_TYPE_KINEMATIC);
     set_vec(position, spec.mutable_position());
     set_vec(velocity, spec.mutable_linear_velocity());
     set_vec(spin, spec.mutable_angular_velocity());
@@ -229,7 +231,12 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(3);
   spawn->add_option("--color", body.colour, "drawing colour 0xRRGGBBAA (0: the viewer's choice)");
-  spawn->add_flag("--static", body.is_static, "a body that never moves");
+  auto* still = spawn->add_flag("--static", body.is_static, "a body that never moves");
+  spawn
+      ->add_flag("--kinematic", body.is_kinematic,
+                 "a body moved only by its velocity (--velocity, --spin; set-state changes it), "
+                 "which pushes dynamic bodies and is never pushed back")
+      ->excludes(still);
   add_body_force_options(spawn, &body.gravity_scale, &body.linear_damping, &body.angular_damping,
                          &body.force, &body.torque, &body.layers, &body.mask);
 
@@ -568,6 +575,8 @@ int main(int argc, char** argv) {
                           {"v", v(s.linear_velocity())},
                           {"w", v(s.angular_velocity())},
                           {"asleep", s.asleep()}};
+      if (d.type() == v1::BODY_TYPE_STATIC) line["static"] = true;
+      if (d.type() == v1::BODY_TYPE_KINEMATIC) line["kinematic"] = true;
       // What acts on it beyond gravity and contacts, where anything does.
       if (d.gravity_scale() != 1) line["gravity_scale"] = d.gravity_scale();
       if (d.linear_damping() != 0) line["linear_damping"] = d.linear_damping();

@@ -86,6 +86,9 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
     case v1::BODY_TYPE_STATIC:
       def.type = BodyType::kStatic;
       break;
+    case v1::BODY_TYPE_KINEMATIC:
+      def.type = BodyType::kKinematic;
+      break;
     default:
       return Status::error("type: unknown body type " + std::to_string(spec.type()));
   }
@@ -132,14 +135,26 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   def.torque = vec(spec.torque());
   if (spec.has_collision_layers()) def.filter.layers = spec.collision_layers();
   if (spec.has_collision_mask()) def.filter.mask = spec.collision_mask();
-  if (def.type == BodyType::kStatic) def.mass = 0;
+  if (def.type != BodyType::kDynamic) def.mass = 0;
   if (Status s = validate(def); !s) return s;  // what only the engine can tell (a flat hull)
   return def;
 }
 
+v1::BodyType proto_body_type(BodyType type) {
+  switch (type) {
+    case BodyType::kStatic:
+      return v1::BODY_TYPE_STATIC;
+    case BodyType::kKinematic:
+      return v1::BODY_TYPE_KINEMATIC;
+    case BodyType::kDynamic:
+      break;
+  }
+  return v1::BODY_TYPE_DYNAMIC;
+}
+
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) {
   out->set_id(id);
-  out->set_type(look.type == BodyType::kStatic ? v1::BODY_TYPE_STATIC : v1::BODY_TYPE_DYNAMIC);
+  out->set_type(proto_body_type(look.type));
   out->set_mass(look.mass);
   out->set_color(look.colour);
   v1::Shape* shape = out->mutable_shape();

@@ -24,6 +24,7 @@ BodyMotion motion_from_proto(const v1::BodyStateUpdate& update,
 Result<ShapeDef> shape_def_from_proto(const v1::Shape& shape);
 
 // What a viewer needs to draw the body with wire id `id`.
+v1::BodyType proto_body_type(BodyType type);
 void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out);
 // What acts on it beyond gravity and contacts, and its collision filter (GetBodies).
 void describe_forces(const BodyView& body, v1::BodyDescription* out);

@@ -204,6 +204,7 @@ class FuzzService {
         break;  // or no shape at all
     }
     if (h.chance(0.15)) spec.set_type(v1::BODY_TYPE_STATIC);
+    if (h.chance(0.1)) spec.set_type(v1::BODY_TYPE_KINEMATIC);
     if (h.chance(0.05)) spec.set_type(static_cast<v1::BodyType>(h.integer(2, 9)));
     if (h.chance(0.7)) set(h.vector(-5, 5), spec.mutable_position());
     if (h.chance(0.3)) set(h, spec.mutable_orientation());

@@ -419,7 +419,7 @@ TEST(StandardScenes, FollowTheSpecification) {
   EXPECT_EQ(bullet.bodies[0].linear_velocity, Vec3(300, 0, 0));
 
   for (const char* name : {"pile:64", "pyramid:5", "tower:3", "mass-ratio", "mass-ratio-inv",
-                           "bullet", "slide", "spin", "bounce", "default"})
+                           "bullet", "slide", "spin", "bounce", "carousel", "default"})
     EXPECT_TRUE(standard_scene(name).ok()) << name;
   EXPECT_FALSE(standard_scene("pile:0").ok());
   EXPECT_FALSE(standard_scene("spin:3").ok());

@@ -211,6 +211,33 @@ TEST(ServerProcess, CliJoinsDrivesReadsAndRemovesJoints) {
   EXPECT_NE(run(tumble + "remove-joints " + joint).code, 0);  // gone
 }
 
+TEST(ServerProcess, CliSpawnsAndSteersAKinematicBody) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  const Output spawned =
+      run(tumble + "spawn box --size 2,2,0.2 --kinematic --linear-velocity 1,0,0 --pos 0,0,1");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  const std::string deck = spawned.text.substr(0, spawned.text.find('\n'));
+  ASSERT_EQ(run(tumble + "step 60").code, 0);
+  nlohmann::json state = nlohmann::json::parse(run(tumble + "bodies " + deck).text);
+  EXPECT_EQ(state["kinematic"], true);
+  EXPECT_NEAR(state["p"][0].get<double>(), 1, 1e-12);  // x0 + v t, exactly
+  EXPECT_NEAR(state["p"][2].get<double>(), 1, 1e-12);  // no gravity
+  ASSERT_EQ(run(tumble + "set-state " + deck + " --linear-velocity 0,0,0").code, 0);
+  ASSERT_EQ(run(tumble + "step 60").code, 0);
+  state = nlohmann::json::parse(run(tumble + "bodies " + deck).text);
+  EXPECT_NEAR(state["p"][0].get<double>(), 1, 1e-12);
+  const Output both = run(tumble + "spawn box --size 1,1,1 --kinematic --static");
+  EXPECT_NE(both.code, 0);
+  EXPECT_NE(both.text.find("excludes"), std::string::npos) << both.text;
+  const Output pushed = run(tumble + "set-state " + deck + " --force 1,0,0");
+  EXPECT_NE(pushed.code, 0);
+  EXPECT_NE(pushed.text.find("force: a kinematic body moves only by the velocity given it"),
+            std::string::npos)
+      << pushed.text;
+}
+
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--max-message-mb", "1"}));

@@ -41,6 +41,15 @@ Status validate(const BodyDef& def) {
   if (Status s = check_vector(def.torque, "torque"); !s) return s;
   if (def.type == BodyType::kStatic && !(def.force.isZero(0) && def.torque.isZero(0)))
     return Status::error("force: a static body does not move");
+  if (def.type == BodyType::kKinematic) {
+    if (Status s = check_kinematic_motion(def.force, def.torque, def.gravity_scale,
+                                          def.linear_damping, def.angular_damping);
+        !s)
+      return s;
+  }
+  if (def.type == BodyType::kStatic &&
+      !(def.linear_velocity.isZero(0) && def.angular_velocity.isZero(0)))
+    return Status::error("linear_velocity: a static body does not move (a kinematic one does)");
   return Status::ok();
 }
 
@@ -51,6 +60,17 @@ Status check_own_forces(double gravity_scale, double linear_damping, double angu
     return Status::error("linear_damping: must be in [0, 1e6] (1/s)");
   if (!(angular_damping >= 0 && angular_damping <= kMaxDamping))
     return Status::error("angular_damping: must be in [0, 1e6] (1/s)");
+  return Status::ok();
+}
+
+Status check_kinematic_motion(const Vec3& force, const Vec3& torque, double gravity_scale,
+                             double linear_damping, double angular_damping) {
+  constexpr const char* kOnlyVelocity = ": a kinematic body moves only by the velocity given it";
+  if (!force.isZero(0)) return Status::error(std::string("force") + kOnlyVelocity);
+  if (!torque.isZero(0)) return Status::error(std::string("torque") + kOnlyVelocity);
+  if (gravity_scale != 1) return Status::error(std::string("gravity_scale") + kOnlyVelocity);
+  if (linear_damping != 0) return Status::error(std::string("linear_damping") + kOnlyVelocity);
+  if (angular_damping != 0) return Status::error(std::string("angular_damping") + kOnlyVelocity);
   return Status::ok();
 }
 

@@ -42,7 +42,16 @@ struct Body {
   std::uint32_t sleep_island = 0;
 
   bool is_static() const { return type == BodyType::kStatic; }
+  bool is_kinematic() const { return type == BodyType::kKinematic; }
+  bool is_dynamic() const { return type == BodyType::kDynamic; }
+  // Dynamic and awake: what the solver moves.
   bool is_moving() const { return type == BodyType::kDynamic && !asleep; }
+  // A kinematic body with a velocity: the step moves it, and what it touches stays awake. One at
+  // rest costs what a static body costs.
+  bool carries() const {
+    return type == BodyType::kKinematic &&
+           !(linear_velocity.isZero(0) && angular_velocity.isZero(0));
+  }
   Pose pose() const { return {position, orientation}; }
   // Anything beyond gravity and contacts: a held force or torque, another gravity, damping. Kept
   // as a flag (refresh_own_forces after any of them changes): the step asks it of every body in
@@ -69,6 +78,11 @@ struct Body {
 // The gravity scale and dampings a body may take; the message names the field. BodyDef's
 // validation, World::check_motion and a restored state's check all ask this.
 Status check_own_forces(double gravity_scale, double linear_damping, double angular_damping);
+
+// What a kinematic body refuses: anything that would move it but its velocity (a held force or
+// torque, a gravity scale, damping); the message names the field.
+Status check_kinematic_motion(const Vec3& force, const Vec3& torque, double gravity_scale,
+                             double linear_damping, double angular_damping);
 
 // Builds a body from a validated definition.
 Result<Body> make_body(const BodyDef& def);

@@ -17,6 +17,10 @@ BodyType BodyView::type() const {
 bool BodyView::is_static() const {
   return body().is_static();
 }
+
+bool BodyView::is_kinematic() const {
+  return body().is_kinematic();
+}
 bool BodyView::asleep() const {
   return body().asleep;
 }

@@ -190,6 +190,26 @@ TUMBLE_INLINE WidePair gather(const ContactPack& pack, std::span<const SolverBod
   return pair;
 }
 
+// Adds to the lanes' motion since the step start (gather's delta_position and delta_angle) a
+// kinematic body's, its velocity times `kinematic_elapsed` (SolverBody::kinematic). Out of line:
+// a world without kinematic bodies never calls it, and its sweeps' code stays as it was.
+[[gnu::noinline]] void add_kinematic_motion(const ContactPack& pack,
+                                            std::span<const SolverBody> bodies,
+                                            double kinematic_elapsed, WidePair* motion) {
+  for (int k = 0; k < kWideLanes; ++k) {
+    const SolverBody& a = bodies[pack.a[k]];
+    const SolverBody& b = bodies[pack.b[k]];
+    if (a.kinematic) {
+      set_lane(&motion->va, k, lane_of(motion->va, k) + kinematic_elapsed * a.v);
+      set_lane(&motion->wa, k, lane_of(motion->wa, k) + kinematic_elapsed * a.w);
+    }
+    if (b.kinematic) {
+      set_lane(&motion->vb, k, lane_of(motion->vb, k) + kinematic_elapsed * b.v);
+      set_lane(&motion->wb, k, lane_of(motion->wb, k) + kinematic_elapsed * b.w);
+    }
+  }
+}
+
 TUMBLE_INLINE void scatter(const ContactPack& pack, WideMask lanes, const WidePair& pair,
                            std::span<SolverBody> bodies) {
   const WideMask moves_a = lanes & pack.moves_a, moves_b = lanes & pack.moves_b;
@@ -399,7 +419,8 @@ void set_packed_sweeps(bool on) {
 }
 
 TUMBLE_PER_CPU
-void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep) {
+void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep,
+                double kinematic_elapsed) {
   WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);
   const WidePair motion =
       gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
@@ -416,22 +437,37 @@ void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_
     apply_tangents(pack, point, rubbing, point.tangent_impulse1, point.tangent_impulse2, pair);
   }
   scatter(pack, kAllLanes, pair, bodies);
+  // The separations again with kinematic bodies' motion (the impulses moved no body).
+  if (kinematic_elapsed != 0) update_separations(pack, bodies, kinematic_elapsed);
+}
+
+// update_separations with kinematic bodies' motion.
+[[gnu::noinline]] void update_kinematic_separations(ContactPack& pack,
+                                                    std::span<const SolverBody> bodies,
+                                                    double kinematic_elapsed) {
+  WidePair motion = gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
+  add_kinematic_motion(pack, bodies, kinematic_elapsed, &motion);
+  for (int p = 0; p < pack.most_points; ++p)
+    set_substep_separation(pack, motion, pack.point[p]);
 }
 
 TUMBLE_PER_CPU
-void update_separations(ContactPack& pack, std::span<const SolverBody> bodies) {
+void update_separations(ContactPack& pack, std::span<const SolverBody> bodies,
+                        double kinematic_elapsed) {
+  if (kinematic_elapsed != 0) return update_kinematic_separations(pack, bodies, kinematic_elapsed);
   const WidePair motion =
       gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
   for (int p = 0; p < pack.most_points; ++p)
     set_substep_separation(pack, motion, pack.point[p]);
 }
 
-TUMBLE_PER_CPU
-void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies, double h,
-                    double (&lane_residuals)[kWideLanes]) {
+template <bool kKinematic>
+TUMBLE_INLINE void residuals_of(const ContactPack& pack, std::span<const SolverBody> bodies,
+                               double h, double (&lane_residuals)[kWideLanes],
+                               double kinematic_elapsed) {
   const WidePair pair = gather<&SolverBody::v, &SolverBody::w>(pack, bodies);
-  const WidePair motion =
-      gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
+  WidePair motion = gather<&SolverBody::delta_position, &SolverBody::delta_angle>(pack, bodies);
+  if constexpr (kKinematic) add_kinematic_motion(pack, bodies, kinematic_elapsed, &motion);
   Wide residual = wide(0);
   for (int p = 0; p < pack.most_points; ++p) {
     const PackPoint& point = pack.point[p];
@@ -447,6 +483,21 @@ void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies,
   }
   for (int k = 0; k < kWideLanes; ++k)
     lane_residuals[k] = residual[k];
+}
+
+[[gnu::noinline]] void kinematic_residuals(const ContactPack& pack,
+                                           std::span<const SolverBody> bodies, double h,
+                                           double (&lane_residuals)[kWideLanes],
+                                           double kinematic_elapsed) {
+  residuals_of<true>(pack, bodies, h, lane_residuals, kinematic_elapsed);
+}
+
+TUMBLE_PER_CPU
+void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies, double h,
+                    double (&lane_residuals)[kWideLanes], double kinematic_elapsed) {
+  if (kinematic_elapsed != 0)
+    return kinematic_residuals(pack, bodies, h, lane_residuals, kinematic_elapsed);
+  residuals_of<false>(pack, bodies, h, lane_residuals, 0);
 }
 
 // Compiled twice, for AVX2 (one register a vector) and for any x86-64 (two), and chosen when the

@@ -69,13 +69,15 @@ void store_impulses(const ContactPack& pack, std::span<ContactRow> rows,
                     std::span<ContactRowCold> cold);
 
 // warm_start's and update_separations' bits for a pack's manifolds.
-void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep);
-void update_separations(ContactPack& pack, std::span<const SolverBody> bodies);
+void warm_start(ContactPack& pack, std::span<SolverBody> bodies, bool keep_last_substep,
+                double kinematic_elapsed = 0);
+void update_separations(ContactPack& pack, std::span<const SolverBody> bodies,
+                        double kinematic_elapsed = 0);
 
 // normal_residual's measure for each lane's manifold, in lane_residuals[k] (0 for a lane without
 // one): the same bits, so an island's residual does not depend on whether it was packed.
 void pack_residuals(const ContactPack& pack, std::span<const SolverBody> bodies, double h,
-                    double (&lane_residuals)[kWideLanes]);
+                    double (&lane_residuals)[kWideLanes], double kinematic_elapsed = 0);
 
 // One Gauss-Seidel sweep over the manifolds of a pack's lanes in `lanes` (solve_manifold's
 // bits, lane by lane).

@@ -263,14 +263,19 @@ Softness contact_softness(double hertz, double damping_ratio, double h) {
 }
 
 void update_separations(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                        std::span<const SolverBody> bodies) {
+                        std::span<const SolverBody> bodies, double kinematic_elapsed) {
+  if (kinematic_elapsed != 0) {
+    for (std::uint32_t id : ids)
+      rows[id].substep_separation = current_separation(rows[id], bodies, kinematic_elapsed);
+    return;
+  }
   for (std::uint32_t id : ids)
     rows[id].substep_separation = current_separation(rows[id], bodies);
 }
 
 void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,
                 std::span<const std::uint32_t> ids, std::span<SolverBody> bodies,
-                bool keep_last_substep) {
+                bool keep_last_substep, double kinematic_elapsed) {
   for (std::uint32_t id : ids) {
     ContactRow& row = rows[id];
     row.substep_separation = current_separation(row, bodies);
@@ -279,6 +284,8 @@ void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,
     if (row.tangent_impulse1 != 0 || row.tangent_impulse2 != 0)
       apply_tangent_impulses(row, row.tangent_impulse1, row.tangent_impulse2, bodies);
   }
+  // The separations again with kinematic bodies' motion (the impulses moved no body).
+  if (kinematic_elapsed != 0) update_separations(rows, ids, bodies, kinematic_elapsed);
 }
 
 namespace {
@@ -588,12 +595,12 @@ void correct_positions(std::span<const ContactRow> rows, std::span<const Contact
 }
 
 double normal_residual(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
-                       std::span<const SolverBody> bodies, double h) {
+                       std::span<const SolverBody> bodies, double h, double kinematic_elapsed) {
   double residual = 0;
   for (std::uint32_t id : ids) {
     const ContactRow& row = rows[id];
     if (row.normal_mass <= 0) continue;
-    const double separation = current_separation(row, bodies);
+    const double separation = current_separation(row, bodies, kinematic_elapsed);
     const double target = separation > 0 ? -separation / h : 0;
     const double gap_velocity = normal_velocity(row, bodies) - target;
     const double impulse_velocity = row.normal_impulse / row.normal_mass;

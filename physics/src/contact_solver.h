@@ -39,6 +39,10 @@ struct SolverBody {
   // the contacts changed (integrate.h says why).
   Quat free_turn = Quat::Identity();
   Vec3 w_free = Vec3::Zero();
+  // A kinematic body with a velocity: v and w are that velocity, which nothing changes, and its
+  // motion since the step start is that velocity times the time since (the islands that share it
+  // each keep their own time, so its delta_position and delta_angle stay 0).
+  bool kinematic = false;
 };
 
 // One contact point between bodies `a` and `b` (the step's solver indices, StepScratch): what the
@@ -108,8 +112,10 @@ Softness contact_softness(double hertz, double damping_ratio, double h);
 
 // Sets each row's substep_separation from where the bodies are now: after every move, before the
 // sweeps that follow it.
+// `kinematic_elapsed`: the time since the step start where kinematic bodies move (else 0; as
+// current_separation, and below).
 void update_separations(std::span<ContactRow> rows, std::span<const std::uint32_t> ids,
-                        std::span<const SolverBody> bodies);
+                        std::span<const SolverBody> bodies, double kinematic_elapsed = 0);
 
 // Sets each row's substep_separation (update_separations) and applies its impulse, which
 // it starts the sweeps from. With `keep_last_substep` (the soft
@@ -117,7 +123,7 @@ void update_separations(std::span<ContactRow> rows, std::span<const std::uint32_
 // row's earlier_substeps_impulse on the way.
 void warm_start(std::span<ContactRow> rows, std::span<ContactRowCold> cold,
                 std::span<const std::uint32_t> ids, std::span<SolverBody> bodies,
-                bool keep_last_substep);
+                bool keep_last_substep, double kinematic_elapsed = 0);
 
 // One Gauss-Seidel sweep. With `soft` set, penetration beyond the slop is pushed out through the
 // spring; without it contacts are rigid and only gaps (speculative contacts) add bias. Sweeps
@@ -154,7 +160,8 @@ void correct_positions(std::span<const ContactRow> rows, std::span<const Contact
 
 // |min(impulse / effective mass, normal velocity - target)| over the normal rows, m/s.
 double normal_residual(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
-                       std::span<const SolverBody> bodies, double h);
+                       std::span<const SolverBody> bodies, double h,
+                       double kinematic_elapsed = 0);
 
 inline double normal_velocity(const ContactRow& row, std::span<const SolverBody> bodies) {
   const SolverBody& a = bodies[row.a];
@@ -202,6 +209,28 @@ inline double current_separation(const ContactRow& row, std::span<const SolverBo
   const SolverBody& b = bodies[row.b];
   return row.separation + row.normal.dot(b.delta_position - a.delta_position) +
          b.delta_angle.dot(row.rb_cross_n) - a.delta_angle.dot(row.ra_cross_n);
+}
+
+// The same with kinematic bodies (SolverBody::kinematic), `elapsed` seconds after the step start
+// (the island's own clock); 0 gives current_separation's answer. Its arithmetic is the packs'
+// (contact_packs.cc), bit for bit.
+inline double current_separation(const ContactRow& row, std::span<const SolverBody> bodies,
+                                 double elapsed) {
+  if (elapsed == 0) return current_separation(row, bodies);
+  const SolverBody& a = bodies[row.a];
+  const SolverBody& b = bodies[row.b];
+  Vec3 moved_a = a.delta_position, turned_a = a.delta_angle;
+  Vec3 moved_b = b.delta_position, turned_b = b.delta_angle;
+  if (a.kinematic) {
+    moved_a = moved_a + elapsed * a.v;
+    turned_a = turned_a + elapsed * a.w;
+  }
+  if (b.kinematic) {
+    moved_b = moved_b + elapsed * b.v;
+    turned_b = turned_b + elapsed * b.w;
+  }
+  return row.separation + row.normal.dot(moved_b - moved_a) + turned_b.dot(row.rb_cross_n) -
+         turned_a.dot(row.ra_cross_n);
 }
 
 }  // namespace tumble

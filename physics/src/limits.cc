@@ -151,6 +151,8 @@ Status check_body_limits(const AnyBody& body, const WorldLimits& limits) {
       return above(span.largest_field, largest, "m", "max_size", limits.max_size);
   }
   if (body.is_static()) return Status::ok();
+  if (body.is_kinematic())
+    return check_speeds(body.linear_velocity(), body.angular_velocity(), limits);
   const double mass = body.mass();
   if (!(mass >= limits.min_mass)) return below("mass", mass, "kg", "min_mass", limits.min_mass);
   if (!(mass <= limits.max_mass)) return above("mass", mass, "kg", "max_mass", limits.max_mass);
@@ -167,6 +169,7 @@ struct BodyFields {
   Vec3 position() const { return body.position; }
   const Shape& shape() const { return body.shape; }
   bool is_static() const { return body.is_static(); }
+  bool is_kinematic() const { return body.is_kinematic(); }
   double mass() const { return body.mass; }
   Vec3 linear_velocity() const { return body.linear_velocity; }
   Vec3 angular_velocity() const { return body.angular_velocity; }

@@ -26,4 +26,10 @@ inline Quat rotated(const Quat& q, const Vec3& theta) {
   return (rotation_quaternion(theta) * q).normalized();
 }
 
+// Where a pose moved at constant velocities (v: m/s of the origin, w: rad/s, world axes) is
+// after dt: exact, as a kinematic body moves.
+inline Pose moved_by(const Pose& pose, const Vec3& v, const Vec3& w, double dt) {
+  return {pose.position + dt * v, rotated(pose.orientation, dt * w)};
+}
+
 }  // namespace tumble

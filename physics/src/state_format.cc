@@ -224,7 +224,7 @@ Status take_body(Reader& r, Body* b) {
   if (!shape) return shape.status().within("shape.");
   b->shape = std::move(shape).value();
   const auto type = r.take<std::uint8_t>("type");
-  if (r.ok() && type > static_cast<std::uint8_t>(BodyType::kDynamic))
+  if (r.ok() && type > static_cast<std::uint8_t>(BodyType::kKinematic))
     return Status::error("type: unknown body type " + std::to_string(type));
   b->type = static_cast<BodyType>(type);
   b->mass = r.take<double>("mass");

@@ -17,6 +17,7 @@
 #include "joint_axial.h"
 #include "parallel.h"
 #include "physics/world.h"
+#include "rotation.h"
 #include "step_limits.h"
 #include "step_scratch.h"
 #include "step_stages.h"
@@ -160,6 +161,7 @@ class SerialIsland {
   }
   // Each move is followed by the joints' position passes (joint_solver.h).
   void integrate_positions(double h) {
+    moved_for_ += h;
     for (std::uint32_t k : c_.bodies)
       integrate_position(h, &bodies_[k], &c_.scratch.poses[k]);
     for (int pass = 0; pass < kJointPositionPasses; ++pass) {
@@ -176,7 +178,10 @@ class SerialIsland {
         correct_joint_position(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
     }
   }
-  void refresh_separations() { update_separations(rows_, c_.rows, bodies_); }
+  void refresh_separations() { update_separations(rows_, c_.rows, bodies_, kinematic_time()); }
+  // How long the island's bodies have moved in this step, which kinematic bodies' motion in its
+  // separations follows (0 where none touches a contact: the separations' arithmetic without it).
+  double kinematic_time() const { return c_.scratch.kinematic_contacts ? moved_for_ : 0.0; }
   void warm_start(bool keep_last_substep) {
     for (std::uint32_t j : c_.joints) {
       JointRow& row = c_.scratch.joint_rows[j];
@@ -191,7 +196,7 @@ class SerialIsland {
       }
       warm_start_joint(row, bodies_, c_.scratch.poses);
     }
-    tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep);
+    tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep, kinematic_time());
   }
   // Joints first, then contacts (Box2D v3's order: the contacts have the last word on
   // penetration).
@@ -227,7 +232,7 @@ class SerialIsland {
   bool exact_substep(double h, bool keep_last_substep) {
     // No warm start: the LCP finds each substep's whole impulse (kept for the step's total, as
     // the warm start keeps it).
-    update_separations(rows_, c_.rows, bodies_);
+    update_separations(rows_, c_.rows, bodies_, kinematic_time());
     for (std::uint32_t id : c_.rows) {
       ContactRow& row = rows_[id];
       if (keep_last_substep) cold_[id].earlier_substeps_impulse += row.normal_impulse;
@@ -304,7 +309,7 @@ class SerialIsland {
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    report_->residual = normal_residual(rows_, c_.rows, bodies_, h);
+    report_->residual = normal_residual(rows_, c_.rows, bodies_, h, kinematic_time());
     move();
     apply_restitution();
   }
@@ -321,6 +326,7 @@ class SerialIsland {
   std::span<SolverBody> bodies_;
   JointTree* tree_ = nullptr;  // the island's joints solved directly (joint_tree.h), if so
   bool one_sweep_solves_ = false;
+  double moved_for_ = 0;  // s: the moves so far this step
 };
 
 IslandContext island_context(StepScratch& s, const WorldSettings& settings, std::size_t i) {
@@ -389,13 +395,14 @@ class IslandLanes {
     }
   }
   // The packs solve; the rows take their impulses at the end, for the residual and restitution.
+  // (The lanes' islands move together: any lane's clock is theirs.)
   void refresh_separations() {
     for (ContactPack& pack : packs_)
-      update_separations(pack, s_.bodies);
+      update_separations(pack, s_.bodies, lanes_[0]->kinematic_time());
   }
   void warm_start(bool keep_last_substep) {
     for (ContactPack& pack : packs_)
-      tumble::warm_start(pack, s_.bodies, keep_last_substep);
+      tumble::warm_start(pack, s_.bodies, keep_last_substep, lanes_[0]->kinematic_time());
     for (std::size_t k = 0; k < count_; ++k)
       active_[k] = -1;
   }
@@ -431,7 +438,7 @@ class IslandLanes {
     for (const ContactPack& pack : packs_) {
       store_impulses(pack, s_.rows, s_.cold_rows);
       double lane_residuals[kWideLanes];
-      pack_residuals(pack, s_.bodies, h, lane_residuals);
+      pack_residuals(pack, s_.bodies, h, lane_residuals, lanes_[0]->kinematic_time());
       for (std::size_t k = 0; k < count_; ++k)
         residual[k] = std::max(residual[k], lane_residuals[k]);
     }
@@ -569,17 +576,22 @@ class TeamIsland {
 
   bool has_rows() const { return true; }  // coloured islands have many
   void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
-  void integrate_positions(double h) { team_integrate_positions(c_, h); }
+  void integrate_positions(double h) {
+    moved_for_ += h;
+    team_integrate_positions(c_, h);
+  }
+  double kinematic_time() const { return s_.kinematic_contacts ? moved_for_ : 0.0; }
   // The packs solve; the rows take their impulses at the end, for the residual and restitution.
   void refresh_separations() {
     sweep_packs(
         s_, first_, last_, false,
         [&](ContactPack& pack) {
-          update_separations(pack, s_.bodies);
+          update_separations(pack, s_.bodies, kinematic_time());
           return 0.0;
         },
         [&](const ManifoldRows& manifold) {
-          update_separations(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies);
+          update_separations(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies,
+                             kinematic_time());
           return 0.0;
         },
         false);
@@ -588,12 +600,12 @@ class TeamIsland {
     sweep_packs(
         s_, first_, last_, false,
         [&](ContactPack& pack) {
-          tumble::warm_start(pack, s_.bodies, keep_last_substep);
+          tumble::warm_start(pack, s_.bodies, keep_last_substep, kinematic_time());
           return 0.0;
         },
         [&](const ManifoldRows& manifold) {
           tumble::warm_start(s_.rows, s_.cold_rows, std::span(manifold.ids, manifold.count),
-                             s_.bodies, keep_last_substep);
+                             s_.bodies, keep_last_substep, kinematic_time());
           return 0.0;
         },
         false);
@@ -619,11 +631,12 @@ class TeamIsland {
         [&](const ContactPack& pack) {
           store_impulses(pack, s_.rows, s_.cold_rows);
           double lane_residuals[kWideLanes];
-          pack_residuals(pack, s_.bodies, h, lane_residuals);
+          pack_residuals(pack, s_.bodies, h, lane_residuals, kinematic_time());
           return *std::max_element(std::begin(lane_residuals), std::end(lane_residuals));
         },
         [&](const ManifoldRows& manifold) {
-          return normal_residual(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies, h);
+          return normal_residual(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies, h,
+                                 kinematic_time());
         });
     move();
     each_manifold([&](std::span<const std::uint32_t> ids) {
@@ -654,6 +667,7 @@ class TeamIsland {
   IslandReport* report_;
   std::uint64_t iterations_ = 0;
   std::uint32_t hits_ = 0;
+  double moved_for_ = 0;  // s: the moves so far this step
 };
 
 }  // namespace
@@ -776,9 +790,14 @@ void World::solve_islands(double dt) {
   }
 }
 
-void World::correct_positions() {
+void World::correct_positions(double dt) {
   StepScratch& s = *scratch_;
   const SolverSettings& solver = settings_.solver;
+  // The moving bodies are where the solve left them; kinematic ones are where their velocities
+  // take them (bodies_ keep their start until finish_step).
+  if (s.kinematic_contacts)
+    for (std::uint32_t k = s.moving; k < s.solver_slot.size(); ++k)
+      if (s.bodies[k].kinematic) s.poses[k] = moved_by(s.poses[k], s.bodies[k].v, s.bodies[k].w, dt);
   // Soft islands corrected their penetration inside the substeps, exact ones by their push-out
   // LCP unless it failed.
   auto needs_correction = [&](std::uint32_t i) {
@@ -822,8 +841,8 @@ std::uint32_t World::wake_touched() {
   for (const Contact& contact : contacts_) {
     const Body& a = bodies_[contact.a.index].body;
     const Body& b = bodies_[contact.b.index].body;
-    if (a.asleep && b.is_moving()) woken += wake_island(a.sleep_island);
-    if (b.asleep && a.is_moving()) woken += wake_island(b.sleep_island);
+    if (a.asleep && (b.is_moving() || b.carries())) woken += wake_island(a.sleep_island);
+    if (b.asleep && (a.is_moving() || a.carries())) woken += wake_island(b.sleep_island);
   }
   return woken;
 }
@@ -840,13 +859,24 @@ void World::update_sleep(double dt) {
   reserve(resting_contacts_, resting_contacts_.size() + contacts_.size());
   reserve(resting_island_, resting_island_.size() + contacts_.size());
   reserve(resting_forces_, resting_forces_.size() + impulses_.size());
+  // Bodies a moving kinematic body touches stay awake, however slowly it moves them.
+  s.carried.assign(s.kinematic_contacts ? s.solver_slot.size() : 0, 0);
+  if (s.kinematic_contacts) {
+    for (const Contact& contact : contacts_) {
+      const std::uint32_t a = s.solver_of_slot[contact.a.index];
+      const std::uint32_t b = s.solver_of_slot[contact.b.index];
+      if (s.bodies[a].kinematic) s.carried[b] = 1;
+      if (s.bodies[b].kinematic) s.carried[a] = 1;
+    }
+  }
   bool fell_asleep = false;
   for (std::size_t i = 0; i < s.islands.count(); ++i) {
     double shortest = std::numeric_limits<double>::infinity();
     for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
       Body& body = bodies_[s.solver_slot[s.islands.bodies[k]]].body;
       const bool slow = body.linear_velocity.norm() < solver.sleep_linear_speed &&
-                        body.angular_velocity.norm() < solver.sleep_angular_speed;
+                        body.angular_velocity.norm() < solver.sleep_angular_speed &&
+                        (s.carried.empty() || !s.carried[s.islands.bodies[k]]);
       body.sleep_timer = slow ? body.sleep_timer + dt : 0.0;
       shortest = std::min(shortest, body.sleep_timer);
     }
@@ -922,7 +952,23 @@ void World::finish_step(double dt) {
   stats_.slowed_bodies = slowed;
   stats_.bodies_at_edge = stopped;
   std::swap(s.pairs, s.next_pairs);
+  if (!kinematic_.empty()) move_kinematic(dt);
   time_ += dt;
+}
+
+void World::move_kinematic(double dt) {
+  for (std::uint32_t slot : kinematic_) {
+    Body& body = bodies_[slot].body;
+    if (!body.carries()) continue;
+    const std::uint8_t guard =
+        take_step_result(&body, moved_by(body.pose(), body.linear_velocity,
+                                         body.angular_velocity, dt),
+                         body.linear_velocity, body.angular_velocity, settings_.limits);
+    stats_.bodies_at_edge += (guard & kStepAtEdge) != 0;
+    note_event(slot, kBodyMoved);
+    // Stopped at the world's edge: it rests from now on, as a static body does.
+    if (!body.carries()) resting_changed(slot);
+  }
 }
 
 }  // namespace tumble

@@ -55,6 +55,10 @@ void World::load_solver_bodies() {
   StepScratch& s = *scratch_;
   number_solver_bodies();
   const std::uint32_t solver_bodies = static_cast<std::uint32_t>(s.solver_slot.size());
+  s.kinematic_contacts = false;
+  if (!kinematic_.empty())
+    for (std::uint32_t k = s.moving; k < solver_bodies; ++k)
+      s.kinematic_contacts |= bodies_[s.solver_slot[k]].body.carries();
   s.bodies.resize(solver_bodies);
   s.poses.resize(solver_bodies);
   s.dynamic.resize(solver_bodies);
@@ -67,6 +71,11 @@ void World::load_solver_bodies() {
     s.dynamic[k] = k < s.moving;
     s.body_of[k] = &body;
     s.poses[k] = body.pose();
+    if (body.carries()) {  // its velocity, with no mass to change it
+      sb.v = body.linear_velocity;
+      sb.w = body.angular_velocity;
+      sb.kinematic = true;
+    }
     if (!s.dynamic[k]) return;
     sb.v = body.linear_velocity;
     sb.w = body.angular_velocity;

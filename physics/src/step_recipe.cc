@@ -66,7 +66,7 @@ Status World::step(double dt) {
   regions_since(&parallel.solve, &idle.solve);
 
   stage = std::chrono::steady_clock::now();
-  correct_positions();
+  correct_positions(dt);
   stats_.time.correct_positions = seconds_since(stage);
   regions_since(&parallel.correct_positions, &idle.correct_positions);
 

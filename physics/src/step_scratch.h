@@ -64,6 +64,11 @@ struct StepScratch {
   std::vector<SolverBody> bodies;
   std::vector<Pose> poses;
   std::vector<std::uint8_t> dynamic;  // 1 for [0, moving)
+  // Some contact touches a kinematic body with a velocity (SolverBody::kinematic): the solvers'
+  // separations count its motion, and what it touches does not fall asleep (carried, by solver
+  // index, made by update_sleep).
+  bool kinematic_contacts = false;
+  std::vector<std::uint8_t> carried;
   std::vector<const Body*> body_of;
   std::vector<ContactRow> rows;           // manifold order
   std::vector<ContactRowCold> cold_rows;  // beside rows, row for row

@@ -210,9 +210,10 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     slot.alive = true;
     // A moving body joins the moving set, which every step visits anyway; only a resting one
     // changes what the broad phase keeps.
+    if (slot.body.is_kinematic()) kinematic_.push_back(index);
     if (slot.body.is_moving())
       join_awake(index);
-    else
+    else if (!slot.body.carries())  // a carrier's bounds are made every step, as a moving body's
       resting_changed(index);
     ids.push_back({index, slot.generation});
     ++live_count_;
@@ -232,6 +233,7 @@ Status World::remove_body(BodyId id) {
     leave_awake(id.index);
   else
     resting_changed(id.index);
+  if (slot.body.is_kinematic()) std::erase(kinematic_, id.index);
   // The step's per-slot data forget it (bounds kept for moving bodies are not visited again).
   if (id.index < bounds_.size()) {
     bounds_[id.index] = Aabb();
@@ -291,6 +293,14 @@ Status World::check_motion(BodyId id, const BodyMotion& motion) const {
       return Status::error("orientation: must be a unit quaternion");
   }
   const bool is_static = body.is_static();
+  if (body.is_kinematic()) {
+    if (Status s = check_kinematic_motion(
+            motion.force.value_or(Vec3::Zero()), motion.torque.value_or(Vec3::Zero()),
+            motion.gravity_scale.value_or(1), motion.linear_damping.value_or(0),
+            motion.angular_damping.value_or(0));
+        !s)
+      return s;
+  }
   for (const auto& [velocity, name] : {std::pair{&motion.linear_velocity, "linear_velocity"},
                                        {&motion.angular_velocity, "angular_velocity"}}) {
     if (!*velocity) continue;
@@ -308,6 +318,9 @@ Status World::check_motion(BodyId id, const BodyMotion& motion) const {
                                   motion.angular_damping.value_or(body.angular_damping));
       !s)
     return s;
+  if (body.is_kinematic())
+    return check_speeds(motion.linear_velocity.value_or(body.linear_velocity),
+                        motion.angular_velocity.value_or(body.angular_velocity), settings_.limits);
   if (is_static) {
     for (const auto& [v, name] :
          {std::pair{&motion.force, "force"}, std::pair{&motion.torque, "torque"}})
@@ -328,14 +341,16 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
   if (Status s = check_motion(id, motion); !s) return s;
   ++query_version_;
   Body& body = bodies_[id.index].body;
-  if (body.is_static()) wake_around(body);  // what rested on it where it was
+  const bool immovable = !body.is_dynamic();  // moved here only by the user
+  const bool carried_before = body.carries();
+  if (immovable) wake_around(body);  // what rested on it where it was
   if (motion.position) body.position = *motion.position;
   if (motion.orientation) body.orientation = motion.orientation->normalized();
   if (!body.is_static()) {
     if (motion.linear_velocity) body.linear_velocity = *motion.linear_velocity;
     if (motion.angular_velocity) body.angular_velocity = *motion.angular_velocity;
-    std::tie(body.force, body.torque) = held_forces(body, motion);
   }
+  if (body.is_dynamic()) std::tie(body.force, body.torque) = held_forces(body, motion);
   if (motion.gravity_scale) body.gravity_scale = *motion.gravity_scale;
   if (motion.linear_damping) body.linear_damping = *motion.linear_damping;
   if (motion.angular_damping) body.angular_damping = *motion.angular_damping;
@@ -347,8 +362,10 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
     wake_around(body);
   }
   body.update_world_inertia();
-  if (body.is_static()) resting_changed(id.index);  // (a sleeper wakes below, which counts too)
-  if (body.is_static()) {
+  // A resting body's bounds and cells change; a kinematic one that starts or stops moving joins
+  // or leaves the broad phase's moving bodies. (A sleeper wakes below, which counts too.)
+  if (immovable && (!body.carries() || !carried_before)) resting_changed(id.index);
+  if (immovable) {
     wake_around(body);         // and what it now touches
     wake_joined_to(id.index);  // and what its joints hold, however far
   } else if (body.asleep)
@@ -362,6 +379,8 @@ Status World::set_motion(BodyId id, const BodyMotion& motion) {
 Status World::check_impulse(BodyId id, const Vec3& impulse, const Vec3* point) const {
   if (!contains(id)) return Status::not_found("body: no body with this id");
   if (bodies_[id.index].body.is_static()) return Status::error("body: a static body does not move");
+  if (bodies_[id.index].body.is_kinematic())
+    return Status::error("body: a kinematic body moves only by the velocity given it");
   if (!is_finite(impulse)) return Status::error("impulse: must be finite");
   if (point != nullptr && !is_finite(*point)) return Status::error("point: must be finite");
   const Body& body = bodies_[id.index].body;
@@ -395,6 +414,8 @@ Status World::apply_impulses(std::span<const ImpulseAt> impulses) {
     if (!contains(entry.body)) return Status::not_found(at() + "body: no body with this id");
     const Body& body = bodies_[entry.body.index].body;
     if (body.is_static()) return Status::error(at() + "body: a static body does not move");
+    if (body.is_kinematic())
+      return Status::error(at() + "body: a kinematic body moves only by the velocity given it");
     if (!is_finite(entry.impulse)) return Status::error(at() + "impulse: must be finite");
     if (entry.point && !is_finite(*entry.point))
       return Status::error(at() + "point: must be finite");
@@ -625,7 +646,19 @@ void World::compute_bounds(double dt) {
     const Aabb box = transform_aabb(body.shape.local_bounds(), body.pose());
     const double margin =
         settings_.collision.margin + (dt > 0 ? rest_margin(body.shape, solver) : 0.0);
-    if (dt > 0 && body.is_moving()) {
+    if (dt > 0 && body.carries()) {
+      // Moved by its velocity alone: swept along it, grown by its turn; never swept by
+      // continuous collision (what it meets is pushed, not stopped).
+      const Vec3 travel = body.linear_velocity * dt;
+      const double motion =
+          travel.norm() + body.angular_velocity.norm() * body.shape.outer_radius() * dt;
+      speculative_[i] = motion;
+      motion_[i] = motion;
+      Aabb swept = box;
+      swept.min += travel.cwiseMin(Vec3::Zero());
+      swept.max += travel.cwiseMax(Vec3::Zero());
+      bounds_[i] = swept.expanded(margin + motion - travel.norm());
+    } else if (dt > 0 && body.is_moving()) {
       // The box is swept along the velocity rather than grown by the speed on every side: boxes
       // falling side by side in a pile are not neighbours (a pile of 16,000 halved its pairs).
       // What the velocity cannot say, the pull of gravity over the step and the turn, grows it on
@@ -652,7 +685,7 @@ void World::compute_bounds(double dt) {
       bounds_[i] = box.expanded(margin);
     }
     // Sleepers pair only with moving bodies, as statics do.
-    movable_[i] = body.is_moving() ? 1 : 0;
+    movable_[i] = body.is_moving() || body.carries() ? 1 : 0;
   };
   const int threads = thread_count(settings_.threads);
   const std::span<const std::uint32_t> awake = awake_slots();
@@ -665,10 +698,27 @@ void World::compute_bounds(double dt) {
         bound(slot);
     const std::int64_t n = static_cast<std::int64_t>(awake.size());
     for_indices(threads, n > 256, n, [&](std::int64_t k) { bound(awake[k]); });
+    for (std::uint32_t slot : kinematic_)
+      if (bodies_[slot].body.carries()) bound(slot);
   }
   fast_count_ = 0;
   for (std::uint32_t slot : awake)
     fast_count_ += fast_[slot];
+}
+
+std::span<const std::uint32_t> World::broad_phase_moving() {
+  const std::span<const std::uint32_t> awake = awake_slots();
+  if (kinematic_.empty()) return awake;
+  moving_scratch_.assign(awake.begin(), awake.end());
+  const std::size_t dynamic = moving_scratch_.size();
+  for (std::uint32_t slot : kinematic_)
+    if (bodies_[slot].body.carries()) moving_scratch_.push_back(slot);
+  if (moving_scratch_.size() == dynamic) return awake;
+  std::sort(moving_scratch_.begin() + static_cast<std::ptrdiff_t>(dynamic), moving_scratch_.end());
+  std::inplace_merge(moving_scratch_.begin(),
+                     moving_scratch_.begin() + static_cast<std::ptrdiff_t>(dynamic),
+                     moving_scratch_.end());
+  return moving_scratch_;
 }
 
 std::span<const BodyPair> World::find_pairs() {
@@ -683,7 +733,7 @@ std::size_t World::max_pairs() const {
 
 void World::run_broad_phase() {
   BroadPhaseInput input{bounds_, movable_, thread_count(settings_.threads)};
-  input.moving = awake_slots();
+  input.moving = broad_phase_moving();
   input.moving_listed = true;
   input.resting_version = resting_version_;
   if (!resting_log_dropped_) {
@@ -747,6 +797,8 @@ void World::find_contacts(double dt) {
         // collision filters keep apart.
         if (!unjoined_pairs_.empty() && unjoined(pairs_[i].a, pairs_[i].b)) return 0u;
         if (filters_used_ && !a.filter.collides_with(b.filter)) return 0u;
+        // A kinematic body meets the dynamic ones only: nothing moves it.
+        if (!kinematic_.empty() && a.inverse_mass == 0 && b.inverse_mass == 0) return 0u;
         const Pose pose_a = a.pose(), pose_b = b.pose();
         CollisionSettings settings = settings_.collision;
         const bool fast = fast_[pairs_[i].a] || fast_[pairs_[i].b];

@@ -15,7 +15,7 @@ namespace tumble {
 // whole motion) is swept from the start pose to the solved end pose; each fast body then ends
 // the step at its first impact, in the state it had there. Only fast bodies are moved back: a
 // slow body keeps its solved pose, and its speculative contacts already covered its own motion.
-void World::sweep_fast_bodies(double /*dt*/) {
+void World::sweep_fast_bodies(double dt) {
   StepScratch& s = *scratch_;
   const SolverSettings& solver = settings_.solver;
   s.swept_pairs.clear();
@@ -35,6 +35,11 @@ void World::sweep_fast_bodies(double /*dt*/) {
     if (k != kNoSolverBody && s.dynamic[k]) {
       motion.translation = s.poses[k].position - body.position;
       motion.rotation = s.bodies[k].delta_angle;  // not wrapped at pi, unlike the end pose
+      motion.outer_radius = body.shape.outer_radius();
+    }
+    if (body.carries()) {
+      motion.translation = dt * body.linear_velocity;
+      motion.rotation = dt * body.angular_velocity;
       motion.outer_radius = body.shape.outer_radius();
     }
     return motion;

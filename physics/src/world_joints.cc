@@ -42,6 +42,10 @@ Status World::check_joint(const JointDef& def) const {
   const Body& a = bodies_[def.a.index].body;
   if (a.is_static() && (world_b || bodies_[def.b.index].body.is_static()))
     return Status::error("a: a joint needs a dynamic body on one side");
+  // Not yet: the joint solvers' position passes would need its motion over the step.
+  if (a.is_kinematic()) return Status::error("a: a joint holds no kinematic body (not yet)");
+  if (!world_b && bodies_[def.b.index].body.is_kinematic())
+    return Status::error("b: a joint holds no kinematic body (not yet)");
   const WorldLimits& limits = settings_.limits;
   auto within = [&](const Vec3& p) { return p.cwiseAbs().maxCoeff() <= limits.max_coordinate; };
   if (!within(def.anchor)) return Status::error("anchor: beyond the world's max_coordinate");

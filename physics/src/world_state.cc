@@ -27,9 +27,10 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
   if (!body.inertia_body.allFinite() || !body.inverse_inertia_body.allFinite() ||
       !body.inverse_inertia_world.allFinite())
     return Status::error("inertia: must be finite");
-  if (body.is_static()) {
+  if (!body.is_dynamic()) {
     if (body.inverse_mass != 0 || !body.inverse_inertia_body.isZero(0))
-      return Status::error("inverse_mass: must be 0 for a static body");
+      return Status::error("inverse_mass: must be 0 for a static or kinematic body");
+    if (body.asleep) return Status::error("asleep: only a dynamic body sleeps");
   } else {
     if (!(body.mass > 0) || !std::isfinite(body.mass) || !(body.inverse_mass > 0) ||
         !std::isfinite(body.inverse_mass))
@@ -61,6 +62,14 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
     return Status::error("force, torque: must be finite");
   if (body.is_static() && !(body.force.isZero(0) && body.torque.isZero(0)))
     return Status::error("force, torque: must be 0 for a static body");
+  if (body.is_static() && !(body.linear_velocity.isZero(0) && body.angular_velocity.isZero(0)))
+    return Status::error("linear_velocity, angular_velocity: must be 0 for a static body");
+  if (body.is_kinematic()) {
+    if (Status s = check_kinematic_motion(body.force, body.torque, body.gravity_scale,
+                                          body.linear_damping, body.angular_damping);
+        !s)
+      return s;
+  }
   if (!(body.sleep_timer >= 0) || !std::isfinite(body.sleep_timer))
     return Status::error("sleep_timer: must be finite and >= 0");
   if (body.sleep_island >= slot_count) return Status::error("sleep_island: out of range");
@@ -113,6 +122,9 @@ Status check_joint(const Joint& joint, std::span<const BodySlotState> slots,
   const bool b_static = joint.b == kWorldAnchor || slots[joint.b].body.is_static();
   if (slots[joint.a].body.is_static() && b_static)
     return Status::error("a: a joint needs a dynamic body on one side");
+  if (slots[joint.a].body.is_kinematic() ||
+      (joint.b != kWorldAnchor && slots[joint.b].body.is_kinematic()))
+    return Status::error("a, b: a joint holds no kinematic body");
   const double reach = 2 * limits.max_coordinate;
   if (!is_finite(joint.local_a) || !is_finite(joint.local_b) ||
       joint.local_a.cwiseAbs().maxCoeff() > reach || joint.local_b.cwiseAbs().maxCoeff() > reach)
@@ -237,6 +249,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     if (!world.bodies_[i].alive) continue;
     if (world.bodies_[i].body.asleep) world.link_sleeper(i, world.bodies_[i].body.sleep_island);
     if (world.bodies_[i].body.is_moving()) world.awake_.push_back(i);
+    if (world.bodies_[i].body.is_kinematic()) world.kinematic_.push_back(i);
     world.filters_used_ = world.filters_used_ || world.bodies_[i].body.filter != CollisionFilter{};
   }
   world.live_count_ = live;

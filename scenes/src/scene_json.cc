@@ -164,7 +164,12 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   BodyDef def;
   def.shape = read_shape(r);
   const bool plane = std::holds_alternative<HalfSpaceDef>(def.shape);
-  def.type = r.boolean("static", plane) ? BodyType::kStatic : BodyType::kDynamic;
+  const bool is_static = r.boolean("static", plane);
+  const bool kinematic = r.boolean("kinematic", false);
+  if (is_static && kinematic) fail(r.child("kinematic"), "a body is static or kinematic, not both");
+  def.type = is_static ? BodyType::kStatic
+             : kinematic ? BodyType::kKinematic
+                         : BodyType::kDynamic;
   def.mass = r.number("mass", 0);
   def.density = r.number("density", def.density);
   def.position = r.vector("position", def.position);
@@ -385,6 +390,7 @@ Json body_json(const BodyDef& def) {
       },
       def.shape);
   out["static"] = def.type == BodyType::kStatic;
+  if (def.type == BodyType::kKinematic) out["kinematic"] = true;
   if (def.mass > 0)
     out["mass"] = def.mass;
   else

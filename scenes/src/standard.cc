@@ -109,6 +109,28 @@ SceneDef spin_scene() {
   return scene;
 }
 
+SceneDef carousel_scene(double turn) {
+  SceneDef scene = base_scene("carousel", 20);
+  scene.bodies.push_back(ground());
+  BodyDef deck = box(Vec3(8, 8, 0.2), 0, Vec3(0, 0, 0.3));
+  deck.type = BodyType::kKinematic;
+  deck.angular_velocity = Vec3(0, 0, turn);
+  scene.bodies.push_back(deck);
+  const double radius = 2.5, size = 0.5;
+  for (int side = 0; side < 4; ++side) {
+    const double angle = side * std::numbers::pi / 2;
+    const Vec3 at(radius * std::cos(angle), radius * std::sin(angle), 0);
+    for (int level = 0; level < 5; ++level) {
+      BodyDef b = box(Vec3::Constant(size), 1, at + Vec3(0, 0, 0.4 + size * (level + 0.5)));
+      b.friction = 0.8;
+      b.linear_velocity = deck.angular_velocity.cross(at);  // where it stands, the deck's
+      b.angular_velocity = deck.angular_velocity;
+      scene.bodies.push_back(b);
+    }
+  }
+  return scene;
+}
+
 SceneDef bounce_scene(double height, double restitution) {
   SceneDef scene = base_scene("bounce", 3);
   BodyDef dropped = box(Vec3::Ones(), 1, Vec3(0, 0, 0.5 + height));
@@ -479,6 +501,10 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     if (Status s = sized("bounce"); !s) return s;
     return bounce_scene();
   }
+  if (name == "carousel") {
+    if (Status s = sized("carousel"); !s) return s;
+    return carousel_scene();
+  }
   if (name == "chain") return chain_scene(size.value_or(20), ratio.value_or(1));
   if (name == "rope-bridge") return rope_bridge_scene(size.value_or(20));
   if (name == "double-pendulum") {
@@ -509,7 +535,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   return Status::error("scene '" + shown(spec) +
                        "': unknown; the standard scenes are pile, pyramid, tower, mass-ratio, "
                        "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
-                       "chain, cradle, door, rope-bridge, arm, ragdolls, default");
+                       "chain, cradle, door, rope-bridge, arm, ragdolls, carousel, default");
 }
 
 }  // namespace

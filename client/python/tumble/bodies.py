@@ -54,12 +54,13 @@ class BodySpec:
     torque: Optional[tuple] = None
     collision_layers: Optional[int] = None
     collision_mask: Optional[int] = None
+    kinematic: bool = False
 
     def __init__(self, shape, position=None, linear_velocity=None, orientation=None,
                  angular_velocity=None, mass=None, density=None, friction=None, restitution=None,
                  color=None, static=False, *, pos=None, vel=None, gravity_scale=None,
                  linear_damping=None, angular_damping=None, force=None, torque=None,
-                 collision_layers=None, collision_mask=None):
+                 collision_layers=None, collision_mask=None, kinematic=False):
         self.shape = shape
         self.position = aliased("position", position, "pos", pos, (0.0, 0.0, 0.0))
         self.linear_velocity = aliased("linear_velocity", linear_velocity, "vel", vel,
@@ -72,6 +73,7 @@ class BodySpec:
         self.restitution = restitution
         self.color = color
         self.static = static
+        self.kinematic = kinematic
         self.gravity_scale = gravity_scale
         self.linear_damping = linear_damping
         self.angular_damping = angular_damping
@@ -86,7 +88,10 @@ class BodySpec:
             raise ArgumentError(f"{name}.shape: expected one of {kinds}, got {self.shape!r}")
         spec = pb.BodySpec()
         spec.shape.CopyFrom(self.shape.to_proto())
-        spec.type = pb.BODY_TYPE_STATIC if self.static else pb.BODY_TYPE_DYNAMIC
+        if self.static and self.kinematic:
+            raise ArgumentError(f"{name}.kinematic: a body is static or kinematic, not both")
+        spec.type = (pb.BODY_TYPE_STATIC if self.static else
+                     pb.BODY_TYPE_KINEMATIC if self.kinematic else pb.BODY_TYPE_DYNAMIC)
         convert.set_vec3(spec.position, self.position, f"{name}.position")
         convert.set_vec3(spec.linear_velocity, self.linear_velocity, f"{name}.linear_velocity")
         if self.orientation is not None:
@@ -128,8 +133,10 @@ class Description:
     id: int
     shape: object
     static: bool
-    mass: float  # kg; 0 for static bodies
+    mass: float  # kg; 0 for static and kinematic bodies
     color: int  # 0xRRGGBBAA; 0: the viewer chooses
+    # Moved only by the velocity given it (spawn, set_state), never pushed back.
+    kinematic: bool = False
 
     @staticmethod
     def from_proto(description):
@@ -139,6 +146,7 @@ class Description:
             static=description.type == pb.BODY_TYPE_STATIC,
             mass=description.mass,
             color=description.color,
+            kinematic=description.type == pb.BODY_TYPE_KINEMATIC,
         )
 
 

@@ -145,8 +145,10 @@ class WorldCalls:
     def spawn(self, shape, position=None, linear_velocity=None, **options):
         """Spawns one body of `shape` (Box, Sphere, Capsule, Hull or Plane); returns its id.
         Options are BodySpec's: orientation, angular_velocity, mass, density, friction,
-        restitution, color, static (and pos, vel: the older names of position and
-        linear_velocity)."""
+        restitution, color, static, kinematic (moved only by its velocity: linear_velocity,
+        angular_velocity, and set_state's), gravity_scale, linear_damping, angular_damping,
+        force, torque, collision_layers, collision_mask (and pos, vel: the older names of
+        position and linear_velocity)."""
         return self.spawn_many([BodySpec(shape, position, linear_velocity, **options)])[0]
 
     def spawn_many(self, specs):

@@ -22,8 +22,10 @@ struct BodyId {
 };
 
 enum class BodyType : std::uint8_t {
-  kStatic,   // infinite mass, never moves
-  kDynamic,  // moved by forces and contacts
+  kStatic,     // infinite mass, never moves
+  kDynamic,    // moved by forces and contacts
+  kKinematic,  // infinite mass, moved only by the velocity the user gives it (a platform, a
+               // conveyor, a door): it pushes dynamic bodies and is never pushed back
 };
 
 // Which bodies collide: two do when each one's layers meet the other's mask (Bullet's group and

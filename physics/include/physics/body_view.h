@@ -26,14 +26,15 @@ class BodyView {
 
   BodyType type() const;
   bool is_static() const;
+  bool is_kinematic() const;
   bool asleep() const;
   // Dynamic and awake: what the step moves.
   bool is_moving() const;
 
   // The shape, re-centred on the centre of mass.
   const Shape& shape() const;
-  double mass() const;          // kg; 0 for static
-  double inverse_mass() const;  // 1/kg; 0 for static
+  double mass() const;          // kg; 0 for static and kinematic
+  double inverse_mass() const;  // 1/kg; 0 for static and kinematic
   Mat3 inertia_body() const;    // kg m^2, body frame
   Mat3 inverse_inertia_world() const;
   double friction() const;

@@ -297,7 +297,7 @@ class World {
   void choose_island_solvers(double dt);
   void group_for_sweeps();
   void solve_islands(double dt);
-  void correct_positions();
+  void correct_positions(double dt);
   void sweep_fast_bodies(double dt);
   void finish_step(double dt);
 
@@ -320,6 +320,15 @@ class World {
   // rest leave it lazily (awake_stale_): awake_slots() drops them.
   std::vector<std::uint32_t> awake_;
   bool awake_sorted_ = true, awake_stale_ = false;
+  // The kinematic bodies' slots, in no order: the step moves those with a velocity (carries()),
+  // which are few, and treats the rest as statics. A world without pays one test of emptiness.
+  std::vector<std::uint32_t> kinematic_;
+  // The broad phase's moving bodies: awake_ and the kinematic bodies with a velocity, ascending
+  // (awake_ itself where there are none).
+  std::vector<std::uint32_t> moving_scratch_;
+  std::span<const std::uint32_t> broad_phase_moving();
+  // Moves the kinematic bodies with a velocity by dt (after the solve).
+  void move_kinematic(double dt);
   std::size_t sleeping_count_ = 0;  // bodies in sleeper_head_'s sets
   // Bodies that do not move (statics, sleepers) keep their bounds, and the broad phase their
   // cells, until one of them changes: every change to them (made, removed, moved, asleep, woken)

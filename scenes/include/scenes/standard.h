@@ -35,6 +35,10 @@ SceneDef mass_ratio_scene(bool inverted = false);  // S4: 1, 1, 1000 kg bottom t
 SceneDef bullet_scene();                           // S5: 0.1 m box at 300 m/s at a 5 cm wall, 1 s
 SceneDef slide_scene(double speed = 5);            // S6: a box sliding on the ground, 3 s
 SceneDef spin_scene();                             // S7: a 1x2x3 box spinning near its middle axis
+// A kinematic deck (8 x 8 x 0.2 m) turning at `turn` rad/s about its centre over the ground,
+// carrying four stacks of five 0.5 m boxes 2.5 m from the centre, started at the deck's velocity
+// where they stand; 20 s.
+SceneDef carousel_scene(double turn = 0.5);
 SceneDef bounce_scene(double height = 1,
                       double restitution = 0.5);  // dropped from `height`
                                                   // (bottom face above ground), 3 s
