@@ -306,6 +306,24 @@ int main(int argc, char** argv) {
   std::optional<std::uint32_t> overlap_mask;
   overlap->add_option("--mask", overlap_mask, "meet only bodies in these collision layers (bits)");
 
+  CLI::App* cast = app.add_subcommand(
+      "cast", "sweep a shape along a straight path: the first body it meets, as JSON");
+  SpawnOptions swept;
+  add_shape_options(cast, &swept);
+  cast->add_option("--position,--pos", swept.position, "x,y,z (m): where the sweep starts")
+      ->delimiter(',')
+      ->expected(3);
+  std::vector<double> cast_orientation, cast_translation;
+  cast->add_option("--orientation", cast_orientation, "w,x,y,z (the shape does not turn)")
+      ->delimiter(',')
+      ->expected(4);
+  cast->add_option("--translation,--by", cast_translation, "x,y,z (m, world): the sweep")
+      ->required()
+      ->delimiter(',')
+      ->expected(3);
+  std::optional<std::uint32_t> cast_mask;
+  cast->add_option("--mask", cast_mask, "meet only bodies in these collision layers (bits)");
+
   CLI::App* closest =
       app.add_subcommand("closest", "the point of a body's surface nearest to a point, as JSON");
   std::uint64_t closest_id = 0;
@@ -644,6 +662,36 @@ int main(int argc, char** argv) {
     Result<v1::QueryResponse> found = client.query(request);
     if (!found) return fail("overlap", found.status());
     print_line(nlohmann::json{{"ids", found.value().overlap_ids()}}.dump());
+  } else if (*cast) {
+    v1::QueryRequest request;
+    v1::ShapeCastQuery* query = request.add_shape_casts();
+    const v1::BodySpec spec = swept.spec();
+    *query->mutable_shape() = spec.shape();
+    *query->mutable_position() = spec.position();
+    if (!cast_orientation.empty()) {
+      v1::Quat* q = query->mutable_orientation();
+      q->set_w(cast_orientation[0]);
+      q->set_x(cast_orientation[1]);
+      q->set_y(cast_orientation[2]);
+      q->set_z(cast_orientation[3]);
+    }
+    set_vec(cast_translation, query->mutable_translation());
+    if (cast_mask) query->set_mask(*cast_mask);
+    Result<v1::QueryResponse> found = client.query(request);
+    if (!found) return fail("cast", found.status());
+    const v1::QueryResponse& r = found.value();
+    if (!r.cast_hits(0)) {
+      print_line(nlohmann::json{{"hit", false}}.dump());
+    } else {
+      const auto triple = [](const auto& v) { return nlohmann::json{v[0], v[1], v[2]}; };
+      print_line(nlohmann::json{{"hit", true},
+                                {"id", r.cast_ids(0)},
+                                {"fraction", r.cast_fractions(0)},
+                                {"point", triple(r.cast_points())},
+                                {"normal", triple(r.cast_normals())},
+                                {"converged", r.cast_converged(0)}}
+                     .dump());
+    }
   } else if (*closest) {
     v1::QueryRequest request;
     v1::ClosestPointQuery* query = request.add_closest_points();

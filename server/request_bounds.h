@@ -23,6 +23,9 @@ inline constexpr std::size_t kMaxQueryRays = 262144, kMaxQueryHits = 262144, kMa
 inline constexpr std::size_t kMaxQueryOverlaps = 256;
 // Closest-point queries a request may hold.
 inline constexpr std::size_t kMaxQueryClosest = 65536;
+// Shape casts a request may hold, and the bodies their swept bounds may reach in all (each is met
+// by up to kShapeCastIterations narrow-phase calls): refused before any is tested.
+inline constexpr std::size_t kMaxQueryShapeCasts = 1024, kMaxCastCandidates = 65536;
 
 // The largest request of each method, in bytes on the wire (after decompression).
 struct MethodBounds {

@@ -410,6 +410,16 @@ class FuzzService {
           set(h.vector(-10, 10), closest->mutable_point());
           if (h.chance(0.5)) closest->set_max_distance(h.number(0, 100));
         }
+        for (int n = h.chance(0.02) ? 1100 : h.integer(0, 2); n > 0; --n) {
+          v1::ShapeCastQuery* cast = request.add_shape_casts();
+          const v1::BodySpec spec = body(h);
+          *cast->mutable_shape() = spec.shape();
+          *cast->mutable_position() = spec.position();
+          if (spec.has_orientation()) *cast->mutable_orientation() = spec.orientation();
+          const double reach = h.chance(0.05) ? 1e12 : h.chance(0.05) ? NAN : 20.0;
+          set(h.vector(-reach, reach), cast->mutable_translation());
+          if (h.chance(0.2)) cast->set_mask(h.integer(0, 7));
+        }
         v1::QueryResponse response;
         return stub_->Query(&context, request, &response);
       }

@@ -387,5 +387,157 @@ TEST(Overlaps, BadShapesAreRefusedNamingTheField) {
   EXPECT_EQ(world.overlap(query, 10, &found).error().rfind("orientation:", 0), 0u);
 }
 
+ShapeCast cast_of(ShapeDef shape, const Vec3& from, const Vec3& translation,
+                  const Quat& orientation = Quat::Identity()) {
+  ShapeCast cast;
+  cast.shape = std::move(shape);
+  cast.pose = {from, orientation};
+  cast.translation = translation;
+  return cast;
+}
+
+TEST(ShapeCasts, AgainstClosedForms) {
+  World world;
+  const BodyId ground = add(&world, HalfSpaceDef{}, Vec3::Zero());
+  const BodyId ball = add(&world, SphereDef{1}, Vec3(10, 1.5, 3));
+  // A ball of 0.5 swept along x at z = 3, y = 0.3: it first touches the ball of 1 (centre 1.2
+  // off its line) where the centres are 1.5 apart, x = 10 - sqrt(1.5^2 - 1.2^2) = 9.1. The answer
+  // is where the gap first falls below the tolerance: along the path, within the tolerance over
+  // the cosine of the approach (0.9 / 1.5).
+  const double length = 20;
+  Result<ShapeHit> hit =
+      world.cast_shape(cast_of(SphereDef{0.5}, Vec3(0, 0.3, 3), Vec3(length, 0, 0)));
+  ASSERT_TRUE(hit) << hit.status().message();
+  ASSERT_TRUE(hit.value().hit());
+  EXPECT_EQ(hit.value().body, ball);
+  EXPECT_TRUE(hit.value().converged);
+  EXPECT_LE(hit.value().fraction * length, 9.1 + 1e-12);
+  EXPECT_GE(hit.value().fraction * length, 9.1 - kShapeCastTolerance * 1.5 / 0.9);
+  const Vec3 at(hit.value().fraction * length, 0.3, 3);
+  EXPECT_LT((hit.value().normal - (at - Vec3(10, 1.5, 3)).normalized()).norm(), 1e-5);
+  EXPECT_LT((hit.value().point - (Vec3(10, 1.5, 3) + hit.value().normal)).norm(), 1e-5);
+  // A head-on approach: the ball of 0.5 centred on the other's line meets it at x = 8.5.
+  hit = world.cast_shape(cast_of(SphereDef{0.5}, Vec3(0, 1.5, 3), Vec3(length, 0, 0)));
+  ASSERT_TRUE(hit.value().hit());
+  EXPECT_NEAR(hit.value().fraction * length, 8.5, kShapeCastTolerance);
+  EXPECT_LT((hit.value().point - Vec3(9, 1.5, 3)).norm(), 1e-5);
+  EXPECT_LT((hit.value().normal - Vec3(-1, 0, 0)).norm(), 1e-9);
+  // A box turned 45 degrees about z dropped on the ground from 5 m: its bottom face lands when
+  // its centre is at 0.5, 4.5 m down 10.
+  const Quat turned(Eigen::AngleAxisd(std::numbers::pi / 4, Vec3::UnitZ()));
+  hit = world.cast_shape(cast_of(BoxDef{Vec3(0.5, 0.5, 0.5)}, Vec3(-5, 0, 5), Vec3(0, 0, -10),
+                                 turned));
+  ASSERT_TRUE(hit.value().hit());
+  EXPECT_EQ(hit.value().body, ground);
+  EXPECT_NEAR(hit.value().fraction, 0.45, 1e-12);
+  EXPECT_NEAR(hit.value().point.z(), 0, 1e-9);
+  EXPECT_LT((hit.value().normal - Vec3::UnitZ()).norm(), 1e-12);
+  // A capsule lying along x swept sideways into the box-shaped body's face.
+  const BodyId wall = add(&world, BoxDef{Vec3(0.1, 2, 2)}, Vec3(-10, 0, 5));
+  CapsuleDef lying{0.25, 1};
+  const Quat along_x(Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()));
+  hit = world.cast_shape(cast_of(lying, Vec3(-20, 0, 5), Vec3(10, 0, 0), along_x));
+  ASSERT_TRUE(hit.value().hit());
+  EXPECT_EQ(hit.value().body, wall);
+  // The capsule's end (centre - 1.25) meets the wall's face at -10.1: centre at -11.35.
+  EXPECT_NEAR(hit.value().fraction * 10, -11.35 + 20, 1e-6);
+  // Already overlapping: fraction 0. Nothing in the way: no hit.
+  hit = world.cast_shape(cast_of(SphereDef{0.5}, Vec3(10, 1.5, 3.2), Vec3(1, 0, 0)));
+  ASSERT_TRUE(hit.value().hit());
+  EXPECT_EQ(hit.value().fraction, 0);
+  hit = world.cast_shape(cast_of(SphereDef{0.5}, Vec3(0, 50, 3), Vec3(10, 0, 0)));
+  EXPECT_FALSE(hit.value().hit());
+}
+
+// Each body in a layer of its own: the nearest hit over all of them must be the earliest of the
+// casts against each body alone, to the bit, with any thread count.
+TEST(ShapeCasts, TheNearestOfEveryBodyCastAloneOnAnyThreadCount) {
+  Crowd crowd;
+  make_crowd(&crowd, 32, 11);
+  for (int k = 0; k < 32; ++k) {
+    BodyMotion motion;
+    motion.filter = CollisionFilter{1u << k, 0xFFFFFFFF};
+    ASSERT_TRUE(crowd.world.set_motion(crowd.ids[k], motion).is_ok());
+  }
+  testing::Random random(5);
+  std::vector<ShapeCast> casts;
+  const ShapeDef shapes[3] = {SphereDef{0.3}, BoxDef{Vec3(0.3, 0.2, 0.4)}, CapsuleDef{0.2, 0.3}};
+  for (int i = 0; i < 120; ++i) {
+    // Aimed near a body, 1.5 times as far as it: many hit, some miss.
+    const Vec3 from = random.vector(-15, 15);
+    const Vec3 aim = crowd.world.body(crowd.ids[i % 32])->position() + random.vector(-1.5, 1.5);
+    casts.push_back(cast_of(shapes[i % 3], from, 1.5 * (aim - from), random.rotation()));
+  }
+  std::vector<ShapeHit> hits(casts.size());
+  ASSERT_TRUE(crowd.world.cast_shapes(casts, hits).is_ok());
+  int hit_count = 0;
+  for (std::size_t i = 0; i < casts.size(); ++i) {
+    ShapeHit earliest;
+    for (int k = 0; k < 32; ++k) {
+      ShapeCast alone = casts[i];
+      alone.mask = 1u << k;
+      const ShapeHit h = crowd.world.cast_shape(alone).value();
+      if (h.hit() && (!earliest.hit() || h.fraction < earliest.fraction)) earliest = h;
+    }
+    ASSERT_EQ(hits[i].hit(), earliest.hit()) << i;
+    if (!earliest.hit()) continue;
+    ++hit_count;
+    EXPECT_EQ(hits[i].body, earliest.body) << i;
+    EXPECT_EQ(hits[i].fraction, earliest.fraction) << i;
+    EXPECT_EQ(hits[i].point, earliest.point) << i;
+    EXPECT_TRUE(hits[i].converged) << i;
+  }
+  EXPECT_GT(hit_count, 60);
+  EXPECT_LT(hit_count, 120);
+  WorldSettings one_thread = crowd.world.settings();
+  one_thread.threads = 1;
+  ASSERT_TRUE(crowd.world.set_settings(one_thread).is_ok());
+  std::vector<ShapeHit> again(casts.size());
+  ASSERT_TRUE(crowd.world.cast_shapes(casts, again).is_ok());
+  for (std::size_t i = 0; i < casts.size(); ++i) {
+    EXPECT_EQ(again[i].body, hits[i].body);
+    EXPECT_EQ(again[i].fraction, hits[i].fraction);
+  }
+}
+
+TEST(ShapeCasts, BadCastsAreRefusedNamingTheField) {
+  World world;
+  add(&world, SphereDef{1}, Vec3::Zero());
+  EXPECT_EQ(world.cast_shape(cast_of(HalfSpaceDef{}, Vec3::Zero(), Vec3::UnitX()))
+                .status()
+                .message(),
+            "shape: a half-space holds half the world and cannot be swept");
+  EXPECT_EQ(world.cast_shape(cast_of(SphereDef{1}, Vec3::Zero(), Vec3(NAN, 0, 0)))
+                .status()
+                .message(),
+            "translation: must be finite");
+  EXPECT_EQ(world.cast_shape(cast_of(SphereDef{1}, Vec3::Zero(), Vec3(2e10, 0, 0)))
+                .status()
+                .message(),
+            "translation: longer than 1e10 m");
+  std::vector<ShapeCast> casts = {cast_of(SphereDef{1}, Vec3(5, 0, 0), Vec3(-10, 0, 0)),
+                                  cast_of(SphereDef{-1}, Vec3(5, 0, 0), Vec3(-10, 0, 0))};
+  std::vector<ShapeHit> hits(2);
+  hits[0].fraction = 0.25;
+  const Status refused = world.cast_shapes(casts, hits);
+  EXPECT_NE(refused.message().find("casts[1].shape.radius"), std::string::npos)
+      << refused.message();
+  EXPECT_EQ(hits[0].fraction, 0.25);  // nothing was cast
+  // A batch whose sweeps reach more bodies than it may test is refused before any is tested.
+  for (int i = 0; i < 5; ++i)
+    add(&world, SphereDef{0.5}, Vec3(3.0 * i + 3, 0, 0));
+  casts = {cast_of(SphereDef{0.1}, Vec3(-2, 0, 0), Vec3(20, 0, 0))};
+  hits.assign(1, ShapeHit{});
+  hits[0].fraction = 0.25;
+  const Status too_many = world.cast_shapes(casts, hits, 4);
+  EXPECT_EQ(too_many.code(), StatusCode::kResourceExhausted);
+  EXPECT_NE(too_many.message().find("more than the 4 bodies"), std::string::npos)
+      << too_many.message();
+  EXPECT_EQ(hits[0].fraction, 0.25);
+  ASSERT_TRUE(world.cast_shapes(casts, hits, 6).is_ok());
+  // Head-on into the ball of 1 at the origin: the cast's centre stops at x = -1.1.
+  EXPECT_NEAR(hits[0].fraction * 20, 0.9, kShapeCastTolerance);
+}
+
 }  // namespace
 }  // namespace tumble

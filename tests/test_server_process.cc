@@ -238,6 +238,29 @@ TEST(ServerProcess, CliSpawnsAndSteersAKinematicBody) {
       << pushed.text;
 }
 
+TEST(ServerProcess, CliCastsAShape) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  // Far from the default scene's bodies.
+  const Output spawned = run(tumble + "spawn box --size 1,1,1 --static --pos 100,0,0.5");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  const std::string cube = spawned.text.substr(0, spawned.text.find('\n'));
+  const Output hit =
+      run(tumble + "cast sphere --radius 0.25 --pos 95,0,0.5 --translation 10,0,0");
+  ASSERT_EQ(hit.code, 0) << hit.text;
+  const nlohmann::json found = nlohmann::json::parse(hit.text);
+  EXPECT_EQ(found["hit"], true);
+  EXPECT_EQ(std::to_string(found["id"].get<std::uint64_t>()), cube);
+  EXPECT_NEAR(found["fraction"].get<double>() * 10, 4.25, 1e-6);
+  EXPECT_NEAR(found["normal"][0].get<double>(), -1, 1e-9);
+  const Output miss = run(tumble + "cast box --size 1,1,1 --pos 95,5,0.6 --by 10,0,0");
+  EXPECT_EQ(nlohmann::json::parse(miss.text)["hit"], false) << miss.text;
+  const Output refused = run(tumble + "cast sphere --radius -1 --translation 1,0,0");
+  EXPECT_NE(refused.code, 0);
+  EXPECT_NE(refused.text.find("shape_casts[0].shape.sphere.radius"), std::string::npos) << refused.text;
+}
+
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--max-message-mb", "1"}));

@@ -107,3 +107,26 @@ def test_closest_point_of_a_body(world):
         world.closest_point(987654, (0, 0, 0))
     with pytest.raises(tumble.Error, match=r"closest_points\[0\]\.max_distance: must be in"):
         world.closest_point(cube, (0, 0, 0), max_distance=-1)
+
+
+@pytest.mark.parametrize("where", ["remote", "local"])
+def test_cast_shape_finds_the_first_body_a_sweep_meets(world, where):
+    world = world if where == "remote" else tumble.World()
+    ground, cube = boxes_on_the_ground(world)
+    # A ball of 0.25 swept along x at the cube's height meets its face x = -0.5 when its centre
+    # is at -0.75: 4.25 m of the 10.
+    hit = world.cast_shape(tumble.Sphere(0.25), (-5, 0, 0.5), (10, 0, 0))
+    assert hit["body"] == cube and hit["converged"]
+    assert hit["fraction"] * 10 == pytest.approx(4.25, abs=1e-6)
+    np.testing.assert_allclose(hit["point"], [-0.5, 0, 0.5], atol=1e-5)
+    np.testing.assert_allclose(hit["normal"], [-1, 0, 0], atol=1e-9)
+    # A box dropped from 5 m lands on the ground (its bottom at z = 0: centre at 0.1).
+    hit = world.cast_shape(tumble.Box((1, 1, 0.2)), (3, 0, 5), (0, 0, -10))
+    assert hit["body"] == ground
+    assert hit["fraction"] == pytest.approx(0.49, abs=1e-12)
+    assert world.cast_shape(tumble.Sphere(0.25), (-5, 3, 0.5), (10, 0, 0)) is None
+    assert world.cast_shape(tumble.Sphere(0.25), (-5, 0, 0.5), (10, 0, 0), mask=0) is None
+    with pytest.raises(tumble.Error, match=r"shape_casts\[0\]\.shape: a half-space"):
+        world.cast_shape(tumble.Plane(), (0, 0, 0), (1, 0, 0))
+    with pytest.raises(tumble.Error, match=r"shape_casts\[0\]\.translation: must be finite"):
+        world.cast_shape(tumble.Sphere(0.25), (0, 0, 0), (float("nan"), 0, 0))

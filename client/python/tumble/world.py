@@ -319,6 +319,32 @@ class WorldCalls:
                 "point": np.array(response.closest_surface_points[:3]),
                 "normal": np.array(response.closest_normals[:3])}
 
+    def cast_shape(self, shape, position, translation, orientation=None, *, mask=None):
+        """Sweeps `shape` (Box, Sphere, Capsule or Hull) from `position` (m, world) along
+        `translation` (m, world) without turning it (`orientation`: w, x, y, z); returns the first
+        body it meets as a dict (body, fraction of the translation at first contact, 0 if it
+        starts touching; point on the body and the body's outward normal there, world; converged:
+        False when the advancement stopped at its bound), or None. `mask`: the collision layers
+        it meets (default every layer)."""
+        query = pb.ShapeCastQuery()
+        if not isinstance(shape, shapes.SHAPES):
+            raise ArgumentError(f"shape: expected a Box, Sphere, Capsule or Hull, got {shape!r}",
+                                "cast_shape")
+        query.shape.CopyFrom(shape.to_proto())
+        convert.set_vec3(query.position, position, "position")
+        convert.set_vec3(query.translation, translation, "translation")
+        if orientation is not None:
+            convert.set_quat(query.orientation, orientation, "orientation")
+        if mask is not None:
+            query.mask = bits(mask, "mask")
+        response = self._rpc("Query", pb.QueryRequest(shape_casts=[query]))
+        if not response.cast_hits[0]:
+            return None
+        return {"body": int(response.cast_ids[0]), "fraction": response.cast_fractions[0],
+                "point": np.array(response.cast_points[:3]),
+                "normal": np.array(response.cast_normals[:3]),
+                "converged": response.cast_converged[0]}
+
     def cast_ray(self, origin, direction, max_distance=1000.0, *, mask=None):
         """One ray's nearest hit as a dict (body, distance, fraction, point, normal), or None."""
         found = self.cast_rays([convert.array(origin, 3, "origin")],

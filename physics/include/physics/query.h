@@ -1,5 +1,5 @@
 // Asking the world what is there, between steps: ray casts (World::cast_ray, cast_rays,
-// cast_ray_all). A query reads the world and changes nothing; batches spread over the world's
+// cast_ray_all), shape casts (cast_shape, cast_shapes), overlaps and closest points. A query reads the world and changes nothing; batches spread over the world's
 // threads and give the same answers for any thread count.
 #pragma once
 
@@ -51,5 +51,36 @@ struct OverlapQuery {
   Pose pose;                      // of the shape's frame, world
   std::uint32_t mask = 0xFFFFFFFF;  // as RayCast::mask
 };
+
+// A shape swept along a straight path without turning, to find the first body it meets: a
+// gripper closing in, a character's step, a thick ray.
+struct ShapeCast {
+  ShapeDef shape = SphereDef{};      // any shape a body may have but a half-space
+  Pose pose;                          // of the shape's frame at the start, world
+  Vec3 translation = Vec3::Zero();    // m, world: the sweep; |translation| <= kMaxRayLength
+  std::uint32_t mask = 0xFFFFFFFF;    // as RayCast::mask
+};
+
+// m: a shape cast's answer is the first place along its sweep where the shape comes within this
+// of a body (conservative advancement stops there; docs/COLLISION.md, "Queries").
+inline constexpr double kShapeCastTolerance = 1e-6;
+// Advancement steps a shape cast takes against one body at most (each a narrow-phase call).
+inline constexpr int kShapeCastIterations = 64;
+
+struct ShapeHit {
+  BodyId body;                 // invalid: no hit
+  double fraction = 0;         // of the translation at first contact, in [0, 1]; 0 if it starts
+                               // touching or overlapping the body
+  Vec3 point = Vec3::Zero();   // m, world: the contact point on the body's surface there
+  Vec3 normal = Vec3::Zero();  // unit, world: the body's outward normal there (against the sweep)
+  // False when advancement against the body nearest in the sweep hit its bound
+  // (kShapeCastIterations) before coming within the tolerance: nothing is met before `fraction`,
+  // but the contact may lie a little beyond it.
+  bool converged = true;
+  bool hit() const { return body.is_valid(); }
+};
+
+// Checks a shape cast; the message names the field ("translation: must be finite").
+Status validate(const ShapeCast& cast);
 
 }  // namespace tumble

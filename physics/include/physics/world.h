@@ -244,6 +244,15 @@ class World {
   // field ("shape.radius: must be > 0").
   Result<bool> overlap(const OverlapQuery& query, std::size_t max_bodies,
                        std::vector<BodyId>* bodies) const;
+  // The first body a shape meets along its sweep (ShapeHit::hit() false for none; equal
+  // fractions go to the lower slot): one cast, or a batch spread over the world's threads (the
+  // same answers for any thread count). A cast refused names its entry ("casts[2].shape.radius:
+  // must be > 0") and nothing is cast. `max_candidates` bounds the bodies the batch's swept bounds
+  // may reach (each is then met by up to kShapeCastIterations narrow-phase calls): past it the
+  // batch is refused before any is tested.
+  Result<ShapeHit> cast_shape(const ShapeCast& cast) const;
+  Status cast_shapes(std::span<const ShapeCast> casts, std::span<ShapeHit> hits,
+                     std::size_t max_candidates = static_cast<std::size_t>(-1)) const;
   // The point of the body's surface nearest to `point` (m, world), if within max_distance (m,
   // > 0 and <= 1e10; a point inside always is); the narrow phase's exact distance.
   Result<ClosestPoint> closest_point(BodyId body, const Vec3& point, double max_distance) const;
