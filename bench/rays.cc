@@ -3,14 +3,19 @@
 // sensors above it looking down at random. Rays per second (the median of five runs) for Tumble on
 // one and two threads and Bullet (float, its dynamic AABB tree, ClosestRayResultCallback) on one;
 // and the disagreements of Tumble's nearest hits with a brute-force pass over every body (a
-// sample of the rays), and of Bullet's with Tumble's.
-// Usage: bench_rays [--rays N] [--boxes N]
+// sample of the rays), and of Bullet's with Tumble's. Then sphere casts (a ball of 0.3 m swept
+// along each of the first casts' rays) beside Bullet's convexSweepTest: casts per second, and
+// each of Tumble's answers checked on a sample against a reference of our own that needs no GJK
+// (the distance from the swept centre to each box, exact, is convex along the path: its first
+// fall below the radius by bisection).
+// Usage: bench_rays [--rays N] [--boxes N] [--casts N]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -73,10 +78,11 @@ double rays_per_second(std::size_t rays, Run&& run) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int ray_count = 100000, box_count = 10000;
+  int ray_count = 100000, box_count = 10000, cast_count = 10000;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rays")) ray_count = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--boxes")) box_count = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--casts")) cast_count = std::atoi(argv[i + 1]);
   }
   std::mt19937_64 rng(2026);
   const Scene scene = make_scene(box_count, &rng);
@@ -155,6 +161,107 @@ int main(int argc, char** argv) {
   std::printf("  brute force, %d rays: %d disagreements (closest hit within 1e-9 m), worst %.3g m\n",
               sample, disagreements, worst);
 
+  // Sphere casts: a ball of 0.3 m along the rays (their full length).
+  constexpr double kBall = 0.3;
+  cast_count = std::min(cast_count, ray_count);
+  std::vector<ShapeCast> casts(cast_count);
+  for (int i = 0; i < cast_count; ++i) {
+    casts[i].shape = SphereDef{kBall};
+    casts[i].pose.position = rays[i].origin;
+    casts[i].translation = rays[i].max_distance * rays[i].direction.normalized();
+  }
+  std::vector<ShapeHit> cast_hits(casts.size());
+  std::printf("%d sphere casts (a ball of %.1f m along the first rays)\n", cast_count, kBall);
+  for (int threads : {1, 2}) {
+    WorldSettings settings = world.settings();
+    settings.threads = threads;
+    (void)world.set_settings(settings);
+    const double rate =
+        rays_per_second(casts.size(), [&] { (void)world.cast_shapes(casts, cast_hits); });
+    std::printf("  Tumble, %d thread%s   %12.0f casts/s\n", threads, threads > 1 ? "s" : " ",
+                rate);
+  }
+  int cast_hit_count = 0, unconverged = 0;
+  for (const ShapeHit& hit : cast_hits) {
+    cast_hit_count += hit.hit();
+    unconverged += hit.hit() && !hit.converged;
+  }
+  std::printf("  %d of %d casts hit something, %d stopped at the iteration bound\n",
+              cast_hit_count, cast_count, unconverged);
+  // The reference: the exact distance from a point to a turned box, and for each box the swept
+  // centre's first fall within the ball's radius (the distance is convex along the path: its
+  // minimum by golden-section search, then the first crossing by bisection, to 1e-12 of the path).
+  auto box_distance = [&](std::size_t b, const Vec3& point) {
+    const Vec3 local = scene.pose[b].orientation.conjugate() * (point - scene.pose[b].position);
+    return (local.cwiseAbs() - scene.half[b]).cwiseMax(0.0).norm();
+  };
+  auto first_within = [&](std::size_t b, const ShapeCast& cast, double radius) {
+    auto gap = [&](double t) {
+      return box_distance(b, cast.pose.position + t * cast.translation) - radius;
+    };
+    if (gap(0) <= 0) return 0.0;
+    double lo = 0, hi = 1;
+    for (int k = 0; k < 100; ++k) {  // the minimum of a convex function, by thirds
+      const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+      if (gap(m1) < gap(m2))
+        hi = m2;
+      else
+        lo = m1;
+    }
+    if (gap(lo) > 0) return std::numeric_limits<double>::infinity();
+    double a = 0, b2 = lo;
+    for (int k = 0; k < 100; ++k) {
+      const double m = 0.5 * (a + b2);
+      (gap(m) > 0 ? a : b2) = m;
+    }
+    return b2;
+  };
+  auto reference_cast = [&](const ShapeCast& cast) {
+    double best = INFINITY;
+    const double dz = cast.translation.z();
+    if (dz < 0) best = std::max(0.0, (cast.pose.position.z() - kBall) / -dz);
+    if (best > 1) best = INFINITY;
+    const Vec3 end = cast.pose.position + cast.translation;
+    const Vec3 low = cast.pose.position.cwiseMin(end) - Vec3::Constant(kBall);
+    const Vec3 high = cast.pose.position.cwiseMax(end) + Vec3::Constant(kBall);
+    for (std::size_t b = 0; b < scene.half.size(); ++b) {
+      const double reach = scene.half[b].norm();
+      const Vec3& c = scene.pose[b].position;
+      if ((c.array() + reach < low.array()).any() || (c.array() - reach > high.array()).any())
+        continue;
+      best = std::min(best, first_within(b, cast, kBall));
+    }
+    return best;
+  };
+  const int cast_sample = std::min(cast_count, 500);
+  int cast_wrong = 0;
+  double worst_gap = 0, worst_early = 0;
+  for (int i = 0; i < cast_sample; ++i) {
+    const double reference = reference_cast(casts[i]);
+    const ShapeHit& hit = cast_hits[i];
+    if (!hit.hit()) {
+      cast_wrong += std::isfinite(reference) ? 1 : 0;
+      continue;
+    }
+    // Nothing is met before Tumble's fraction, and there the ball is within the tolerance of a
+    // body: the gap from the centre to the nearest surface, less the radius.
+    const Vec3 centre = casts[i].pose.position + hit.fraction * casts[i].translation;
+    double gap = std::max(0.0, centre.z() - kBall);
+    for (std::size_t b = 0; b < scene.half.size(); ++b)
+      gap = std::min(gap, box_distance(b, centre) - kBall);
+    const double length = casts[i].translation.norm();
+    worst_gap = std::max(worst_gap, gap);
+    worst_early = std::max(worst_early, (reference - hit.fraction) * length);
+    if (gap > kShapeCastTolerance + 1e-12 || gap < -1e-9 ||
+        hit.fraction > reference + 1e-12 || !hit.converged)
+      ++cast_wrong;
+  }
+  std::printf("  reference, %d casts: %d wrong (a miss that hits, a hit beyond the first contact "
+              "or not within %.0e m of a body); the gap at the answers at most %.2g m, the answers "
+              "at most %.2g m before the first contact along the path\n",
+              cast_sample, cast_wrong, kShapeCastTolerance, worst_gap, worst_early);
+  disagreements += cast_wrong;
+
 #ifdef TUMBLE_HAVE_BULLET
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher(&configuration);
@@ -215,6 +322,46 @@ int main(int argc, char** argv) {
               gaps.empty() ? 0.0 : gaps[gaps.size() * 99 / 100], gaps.empty() ? 0.0 : gaps.back());
   std::printf("  of the first %d rays where they differ, the brute force sides with Bullet on %d\n",
               std::min(differ, 200), tumble_wrong);
+  btSphereShape ball(kBall);
+  std::vector<double> bullet_fraction(casts.size());
+  const double bullet_cast_rate = rays_per_second(casts.size(), [&] {
+    for (std::size_t i = 0; i < casts.size(); ++i) {
+      const Vec3 from = casts[i].pose.position, to = from + casts[i].translation;
+      const btTransform a(btQuaternion::getIdentity(), btVector3(from.x(), from.y(), from.z()));
+      const btTransform b(btQuaternion::getIdentity(), btVector3(to.x(), to.y(), to.z()));
+      btCollisionWorld::ClosestConvexResultCallback closest(a.getOrigin(), b.getOrigin());
+      bullet.convexSweepTest(&ball, a, b, closest);
+      bullet_fraction[i] = closest.hasHit() ? closest.m_closestHitFraction : INFINITY;
+    }
+  });
+  std::printf("  Bullet float, 1 thread %12.0f casts/s (convexSweepTest)\n", bullet_cast_rate);
+  int cast_missed = 0, cast_differ = 0, reference_with_bullet = 0;
+  std::vector<double> cast_gaps;
+  for (std::size_t i = 0; i < casts.size(); ++i) {
+    const double tumble = cast_hits[i].hit() ? cast_hits[i].fraction : INFINITY;
+    if (std::isinf(tumble) != std::isinf(bullet_fraction[i])) {
+      ++cast_missed;
+      continue;
+    }
+    if (std::isinf(tumble)) continue;
+    const double length = casts[i].translation.norm();
+    cast_gaps.push_back(std::abs(tumble - bullet_fraction[i]) * length);
+    // Where they differ by over 1 mm, which one the reference sides with (the first 200).
+    if (cast_gaps.back() > 1e-3 && ++cast_differ <= 200) {
+      const double reference = reference_cast(casts[i]);
+      if (std::abs(reference - bullet_fraction[i]) < std::abs(reference - tumble))
+        ++reference_with_bullet;
+    }
+  }
+  std::sort(cast_gaps.begin(), cast_gaps.end());
+  std::printf("  Bullet's sphere casts beside Tumble's: %d hit in one and not the other; the "
+              "distances' differences: median %.2g m, 99th percentile %.2g m, largest %.2g m\n",
+              cast_missed, cast_gaps.empty() ? 0.0 : cast_gaps[cast_gaps.size() / 2],
+              cast_gaps.empty() ? 0.0 : cast_gaps[cast_gaps.size() * 99 / 100],
+              cast_gaps.empty() ? 0.0 : cast_gaps.back());
+  std::printf("  %d casts differ by over 1 mm; of the first %d, the reference sides with Bullet on "
+              "%d\n",
+              cast_differ, std::min(cast_differ, 200), reference_with_bullet);
 #else
   std::printf("  (no Bullet: built without the peers)\n");
 #endif

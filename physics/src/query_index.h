@@ -6,7 +6,10 @@
 // every ray.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <span>
 #include <vector>
@@ -14,6 +17,30 @@
 #include "physics/math.h"
 
 namespace tumble {
+
+// The first fraction t in [0, 1] at which `box` moved by t * translation meets `target`;
+// infinity when it never does (the slabs of the two boxes' Minkowski difference). Infinite
+// targets (a half-space) are met from the start on their unbounded sides.
+inline double sweep_entry(const Aabb& box, const Vec3& translation, const Aabb& target) {
+  double enter = 0, leave = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double low = target.min[k] - box.max[k];   // the move along k that starts the overlap
+    const double high = target.max[k] - box.min[k];  // and that ends it
+    const double d = translation[k];
+    if (d == 0) {
+      if (!(low <= 0 && high >= 0)) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double t0 = low / d, t1 = high / d;
+    if (t0 > t1) std::swap(t0, t1);
+    if (std::isnan(t0)) t0 = 0;  // an infinite side moved along: met throughout
+    if (std::isnan(t1)) t1 = 1;
+    enter = std::max(enter, t0);
+    leave = std::min(leave, t1);
+    if (enter > leave) return std::numeric_limits<double>::infinity();
+  }
+  return enter;
+}
 
 class QueryIndex {
  public:
@@ -33,6 +60,11 @@ class QueryIndex {
   // Calls visit(slot) for every body whose box overlaps `box` (and every unbounded one).
   template <class Visit>
   void visit_box(const Aabb& box, Visit&& visit) const;
+
+  // Calls visit(slot, entry) for every body whose box `box` moved by t * translation, t in
+  // [0, 1], meets, with the first such t (sweep_entry); only the nodes along the path are opened.
+  template <class Visit>
+  void visit_sweep(const Aabb& box, const Vec3& translation, Visit&& visit) const;
 
   // The version of the world this tree was built for (World's query version), and the lock that
   // lets one thread build it while queries from others wait.
@@ -102,6 +134,28 @@ void QueryIndex::visit_box(const Aabb& box, Visit&& visit) const {
     if (node.count > 0) {
       for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
         if (entries_[k].bounds.overlaps(box)) visit(entries_[k].slot);
+      continue;
+    }
+    stack[depth++] = node.first;
+    stack[depth++] = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
+  }
+}
+
+template <class Visit>
+void QueryIndex::visit_sweep(const Aabb& box, const Vec3& translation, Visit&& visit) const {
+  for (std::uint32_t slot : unbounded_)
+    visit(slot, 0.0);
+  if (nodes_.empty()) return;
+  std::uint32_t stack[64];
+  int depth = 0;
+  stack[depth++] = 0;
+  while (depth > 0) {
+    const Node& node = nodes_[stack[--depth]];
+    if (!(sweep_entry(box, translation, node.bounds) <= 1)) continue;
+    if (node.count > 0) {
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+        if (const double entry = sweep_entry(box, translation, entries_[k].bounds); entry <= 1)
+          visit(entries_[k].slot, entry);
       continue;
     }
     stack[depth++] = node.first;

@@ -1,5 +1,5 @@
 // Shape casts (physics/query.h): the shape's bounds swept along its path pick candidate bodies
-// from the query tree (query_index.h); they are met in the order in which the sweeping box can
+// from the query tree (query_index.h, visit_sweep); they are met in the order in which the sweeping box can
 // first reach them, each by conservative advancement (continuous.h, with no rotation: the gap is
 // then a convex function of the fraction and each step is its tangent, so advancement never
 // steps over the first contact), until no candidate left can come before the best hit.
@@ -34,30 +34,6 @@ Status validate(const ShapeCast& cast) {
 
 namespace {
 
-// The first fraction t in [0, 1] at which `box` moved by t * translation meets `target`; infinity
-// when it never does. A lower bound on the shapes' first contact, from their bounds alone.
-double box_entry(const Aabb& box, const Vec3& translation, const Aabb& target) {
-  double enter = 0, leave = 1;
-  for (int k = 0; k < 3; ++k) {
-    // Unbounded targets (a half-space) are met from the start on their unbounded sides.
-    const double low = target.min[k] - box.max[k];   // the move along k that starts the overlap
-    const double high = target.max[k] - box.min[k];  // and that ends it
-    const double d = translation[k];
-    if (d == 0) {
-      if (!(low <= 0 && high >= 0)) return std::numeric_limits<double>::infinity();
-      continue;
-    }
-    double t0 = low / d, t1 = high / d;
-    if (t0 > t1) std::swap(t0, t1);
-    if (std::isnan(t0)) t0 = 0;  // an infinite side moved along: met throughout
-    if (std::isnan(t1)) t1 = 1;
-    enter = std::max(enter, t0);
-    leave = std::min(leave, t1);
-    if (enter > leave) return std::numeric_limits<double>::infinity();
-  }
-  return enter;
-}
-
 struct Candidate {
   double entry;
   std::uint32_t slot;
@@ -86,25 +62,23 @@ Status World::cast_shapes(std::span<const ShapeCast> casts, std::span<ShapeHit> 
     if (!shape) return shape.status().within(at + "shape.");
     shapes.push_back(std::move(shape).value());
   }
-  // Every cast's candidates first, from the tree alone, so that a batch whose sweeps reach more
-  // bodies than it may test is refused before any is tested.
+  // Every cast's candidates first, from the tree alone (over the threads), so that a batch whose
+  // sweeps reach more bodies than it may test is refused before any is tested.
   const QueryIndex& index = query_index();
   std::vector<std::vector<Candidate>> candidates(casts.size());
-  std::size_t total = 0;
-  for (std::size_t i = 0; i < casts.size(); ++i) {
+  const int threads = team_size(settings_.threads);
+  const std::int64_t n = static_cast<std::int64_t>(casts.size());
+  for_indices(threads, n >= 8, n, [&](std::int64_t i) {
     const ShapeCast& cast = casts[i];
     const Aabb start = transform_aabb(shapes[i].local_bounds(),
                                       {cast.pose.position, cast.pose.orientation.normalized()});
-    Aabb swept = start;
-    swept.min += cast.translation.cwiseMin(Vec3::Zero());
-    swept.max += cast.translation.cwiseMax(Vec3::Zero());
-    index.visit_box(swept, [&](std::uint32_t slot) {
-      const Body& body = bodies_[slot].body;
-      if ((body.filter.layers & cast.mask) == 0) return;
-      const double entry = box_entry(
-          start, cast.translation, transform_aabb(body.shape.local_bounds(), body.pose()));
-      if (entry <= 1) candidates[i].push_back({entry, slot});
+    index.visit_sweep(start, cast.translation, [&](std::uint32_t slot, double entry) {
+      if ((bodies_[slot].body.filter.layers & cast.mask) != 0)
+        candidates[i].push_back({entry, slot});
     });
+  });
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < casts.size(); ++i) {
     total += candidates[i].size();
     if (total > max_candidates)
       return Status::error("casts: the sweeps reach more than the " +
@@ -113,8 +87,6 @@ Status World::cast_shapes(std::span<const ShapeCast> casts, std::span<ShapeHit> 
                                "]); cast shorter or fewer",
                            StatusCode::kResourceExhausted);
   }
-  const int threads = team_size(settings_.threads);
-  const std::int64_t n = static_cast<std::int64_t>(casts.size());
   for_indices(threads, n >= 8, n, [&](std::int64_t i) {
     const ShapeCast& cast = casts[i];
     const Shape& shape = shapes[i];
