@@ -49,6 +49,10 @@ class BulletSimulation final : public Simulation {
   // False (with the reason) for a shape this adapter does not map.
   bool add(const BodyDef& def, double mass, const Vec3& inertia, const PeerOptions& options,
            std::string* why_not) {
+    if (def.type == BodyType::kKinematic) {
+      *why_not = "kinematic bodies are not mapped to this peer";
+      return false;
+    }
     std::unique_ptr<btCollisionShape> shape;
     btTransform pose(btQuaternion(def.orientation.x(), def.orientation.y(), def.orientation.z(),
                                   def.orientation.w()),

@@ -104,6 +104,11 @@ struct Placement {
 // become free roots, lowest index first, and the growth goes on from them.
 bool place(const SceneDef& scene, std::vector<Placement>* placements, std::string* why_not) {
   const std::size_t n = scene.bodies.size();
+  for (const BodyDef& def : scene.bodies)
+    if (def.type == BodyType::kKinematic) {
+      *why_not = "kinematic bodies are not mapped to this peer";
+      return false;
+    }
   std::vector<Placement>& at = *placements;
   at.assign(n, {});
   for (std::size_t i = 0; i < n; ++i)

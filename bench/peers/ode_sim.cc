@@ -46,6 +46,10 @@ class OdeSimulation final : public Simulation {
   }
 
   bool add(const BodyDef& def, double mass_kg, const Vec3& inertia, std::string* why_not) {
+    if (def.type == BodyType::kKinematic) {
+      *why_not = "kinematic bodies are not mapped to this peer";
+      return false;
+    }
     scene_bodies_.push_back(nullptr);
     dGeomID geom = nullptr;
     if (std::holds_alternative<HalfSpaceDef>(def.shape)) {

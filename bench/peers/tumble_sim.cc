@@ -35,7 +35,7 @@ class TumbleSimulation final : public Simulation {
     settings_ += "; " + (threads > 0 ? std::to_string(threads) : std::string("all")) + " thread" +
                  (threads == 1 ? "" : "s") + "; sleeping " + (s.sleeping ? "on" : "off");
     for (std::uint32_t i = 0; i < world_.slot_count(); ++i)
-      if (const BodyView b = world_.body(world_.id_at(i)); b && !b->is_static())
+      if (const BodyView b = world_.body(world_.id_at(i)); b && b->type() == BodyType::kDynamic)
         dynamic_.push_back(world_.id_at(i));
   }
   bool step() override { return world_.step(dt_).is_ok(); }

@@ -283,8 +283,45 @@ Reference converged_reference(SceneDef scene, std::string what, bool quick) {
       }};
 }
 
+// The standard scene `carousel`: stacks carried round on a kinematic deck turning at 0.5 rad/s
+// stay where they stand on it. The error is the farthest any box ends from its place on the
+// deck (its creep outward, docs/DYNAMICS.md, "Kinematic bodies"), in m.
+class CarriedStacks final : public ErrorMeter {
+ public:
+  explicit CarriedStacks(SceneDef scene) : scene_(std::move(scene)) {}
+  void observe(const bench::Simulation& sim, double t) override {
+    const Eigen::AngleAxisd turned(0.5 * t, Vec3::UnitZ());
+    worst_ = 0;
+    std::size_t box = 0;
+    for (const BodyDef& def : scene_.bodies) {
+      if (def.type != BodyType::kDynamic) continue;
+      const Vec3 place = turned * def.position;
+      const Vec3 at = sim.body(box++).position;
+      worst_ = at.allFinite() ? std::max(worst_, (at - place).norm()) : kNaN;
+    }
+  }
+  double error() const override { return worst_; }
+
+ private:
+  SceneDef scene_;
+  double worst_ = kNaN;
+};
+
+Reference carousel(bool quick) {
+  SceneDef scene = carousel_scene(0.5);
+  if (quick) scene.duration = 5;
+  return {{"carousel",
+           "four stacks of five boxes carried round on a kinematic deck turning at 0.5 rad/s: "
+           "the farthest any box ends from its place on the deck after " +
+               std::to_string(static_cast<int>(scene.duration)) + " s",
+           "0 (each box stays where it stands on the deck)", "m"},
+          scene,
+          [scene] { return std::make_unique<CarriedStacks>(scene); }};
+}
+
 std::vector<Reference> references(bool quick) {
-  std::vector<Reference> out = {slide(), bounce(), spin(quick), flip(), roll(), projectile()};
+  std::vector<Reference> out = {slide(),  bounce(),     spin(quick),   flip(),
+                                roll(),   projectile(), carousel(quick)};
   SceneDef pile = pile_scene(27);
   pile.duration = 1.0;
   out.push_back(converged_reference(
