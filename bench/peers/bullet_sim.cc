@@ -49,10 +49,6 @@ class BulletSimulation final : public Simulation {
   // False (with the reason) for a shape this adapter does not map.
   bool add(const BodyDef& def, double mass, const Vec3& inertia, const PeerOptions& options,
            std::string* why_not) {
-    if (def.type == BodyType::kKinematic) {
-      *why_not = "kinematic bodies are not mapped to this peer";
-      return false;
-    }
     std::unique_ptr<btCollisionShape> shape;
     btTransform pose(btQuaternion(def.orientation.x(), def.orientation.y(), def.orientation.z(),
                                   def.orientation.w()),
@@ -71,7 +67,10 @@ class BulletSimulation final : public Simulation {
       *why_not = "hulls are not mapped to Bullet";
       return false;
     }
-    const bool is_static = def.type == BodyType::kStatic;
+    // A kinematic body is Bullet's: no mass, CF_KINEMATIC_OBJECT, moved through its motion state
+    // each step (step()), from which Bullet takes its velocity.
+    const bool kinematic = def.type == BodyType::kKinematic;
+    const bool is_static = def.type == BodyType::kStatic || kinematic;
     states_.push_back(std::make_unique<btDefaultMotionState>(pose));
     btRigidBody::btRigidBodyConstructionInfo info(is_static ? 0 : mass, states_.back().get(),
                                                   shape.get(),
@@ -89,6 +88,11 @@ class BulletSimulation final : public Simulation {
     if (options.ccd && !is_static) {
       body->setCcdMotionThreshold(0.05);
       body->setCcdSweptSphereRadius(0.04);
+    }
+    if (kinematic) {
+      body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+      body->setActivationState(DISABLE_DEACTIVATION);
+      kinematic_.push_back({states_.back().get(), def.linear_velocity, def.angular_velocity});
     }
     world_.addRigidBody(body);
     if (!is_static) dynamic_.push_back(body);
@@ -170,6 +174,17 @@ class BulletSimulation final : public Simulation {
   }
 
   bool step() override {
+    for (const Kinematic& k : kinematic_) {
+      btTransform pose;
+      k.state->getWorldTransform(pose);
+      const btVector3 turn = to_bt(k.angular_velocity * dt_);
+      const btScalar angle = turn.length();
+      btQuaternion q = pose.getRotation();
+      if (angle > 0) q = btQuaternion(turn / angle, angle) * q;
+      pose.setRotation(q.normalized());
+      pose.setOrigin(pose.getOrigin() + to_bt(k.linear_velocity * dt_));
+      k.state->setWorldTransform(pose);
+    }
     world_.stepSimulation(dt_, 0);
     return true;
   }
@@ -193,6 +208,11 @@ class BulletSimulation final : public Simulation {
   std::vector<std::unique_ptr<btDefaultMotionState>> states_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
   std::vector<btRigidBody*> dynamic_;
+  struct Kinematic {
+    btDefaultMotionState* state;
+    Vec3 linear_velocity, angular_velocity;
+  };
+  std::vector<Kinematic> kinematic_;
   std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
 };
 
