@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "physics/world.h"
@@ -217,17 +218,94 @@ TEST(Kinematic, RefusesWhatWouldMoveItOtherwise) {
   BodyMotion fast;
   fast.angular_velocity = Vec3(0, 0, 1e9);
   EXPECT_NE(world.set_motion(k, fast).message().find("angular_velocity"), std::string::npos);
-  const BodyId d = world.create_body(box(Vec3(0.5, 0.5, 0.5), Vec3(3, 0, 0))).value();
+  BodyDef other_def = box(Vec3(0.5, 0.5, 0.5), Vec3(3, 0, 0), BodyType::kKinematic);
+  const BodyId other = world.create_body(other_def).value();
   JointDef hinge;
   hinge.kind = JointKind::kBall;
-  hinge.a = d;
+  hinge.a = other;
   hinge.b = k;
   hinge.anchor = Vec3(1.5, 0, 0);
   EXPECT_EQ(world.create_joint(hinge).status().message(),
-            "b: a joint holds no kinematic body (not yet)");
+            "a: a joint needs a dynamic body on one side");
+  hinge.b = BodyId{};  // the world
+  EXPECT_EQ(world.create_joint(hinge).status().message(),
+            "a: a joint needs a dynamic body on one side");
   // Nothing refused changed the body.
   EXPECT_EQ(world.body(k)->linear_velocity(), Vec3::Zero());
   EXPECT_EQ(world.body(k)->mass(), 0);
+}
+
+// A pendulum hung from a kinematic crane moving at a steady velocity swings, seen from the
+// crane, as one hung from a fixed pivot (Galilean invariance): the same path to rounding, and the
+// joint holds as well. Both solvers of joints: Gauss-Seidel rows and the direct solve.
+TEST(Kinematic, APendulumFromAMovingCraneSwingsAsFromAFixedOne) {
+  for (const bool direct : {true, false}) {
+    auto hang = [direct](BodyType pivot_type, const Vec3& velocity) {
+      WorldSettings settings;
+      settings.solver.kind = direct ? SolverKind::kAuto : SolverKind::kSoft;
+      World world(settings);
+      BodyDef pivot = box(Vec3(0.2, 0.2, 0.2), Vec3(0, 0, 5), pivot_type);
+      pivot.linear_velocity = velocity;
+      const BodyId crane = world.create_body(pivot).value();
+      BodyDef bob;
+      bob.shape = SphereDef{0.1};
+      bob.mass = 1;
+      bob.position = Vec3(1, 0, 5);  // level with the pivot: a swing of 180 degrees
+      bob.linear_velocity = velocity;
+      const BodyId ball = world.create_body(bob).value();
+      JointDef rod;
+      rod.kind = JointKind::kBall;
+      rod.a = ball;
+      rod.b = crane;
+      rod.anchor = Vec3(0, 0, 5);
+      EXPECT_TRUE(world.create_joint(rod).status().is_ok());
+      return std::tuple{std::move(world), crane, ball};
+    };
+    auto [fixed, fixed_crane, fixed_ball] = hang(BodyType::kStatic, Vec3::Zero());
+    const Vec3 velocity(2, 0.5, 1);
+    auto [moving, crane, ball] = hang(BodyType::kKinematic, velocity);
+    double worst = 0, worst_gap = 0;
+    for (int i = 0; i < 120; ++i) {
+      ASSERT_TRUE(fixed.step(kDt).is_ok());
+      ASSERT_TRUE(moving.step(kDt).is_ok());
+      const Vec3 seen = moving.body(ball)->position() - moving.body(crane)->position();
+      const Vec3 expected = fixed.body(fixed_ball)->position() - fixed.body(fixed_crane)->position();
+      worst = std::max(worst, (seen - expected).norm());
+      worst_gap = std::max(worst_gap, std::abs(seen.norm() - 1));
+    }
+    EXPECT_NEAR((moving.body(crane)->position() - Vec3(0, 0, 5) - 2.0 * velocity).norm(), 0,
+                1e-12);
+    EXPECT_LT(worst, 1e-6) << (direct ? "direct" : "Gauss-Seidel");
+    EXPECT_LT(worst_gap, 1e-9) << (direct ? "direct" : "Gauss-Seidel");
+    EXPECT_FALSE(moving.body(ball)->asleep());
+  }
+}
+
+// A pendulum asleep under a still crane wakes when the crane starts to move, and is carried.
+TEST(Kinematic, AMovingCraneWakesWhatHangsFromIt) {
+  World world;
+  BodyDef pivot = box(Vec3(0.2, 0.2, 0.2), Vec3(0, 0, 5), BodyType::kKinematic);
+  const BodyId crane = world.create_body(pivot).value();
+  BodyDef bob;
+  bob.shape = SphereDef{0.1};
+  bob.mass = 1;
+  bob.position = Vec3(0, 0, 4);
+  const BodyId ball = world.create_body(bob).value();
+  JointDef rod;
+  rod.kind = JointKind::kBall;
+  rod.a = ball;
+  rod.b = crane;
+  rod.anchor = Vec3(0, 0, 5);
+  ASSERT_TRUE(world.create_joint(rod).status().is_ok());
+  run(&world, 180);
+  ASSERT_TRUE(world.body(ball)->asleep());
+  BodyMotion go;
+  go.linear_velocity = Vec3(1, 0, 0);
+  ASSERT_TRUE(world.set_motion(crane, go).is_ok());
+  run(&world, 60);
+  EXPECT_FALSE(world.body(ball)->asleep());
+  EXPECT_GT(world.body(ball)->position().x(), 0.5);  // dragged along behind the crane
+  EXPECT_NEAR((world.body(ball)->position() - world.body(crane)->position()).norm(), 1, 1e-6);
 }
 
 // A restored world steps on bit for bit, kinematic bodies and their riders included, and the

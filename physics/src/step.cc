@@ -123,6 +123,17 @@ class SerialIsland {
         rows_(c.scratch.rows),
         cold_(c.scratch.cold_rows),
         bodies_(c.scratch.bodies) {
+    // The direct solve takes a joint's body that it does not move to be at rest: joints that
+    // hold a kinematic body with a velocity are swept as Gauss-Seidel rows instead.
+    if (report->joint_tree && c.scratch.kinematic_contacts) {
+      for (std::uint32_t j : c.joints) {
+        const JointRow& row = c.scratch.joint_rows[j];
+        if (bodies_[row.a].kinematic || (row.b != kWorldAnchor && bodies_[row.b].kinematic)) {
+          report->joint_tree = false;
+          report->exact_joints = false;
+        }
+      }
+    }
     if (report->joint_tree && !c.joints.empty()) {
       tree_ = &c.scratch.joint_trees[omp_get_thread_num()];
       if (!tree_->build(c.joints, c.scratch.joint_rows, bodies_, bodies_.size())) {
@@ -164,6 +175,17 @@ class SerialIsland {
     moved_for_ += h;
     for (std::uint32_t k : c_.bodies)
       integrate_position(h, &bodies_[k], &c_.scratch.poses[k]);
+    // Kinematic bodies the joints hold (each joint's own: World::prepare_joint_rows) go where
+    // their velocities take them by now, exactly.
+    if (c_.scratch.kinematic_contacts) {
+      for (std::uint32_t j : c_.joints) {
+        const JointRow& row = c_.scratch.joint_rows[j];
+        for (const std::uint32_t k : {row.a, row.b})
+          if (k != kWorldAnchor && bodies_[k].kinematic)
+            c_.scratch.poses[k] =
+                moved_by(c_.body_of[k]->pose(), bodies_[k].v, bodies_[k].w, moved_for_);
+      }
+    }
     for (int pass = 0; pass < kJointPositionPasses; ++pass) {
       if (tree_ != nullptr) {
         for (std::uint32_t j : c_.joints)
@@ -867,6 +889,11 @@ void World::update_sleep(double dt) {
       const std::uint32_t b = s.solver_of_slot[contact.b.index];
       if (s.bodies[a].kinematic) s.carried[b] = 1;
       if (s.bodies[b].kinematic) s.carried[a] = 1;
+    }
+    for (const JointRow& row : s.joint_rows) {
+      if (row.b == kWorldAnchor) continue;
+      if (s.bodies[row.a].kinematic) s.carried[row.b] = 1;
+      if (s.bodies[row.b].kinematic) s.carried[row.a] = 1;
     }
   }
   bool fell_asleep = false;

@@ -24,8 +24,8 @@ namespace tumble {
 
 void World::choose_island_solvers(double dt) {
   StepScratch& s = *scratch_;
+  prepare_joint_rows();  // (may add solver bodies: kinematic ones of joints' own)
   const std::uint32_t solver_bodies = static_cast<std::uint32_t>(s.solver_slot.size());
-  prepare_joint_rows();
   build_islands(s.dynamic, s.links, s.joint_links, &s.islands);
   s.support_level.resize(solver_bodies);
 

@@ -40,12 +40,8 @@ Status World::check_joint(const JointDef& def) const {
   const bool world_b = !def.b.is_valid();
   if (!world_b && !contains(def.b)) return Status::not_found("b: no body with this id");
   const Body& a = bodies_[def.a.index].body;
-  if (a.is_static() && (world_b || bodies_[def.b.index].body.is_static()))
+  if (!a.is_dynamic() && (world_b || !bodies_[def.b.index].body.is_dynamic()))
     return Status::error("a: a joint needs a dynamic body on one side");
-  // Not yet: the joint solvers' position passes would need its motion over the step.
-  if (a.is_kinematic()) return Status::error("a: a joint holds no kinematic body (not yet)");
-  if (!world_b && bodies_[def.b.index].body.is_kinematic())
-    return Status::error("b: a joint holds no kinematic body (not yet)");
   const WorldLimits& limits = settings_.limits;
   auto within = [&](const Vec3& p) { return p.cwiseAbs().maxCoeff() <= limits.max_coordinate; };
   if (!within(def.anchor)) return Status::error("anchor: beyond the world's max_coordinate");
@@ -284,8 +280,8 @@ std::uint32_t World::wake_jointed() {
     if (!slot.alive || slot.joint.b == kWorldAnchor) continue;
     const Body& a = bodies_[slot.joint.a].body;
     const Body& b = bodies_[slot.joint.b].body;
-    if (a.is_moving() && b.asleep) woken += wake_island(b.sleep_island);
-    if (b.is_moving() && a.asleep) woken += wake_island(a.sleep_island);
+    if ((a.is_moving() || a.carries()) && b.asleep) woken += wake_island(b.sleep_island);
+    if ((b.is_moving() || b.carries()) && a.asleep) woken += wake_island(a.sleep_island);
   }
   return woken;
 }
@@ -305,6 +301,23 @@ void World::prepare_joint_rows() {
   s.joint_rows.clear();
   s.joint_links.clear();
   if (joint_count_ == 0) return;
+  // A kinematic body with a velocity gets a solver body of its own in each joint that holds it:
+  // the island's position passes move it to where it is at the island's time (SerialIsland),
+  // and islands that share it run at different times on different threads.
+  const auto kinematic_of_its_own = [&s](std::uint32_t k) {
+    if (!s.bodies[k].kinematic) return k;
+    const std::uint32_t copy = static_cast<std::uint32_t>(s.bodies.size());
+    const SolverBody body = s.bodies[k];
+    const Pose pose = s.poses[k];
+    const Body* const of = s.body_of[k];
+    const std::uint32_t slot = s.solver_slot[k];
+    s.bodies.push_back(body);
+    s.poses.push_back(pose);
+    s.dynamic.push_back(0);
+    s.body_of.push_back(of);
+    s.solver_slot.push_back(slot);
+    return copy;
+  };
   for (std::uint32_t index = 0; index < joints_.size(); ++index) {
     const JointSlot& slot = joints_[index];
     if (!slot.alive) continue;
@@ -316,7 +329,8 @@ void World::prepare_joint_rows() {
     if (!moves_a && !moves_b) continue;  // asleep, or both static
     // number_solver_bodies numbered both bodies of a joint with a moving body.
     TUMBLE_ASSERT(a != kNoSolverBody && (world_b || b != kNoSolverBody));
-    s.joint_rows.push_back({slot.joint, a, b, index});
+    s.joint_rows.push_back({slot.joint, kinematic_of_its_own(a), world_b ? b : kinematic_of_its_own(b),
+                            index});
     s.joint_links.push_back({a, b == kWorldAnchor ? a : b});
   }
 }

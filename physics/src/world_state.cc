@@ -122,9 +122,9 @@ Status check_joint(const Joint& joint, std::span<const BodySlotState> slots,
   const bool b_static = joint.b == kWorldAnchor || slots[joint.b].body.is_static();
   if (slots[joint.a].body.is_static() && b_static)
     return Status::error("a: a joint needs a dynamic body on one side");
-  if (slots[joint.a].body.is_kinematic() ||
-      (joint.b != kWorldAnchor && slots[joint.b].body.is_kinematic()))
-    return Status::error("a, b: a joint holds no kinematic body");
+  if (!slots[joint.a].body.is_dynamic() &&
+      (joint.b == kWorldAnchor || !slots[joint.b].body.is_dynamic()))
+    return Status::error("a: a joint needs a dynamic body on one side");
   const double reach = 2 * limits.max_coordinate;
   if (!is_finite(joint.local_a) || !is_finite(joint.local_b) ||
       joint.local_a.cwiseAbs().maxCoeff() > reach || joint.local_b.cwiseAbs().maxCoeff() > reach)
