@@ -45,6 +45,24 @@ Vec3 seen_from(const World& world, BodyId frame, BodyId body) {
   return f.orientation().conjugate() * (world.body(body)->position() - f.position());
 }
 
+// A 1 kg ball of 0.1 m at `at`, hung by a ball joint at `pivot` from `crane`.
+BodyId hang_ball(World* world, BodyId crane, const Vec3& pivot, const Vec3& at,
+                 const Vec3& velocity = Vec3::Zero()) {
+  BodyDef bob;
+  bob.shape = SphereDef{0.1};
+  bob.mass = 1;
+  bob.position = at;
+  bob.linear_velocity = velocity;
+  const BodyId ball = world->create_body(bob).value();
+  JointDef rod;
+  rod.kind = JointKind::kBall;
+  rod.a = ball;
+  rod.b = crane;
+  rod.anchor = pivot;
+  EXPECT_TRUE(world->create_joint(rod).status().is_ok());
+  return ball;
+}
+
 TEST(Kinematic, MovesExactlyByItsVelocityAndIsNeverPushedBack) {
   World world;
   add_ground(&world);
@@ -247,18 +265,8 @@ TEST(Kinematic, APendulumFromAMovingCraneSwingsAsFromAFixedOne) {
       BodyDef pivot = box(Vec3(0.2, 0.2, 0.2), Vec3(0, 0, 5), pivot_type);
       pivot.linear_velocity = velocity;
       const BodyId crane = world.create_body(pivot).value();
-      BodyDef bob;
-      bob.shape = SphereDef{0.1};
-      bob.mass = 1;
-      bob.position = Vec3(1, 0, 5);  // level with the pivot: a swing of 180 degrees
-      bob.linear_velocity = velocity;
-      const BodyId ball = world.create_body(bob).value();
-      JointDef rod;
-      rod.kind = JointKind::kBall;
-      rod.a = ball;
-      rod.b = crane;
-      rod.anchor = Vec3(0, 0, 5);
-      EXPECT_TRUE(world.create_joint(rod).status().is_ok());
+      // Level with the pivot: a swing of 180 degrees.
+      const BodyId ball = hang_ball(&world, crane, Vec3(0, 0, 5), Vec3(1, 0, 5), velocity);
       return std::tuple{std::move(world), crane, ball};
     };
     auto [fixed, fixed_crane, fixed_ball] = hang(BodyType::kStatic, Vec3::Zero());
@@ -286,17 +294,7 @@ TEST(Kinematic, AMovingCraneWakesWhatHangsFromIt) {
   World world;
   BodyDef pivot = box(Vec3(0.2, 0.2, 0.2), Vec3(0, 0, 5), BodyType::kKinematic);
   const BodyId crane = world.create_body(pivot).value();
-  BodyDef bob;
-  bob.shape = SphereDef{0.1};
-  bob.mass = 1;
-  bob.position = Vec3(0, 0, 4);
-  const BodyId ball = world.create_body(bob).value();
-  JointDef rod;
-  rod.kind = JointKind::kBall;
-  rod.a = ball;
-  rod.b = crane;
-  rod.anchor = Vec3(0, 0, 5);
-  ASSERT_TRUE(world.create_joint(rod).status().is_ok());
+  const BodyId ball = hang_ball(&world, crane, Vec3(0, 0, 5), Vec3(0, 0, 4));
   run(&world, 180);
   ASSERT_TRUE(world.body(ball)->asleep());
   BodyMotion go;

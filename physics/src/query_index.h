@@ -72,6 +72,11 @@ class QueryIndex {
   std::mutex building;
 
  private:
+  // Calls visit(entry) for every entry of the leaves whose nodes `meets` accepts (an inner node's
+  // rejection skips its subtree).
+  template <class Meets, class Visit>
+  void visit_nodes(Meets&& meets, Visit&& visit) const;
+
   static constexpr int kLeafSize = 4;
   struct Node {
     Aabb bounds;
@@ -120,20 +125,18 @@ void QueryIndex::visit_ray(const Vec3& origin, const Vec3& direction, double t_m
   }
 }
 
-template <class Visit>
-void QueryIndex::visit_box(const Aabb& box, Visit&& visit) const {
-  for (std::uint32_t slot : unbounded_)
-    visit(slot);
+template <class Meets, class Visit>
+void QueryIndex::visit_nodes(Meets&& meets, Visit&& visit) const {
   if (nodes_.empty()) return;
   std::uint32_t stack[64];
   int depth = 0;
   stack[depth++] = 0;
   while (depth > 0) {
     const Node& node = nodes_[stack[--depth]];
-    if (!node.bounds.overlaps(box)) continue;
+    if (!meets(node.bounds)) continue;
     if (node.count > 0) {
       for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-        if (entries_[k].bounds.overlaps(box)) visit(entries_[k].slot);
+        visit(entries_[k]);
       continue;
     }
     stack[depth++] = node.first;
@@ -142,25 +145,24 @@ void QueryIndex::visit_box(const Aabb& box, Visit&& visit) const {
 }
 
 template <class Visit>
+void QueryIndex::visit_box(const Aabb& box, Visit&& visit) const {
+  for (std::uint32_t slot : unbounded_)
+    visit(slot);
+  visit_nodes([&](const Aabb& bounds) { return bounds.overlaps(box); },
+              [&](const Entry& entry) {
+                if (entry.bounds.overlaps(box)) visit(entry.slot);
+              });
+}
+
+template <class Visit>
 void QueryIndex::visit_sweep(const Aabb& box, const Vec3& translation, Visit&& visit) const {
   for (std::uint32_t slot : unbounded_)
     visit(slot, 0.0);
-  if (nodes_.empty()) return;
-  std::uint32_t stack[64];
-  int depth = 0;
-  stack[depth++] = 0;
-  while (depth > 0) {
-    const Node& node = nodes_[stack[--depth]];
-    if (!(sweep_entry(box, translation, node.bounds) <= 1)) continue;
-    if (node.count > 0) {
-      for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-        if (const double entry = sweep_entry(box, translation, entries_[k].bounds); entry <= 1)
-          visit(entries_[k].slot, entry);
-      continue;
-    }
-    stack[depth++] = node.first;
-    stack[depth++] = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
-  }
+  visit_nodes([&](const Aabb& bounds) { return sweep_entry(box, translation, bounds) <= 1; },
+              [&](const Entry& entry) {
+                if (const double t = sweep_entry(box, translation, entry.bounds); t <= 1)
+                  visit(entry.slot, t);
+              });
 }
 
 }  // namespace tumble
