@@ -29,6 +29,22 @@ Status find_entries(const HostedWorld& hosted, const char* list, const Entries& 
   return Status::ok();
 }
 
+// A query's shape placed in the world (OverlapQuery, ShapeCastQuery): its shape, position,
+// orientation (identity when absent) and mask, which the engine checks.
+template <class Asked, class Query>
+Status place_shape(const Asked& asked, const std::string& at, Query* query) {
+  Result<ShapeDef> shape = shape_def_from_proto(asked.shape());
+  if (!shape) return shape.status().within(at);
+  query->shape = std::move(shape).value();
+  query->pose.position = vec_from_proto(asked.position());
+  if (asked.has_orientation()) {
+    const v1::Quat& q = asked.orientation();
+    query->pose.orientation = Quat(q.w(), q.x(), q.y(), q.z());
+  }
+  if (asked.has_mask()) query->mask = asked.mask();
+  return Status::ok();
+}
+
 }  // namespace
 
 Status find_bodies(const HostedWorld& hosted, const WireIds& wire_ids, std::vector<BodyId>* ids) {
@@ -154,17 +170,8 @@ Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
                          StatusCode::kResourceExhausted);
   std::vector<OverlapQuery> overlaps(request.overlaps_size());
   for (int i = 0; i < request.overlaps_size(); ++i) {
-    const v1::OverlapQuery& asked = request.overlaps(i);
     const std::string at = "overlaps[" + std::to_string(i) + "].";
-    Result<ShapeDef> shape = shape_def_from_proto(asked.shape());
-    if (!shape) return shape.status().within(at);
-    overlaps[i].shape = std::move(shape).value();
-    overlaps[i].pose.position = vec_from_proto(asked.position());
-    if (asked.has_orientation()) {
-      const v1::Quat& q = asked.orientation();
-      overlaps[i].pose.orientation = Quat(q.w(), q.x(), q.y(), q.z());
-    }
-    if (asked.has_mask()) overlaps[i].mask = asked.mask();
+    if (Status s = place_shape(request.overlaps(i), at, &overlaps[i]); !s) return s;
   }
   if (static_cast<std::size_t>(request.closest_points_size()) > kMaxQueryClosest)
     return Status::error("closest_points: " + std::to_string(request.closest_points_size()) +
@@ -181,17 +188,9 @@ Status query(const HostedWorld& hosted, const v1::QueryRequest& request,
                          StatusCode::kResourceExhausted);
   std::vector<ShapeCast> casts(request.shape_casts_size());
   for (int i = 0; i < request.shape_casts_size(); ++i) {
-    const v1::ShapeCastQuery& asked = request.shape_casts(i);
-    Result<ShapeDef> shape = shape_def_from_proto(asked.shape());
-    if (!shape) return shape.status().within("shape_casts[" + std::to_string(i) + "].");
-    casts[i].shape = std::move(shape).value();
-    casts[i].pose.position = vec_from_proto(asked.position());
-    if (asked.has_orientation()) {
-      const v1::Quat& q = asked.orientation();
-      casts[i].pose.orientation = Quat(q.w(), q.x(), q.y(), q.z());
-    }
-    casts[i].translation = vec_from_proto(asked.translation());
-    if (asked.has_mask()) casts[i].mask = asked.mask();
+    const std::string at = "shape_casts[" + std::to_string(i) + "].";
+    if (Status s = place_shape(request.shape_casts(i), at, &casts[i]); !s) return s;
+    casts[i].translation = vec_from_proto(request.shape_casts(i).translation());
   }
   std::vector<RayCast> rays(n);
   for (std::size_t i = 0; i < n; ++i) {

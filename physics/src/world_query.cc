@@ -23,6 +23,14 @@ Status validate(const RayCast& ray) {
   return Status::ok();
 }
 
+Status validate_placement(const Pose& pose) {
+  if (!is_finite(pose.position)) return Status::error("position: must be finite");
+  const double norm = pose.orientation.norm();
+  if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
+    return Status::error("orientation: must be a unit quaternion");
+  return Status::ok();
+}
+
 namespace {
 
 // The ray met with one body, in the body's frame; false if it misses it within max_t.
@@ -164,10 +172,7 @@ Result<bool> World::overlap(const OverlapQuery& query, std::size_t max_bodies,
     return Status::error("shape: a half-space holds half the world; ask a large box");
   Result<Shape> shape = Shape::create(query.shape);
   if (!shape) return shape.status().within("shape.");
-  if (!is_finite(query.pose.position)) return Status::error("position: must be finite");
-  const double norm = query.pose.orientation.norm();
-  if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
-    return Status::error("orientation: must be a unit quaternion");
+  if (Status s = validate_placement(query.pose); !s) return s;
   const Pose pose{query.pose.position, query.pose.orientation.normalized()};
   const Aabb box = transform_aabb(shape.value().local_bounds(), pose);
   std::vector<std::uint32_t> found;

@@ -22,10 +22,7 @@ namespace tumble {
 Status validate(const ShapeCast& cast) {
   if (std::holds_alternative<HalfSpaceDef>(cast.shape))
     return Status::error("shape: a half-space holds half the world and cannot be swept");
-  if (!is_finite(cast.pose.position)) return Status::error("position: must be finite");
-  const double norm = cast.pose.orientation.norm();
-  if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
-    return Status::error("orientation: must be a unit quaternion");
+  if (Status s = validate_placement(cast.pose); !s) return s;
   if (!is_finite(cast.translation)) return Status::error("translation: must be finite");
   if (!(cast.translation.norm() <= kMaxRayLength))
     return Status::error("translation: longer than 1e10 m");

@@ -30,6 +30,20 @@ _SOLVERS = {
 }
 
 
+def _placed(query, shape, position, orientation, mask, call):
+    """Fills the shape a query places in the world (OverlapQuery, ShapeCastQuery): shape,
+    position, orientation and mask."""
+    if not isinstance(shape, shapes.SHAPES):
+        raise ArgumentError(f"shape: expected a Box, Sphere, Capsule or Hull, got {shape!r}", call)
+    query.shape.CopyFrom(shape.to_proto())
+    convert.set_vec3(query.position, position, "position")
+    if orientation is not None:
+        convert.set_quat(query.orientation, orientation, "orientation")
+    if mask is not None:
+        query.mask = bits(mask, "mask")
+    return query
+
+
 @dataclass
 class Settings:
     """The run's settings in force: dt (s), substeps (soft solver), solver, gravity (m/s^2),
@@ -292,16 +306,7 @@ class WorldCalls:
         """The ids of the bodies that `shape` (Box, Sphere, Capsule or Hull) placed at `position`
         (m, world) and `orientation` (w, x, y, z) overlaps or touches, in the order of their
         slots; `mask`: the collision layers it meets (default every layer)."""
-        query = pb.OverlapQuery()
-        if not isinstance(shape, shapes.SHAPES):
-            raise ArgumentError(f"shape: expected a Box, Sphere, Capsule or Hull, got {shape!r}",
-                                "overlap")
-        query.shape.CopyFrom(shape.to_proto())
-        convert.set_vec3(query.position, position, "position")
-        if orientation is not None:
-            convert.set_quat(query.orientation, orientation, "orientation")
-        if mask is not None:
-            query.mask = bits(mask, "mask")
+        query = _placed(pb.OverlapQuery(), shape, position, orientation, mask, "overlap")
         response = self._rpc("Query", pb.QueryRequest(overlaps=[query]))
         return [int(body) for body in response.overlap_ids]
 
@@ -326,17 +331,8 @@ class WorldCalls:
         starts touching; point on the body and the body's outward normal there, world; converged:
         False when the advancement stopped at its bound), or None. `mask`: the collision layers
         it meets (default every layer)."""
-        query = pb.ShapeCastQuery()
-        if not isinstance(shape, shapes.SHAPES):
-            raise ArgumentError(f"shape: expected a Box, Sphere, Capsule or Hull, got {shape!r}",
-                                "cast_shape")
-        query.shape.CopyFrom(shape.to_proto())
-        convert.set_vec3(query.position, position, "position")
+        query = _placed(pb.ShapeCastQuery(), shape, position, orientation, mask, "cast_shape")
         convert.set_vec3(query.translation, translation, "translation")
-        if orientation is not None:
-            convert.set_quat(query.orientation, orientation, "orientation")
-        if mask is not None:
-            query.mask = bits(mask, "mask")
         response = self._rpc("Query", pb.QueryRequest(shape_casts=[query]))
         if not response.cast_hits[0]:
             return None

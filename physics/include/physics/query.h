@@ -80,6 +80,10 @@ struct ShapeHit {
   bool hit() const { return body.is_valid(); }
 };
 
+// Checks where a query places its shape: a finite position and a unit orientation (within 1e-3,
+// normalised where used); the message names the field.
+Status validate_placement(const Pose& pose);
+
 // Checks a shape cast; the message names the field ("translation: must be finite").
 Status validate(const ShapeCast& cast);
 
