@@ -26,6 +26,13 @@ Json shape_json(const v1::Shape& shape) {
       return {{"capsule", {shape.capsule().radius(), shape.capsule().half_height()}}};
     case v1::Shape::kHull:
       return {{"hull", slice(shape.hull().points(), 0, shape.hull().points_size())}};
+    case v1::Shape::kHeightfield: {
+      const v1::HeightField& f = shape.heightfield();
+      return {{"heightfield",
+               {{"samples", {f.samples_x(), f.samples_y()}},
+                {"spacing", {f.spacing_x(), f.spacing_y()}},
+                {"heights", slice(f.heights(), 0, f.heights_size())}}}};
+    }
     default:
       return {{"plane", true}};
   }

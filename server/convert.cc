@@ -62,10 +62,23 @@ Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
     }
     case v1::Shape::kPlane:
       return ShapeDef{HalfSpaceDef{}};
+    case v1::Shape::kHeightfield: {
+      const v1::HeightField& field = shape.heightfield();
+      HeightFieldDef def;
+      def.samples_x = field.samples_x();
+      def.samples_y = field.samples_y();
+      def.spacing_x = field.spacing_x();
+      def.spacing_y = field.spacing_y();
+      def.heights.assign(field.heights().begin(), field.heights().end());
+      // The engine checks every field and names it; here only the prefix is the message's.
+      if (Result<HeightField> built = HeightField::create(def); !built)
+        return built.status().within("shape.heightfield.");
+      return ShapeDef{std::move(def)};
+    }
     case v1::Shape::KIND_NOT_SET:
       break;
   }
-  return Status::error("shape: required (box, sphere, capsule, hull or plane)");
+  return Status::error("shape: required (box, sphere, capsule, hull, plane or heightfield)");
 }
 
 }  // namespace
@@ -94,6 +107,8 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   }
   if (std::holds_alternative<HalfSpaceDef>(def.shape) && def.type != BodyType::kStatic)
     return Status::error("type: a plane must be static");
+  if (std::holds_alternative<HeightFieldDef>(def.shape) && def.type != BodyType::kStatic)
+    return Status::error("type: a heightfield must be static");
   if (Status s = finite(spec.position(), "position"); !s) return s;
   if (Status s = finite(spec.linear_velocity(), "linear_velocity"); !s) return s;
   if (Status s = finite(spec.angular_velocity(), "angular_velocity"); !s) return s;
@@ -178,6 +193,16 @@ void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) 
     case ShapeType::kHalfSpace:
       shape->mutable_plane();
       break;
+    case ShapeType::kHeightField: {
+      const HeightFieldDef& def = s.height_field()->def();
+      v1::HeightField* field = shape->mutable_heightfield();
+      field->set_samples_x(def.samples_x);
+      field->set_samples_y(def.samples_y);
+      field->set_spacing_x(def.spacing_x);
+      field->set_spacing_y(def.spacing_y);
+      field->mutable_heights()->Assign(def.heights.begin(), def.heights.end());
+      break;
+    }
   }
 }
 

@@ -40,6 +40,7 @@ constexpr char kEmpty[] = "";
 constexpr char kMarkerNamespace[] = "tumble";
 // The ground (a half-space) drawn as a slab this wide and this thin, its top at the surface.
 constexpr double kGroundWidth = 200, kGroundThickness = 0.01;
+constexpr double kMaxMarkerTriangles = 131072;  // a terrain's marker: at most about 10 MB
 
 std_msgs_msg_dds__Header_ header_at(double time) {
   std_msgs_msg_dds__Header_ header;
@@ -381,6 +382,27 @@ void DdsPublisher::describe_for_ros2(const Catalogue& now) {
               const Vec3& v = hull.vertices[hull.face_vertices[face.first + corner]];
               ros.triangles.push_back({v.x(), v.y(), v.z()});
             }
+        break;
+      }
+      case ShapeType::kHeightField: {
+        // Its surface's triangles, every stride-th sample where it has more than a marker
+        // should carry (kMaxMarkerTriangles).
+        marker.type = kTriangleList;
+        marker.scale = {1, 1, 1};
+        const HeightField& field = *shape.height_field();
+        std::uint32_t stride = 1;
+        while (2.0 * (field.cells_x() / stride) * (field.cells_y() / stride) > kMaxMarkerTriangles)
+          ++stride;
+        const auto corner = [&](std::uint32_t i, std::uint32_t j) {
+          const Vec3 p = field.sample(std::min(i, field.cells_x()), std::min(j, field.cells_y()));
+          ros.triangles.push_back({p.x(), p.y(), p.z()});
+        };
+        for (std::uint32_t j = 0; j < field.cells_y(); j += stride)
+          for (std::uint32_t i = 0; i < field.cells_x(); i += stride) {
+            const std::uint32_t i1 = i + stride, j1 = j + stride;
+            corner(i, j), corner(i1, j), corner(i1, j1);
+            corner(i, j), corner(i1, j1), corner(i, j1);
+          }
         break;
       }
     }

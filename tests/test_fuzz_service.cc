@@ -5,6 +5,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -171,7 +172,7 @@ class FuzzService {
   v1::BodySpec body(Hostile& h) {
     v1::BodySpec spec;
     v1::Shape* shape = spec.mutable_shape();
-    switch (h.integer(0, 6)) {
+    switch (h.integer(0, 7)) {
       case 0:
         set(h.vector(0.05, 2), shape->mutable_box()->mutable_size());
         break;
@@ -199,6 +200,21 @@ class FuzzService {
       case 4:
         shape->mutable_plane();
         break;
+      case 5: {
+        // Terrain: sides too short, too long or fine, heights sometimes one too many.
+        v1::HeightField* field = shape->mutable_heightfield();
+        const std::uint32_t sides[] = {0, 1, 2, 3, 8, 9000};
+        field->set_samples_x(sides[h.integer(0, 5)]);
+        field->set_samples_y(sides[h.integer(0, 5)]);
+        field->set_spacing_x(h.number(0.1, 1));
+        field->set_spacing_y(h.number(0.1, 1));
+        const int n = static_cast<int>(std::min<std::uint64_t>(
+                          std::uint64_t{field->samples_x()} * field->samples_y(), 64)) +
+                      (h.chance(0.2) ? 1 : 0);
+        for (int k = 0; k < n; ++k)
+          field->add_heights(h.number(-0.5, 0.5));
+        break;
+      }
       default:
         if (h.chance(0.5)) shape->mutable_sphere()->set_radius(0.2);
         break;  // or no shape at all

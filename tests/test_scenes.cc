@@ -90,6 +90,60 @@ TEST(SceneJson, NamesTheBadField) {
   EXPECT_EQ(error_of(R"([1, 2])"), "scene: must be an object");
 }
 
+TEST(SceneJson, HeightFieldsAreReadCheckedAndWrittenBack) {
+  const Result<SceneDef> scene = parse_scene(R"({"bodies": [
+      {"shape": "heightfield", "samples": [3, 2], "spacing": [0.5, 2], "heights": [0, 1, 2, 3, 4, 5],
+       "position": [0, 0, -1]}]})");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  const auto& field = std::get<HeightFieldDef>(scene.value().bodies[0].shape);
+  EXPECT_EQ(field.samples_x, 3u);
+  EXPECT_EQ(field.samples_y, 2u);
+  EXPECT_EQ(field.spacing_x, 0.5);
+  EXPECT_EQ(field.spacing_y, 2.0);
+  EXPECT_EQ(field.heights[4], 4.0);
+  EXPECT_EQ(scene.value().bodies[0].type, BodyType::kStatic);  // terrain is static unasked
+  EXPECT_EQ(scene_to_json(parse_scene(scene_to_json(scene.value())).value()),
+            scene_to_json(scene.value()));
+
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "spacing": [1, 1],
+      "heights": [0, 0, 0, 0]}]})"),
+            "bodies[0].samples: must be [samples along x, samples along y], whole numbers");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "samples": [2, 9000],
+      "spacing": [1, 1], "heights": []}]})"),
+            "bodies[0].samples[1]: must be 2 to 8192");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "samples": [2, 2],
+      "spacing": [1, -1], "heights": [0, 0, 0, 0]}]})"),
+            "bodies[0].spacing[1]: must be > 0");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "samples": [2, 2],
+      "spacing": [1, 1], "heights": [0, 0, 0]}]})"),
+            "bodies[0].heights: must be an array of samples[0] * samples[1] = 4 heights in m, x "
+            "fastest");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "samples": [2, 2],
+      "spacing": [1, 1], "heights": [0, 0, "high", 0]}]})"),
+            "bodies[0].heights[2]: must be a number");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "samples": [2, 2],
+      "spacing": [1, 1], "heights": [0, 0, 2e6, 0]}]})"),
+            "bodies[0].shape.heights[2]: must be finite, within 1e6 m");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "samples": [2, 2],
+      "spacing": [1, 1], "heights": [0, 0, 0, 0], "static": false}]})"),
+            "bodies[0].type: a heightfield must be static");
+}
+
+TEST(StandardScenes, TerrainPileLandsOnTheHills) {
+  // 27 boxes on the terrain scene's hills: each ends above the surface under it.
+  const SceneDef scene = terrain_pile_scene(27);
+  World world = make_world(scene).value();
+  for (int i = 0; i < 240; ++i)
+    ASSERT_TRUE(world.step(scene.dt).is_ok());
+  const BodyView ground = world.body(world.id_at(0));
+  const HeightField& field = *ground.shape().height_field();
+  for (std::uint32_t slot = 1; slot < world.slot_count(); ++slot) {
+    const BodyView box = world.body(world.id_at(slot));
+    const Vec3 p = box.position();
+    EXPECT_GT(p.z() - field.height_at(p.x(), p.y()), 0.4) << slot;  // a 1 m box's half, less tilt
+  }
+}
+
 TEST(SceneJson, FilesReportTheirPath) {
   const std::string path = ::testing::TempDir() + "tumble_bad_scene.json";
   std::ofstream(path) << R"({"bodies": [{"shape": "sphere", "radius": -1}]})";

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "height_field_mesh.h"
 #include "hull_mesh.h"
 #include "offscreen.h"
 #ifdef TUMBLE_HAVE_WORLD_VIEW  // needs the API (proto/), built with the server
@@ -152,6 +153,35 @@ TEST(HullMesh, TrianglesFaceOutward) {
     EXPECT_GT((corner[1] - corner[0]).cross(corner[2] - corner[0]).dot(normal), 0);
   }
   EXPECT_TRUE(hull_mesh(std::vector<double>{0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}).indices.empty());
+}
+
+// A heightfield's surface: the engine's two triangles a cell, facing up, its normals those of
+// the slope; a description that makes no grid gives nothing to draw.
+TEST(HeightFieldMesh, TrianglesFaceUpWithTheSlopesNormals) {
+  // z = 0.5 x on a 4 x 3 grid of 1 m x 2 m cells (x fastest): a plane tilted about y.
+  std::vector<double> heights;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 4; ++i)
+      heights.push_back(0.5 * (i - 1.5));
+  const Mesh mesh = height_field_mesh(4, 3, 1.0, 2.0, heights);
+  ASSERT_EQ(mesh.vertices.size(), 6u * 12);
+  ASSERT_EQ(mesh.indices.size(), 3u * 2 * 3 * 2);
+  const Eigen::Vector3f slope_normal = Eigen::Vector3f(-0.5f, 0, 1).normalized();
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    Eigen::Vector3f corner[3];
+    for (int k = 0; k < 3; ++k)
+      corner[k] = Eigen::Map<const Eigen::Vector3f>(&mesh.vertices[6 * mesh.indices[t + k]]);
+    const Eigen::Vector3f face = (corner[1] - corner[0]).cross(corner[2] - corner[0]).normalized();
+    EXPECT_LT((face - slope_normal).norm(), 1e-6f);
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3f normal =
+          Eigen::Map<const Eigen::Vector3f>(&mesh.vertices[6 * mesh.indices[t + k] + 3]);
+      EXPECT_LT((normal - slope_normal).norm(), 1e-6f);
+      EXPECT_FLOAT_EQ(corner[k].z(), 0.5f * corner[k].x());  // centred: x = i - 1.5
+    }
+  }
+  EXPECT_TRUE(height_field_mesh(4, 3, 1.0, 2.0, std::vector<double>(11, 0.0)).indices.empty());
+  EXPECT_TRUE(height_field_mesh(1, 3, 1.0, 2.0, std::vector<double>(3, 0.0)).indices.empty());
 }
 
 #ifdef TUMBLE_HAVE_WORLD_VIEW

@@ -33,7 +33,9 @@ std::optional<std::pair<Eigen::Vector3f, float>> WorldView::bounds() const {
   Eigen::Vector3f low = Eigen::Vector3f::Constant(INFINITY), high = -low;
   for (const auto& [id, pose] : poses_) {
     const auto look = looks_.find(id);
-    if (look == looks_.end() || look->second.shape().has_plane()) continue;
+    if (look == looks_.end() || look->second.shape().has_plane() ||
+        look->second.shape().has_heightfield())
+      continue;  // the ground frames the bodies on it, not itself
     const v1::Shape& shape = look->second.shape();
     float reach = 0.5f;
     if (shape.has_box())
@@ -151,6 +153,23 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
                                       shape.hull().points().data(),
                                       static_cast<std::size_t>(shape.hull().points_size())))))
                      .first;
+        instance.model = model.matrix();
+        add(mesh->second, instance);
+        break;
+      }
+      case v1::Shape::kHeightfield: {
+        auto mesh = height_field_meshes_.find(id);
+        if (mesh == height_field_meshes_.end()) {
+          const v1::HeightField& f = shape.heightfield();
+          mesh = height_field_meshes_
+                     .emplace(id, renderer.add_mesh(height_field_mesh(
+                                      f.samples_x(), f.samples_y(), f.spacing_x(),
+                                      f.spacing_y(),
+                                      std::span<const double>(
+                                          f.heights().data(),
+                                          static_cast<std::size_t>(f.heights_size())))))
+                     .first;
+        }
         instance.model = model.matrix();
         add(mesh->second, instance);
         break;

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "height_field_mesh.h"
 #include "hull_mesh.h"
 #include "renderer.h"
 #include "tumble/v1/world.pb.h"
@@ -51,6 +52,7 @@ class WorldView {
   std::map<std::uint64_t, Pose> poses_;  // ordered: the same draw order every frame
   std::map<std::pair<float, float>, int> capsule_meshes_;
   std::unordered_map<std::uint64_t, int> hull_meshes_;  // by body id: each hull its own mesh
+  std::unordered_map<std::uint64_t, int> height_field_meshes_;  // the same for heightfields
   v1::Contacts contacts_;
   v1::JointStates joints_;
   // Each body's place in the order bodies were described, counted from the last time the view

@@ -16,9 +16,10 @@ Status check_vector(const Vec3& v, const char* field) {
 }  // namespace
 
 Status validate(const BodyDef& def) {
-  const bool is_half_space = std::holds_alternative<HalfSpaceDef>(def.shape);
-  if (is_half_space && def.type != BodyType::kStatic)
+  if (std::holds_alternative<HalfSpaceDef>(def.shape) && def.type != BodyType::kStatic)
     return Status::error("type: a half_space must be static");
+  if (std::holds_alternative<HeightFieldDef>(def.shape) && def.type != BodyType::kStatic)
+    return Status::error("type: a heightfield must be static");
   if (Status s = check_vector(def.position, "position"); !s) return s;
   if (!is_finite(def.orientation)) return Status::error("orientation: must be finite");
   const double norm = def.orientation.norm();

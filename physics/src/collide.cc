@@ -25,6 +25,8 @@ std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b
   bool in_b_frame = false;
 
   switch (b.type()) {
+    case ShapeType::kHeightField:  // collide_terrain's
+      break;
     case ShapeType::kHalfSpace:
       flags = collide_half_space(a, a_in_b, a_at, margin, out);
       in_b_frame = true;
@@ -64,7 +66,14 @@ std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const 
                       PolytopeFeature* chosen, ContactManifold* out) {
   out->count = 0;
   if (chosen != nullptr) *chosen = PolytopeFeature{};
-  if (a.type() == ShapeType::kHalfSpace && b.type() == ShapeType::kHalfSpace) return kCollisionOk;
+  if (is_static_only(a.type()) && is_static_only(b.type())) return kCollisionOk;
+  if (is_terrain_pair(a, b)) {
+    TerrainContacts all;
+    const std::uint32_t flags = collide_terrain(a, pose_a, b, pose_b, settings, &all);
+    for (int c = 0; c < all.count; ++c)
+      if (c == 0 || all.manifolds[c].depth > out->depth) *out = all.manifolds[c];
+    return flags;
+  }
   if (a.type() <= b.type())
     return collide_ordered(a, pose_a, b, pose_b, settings, known, chosen, out);
   const std::uint32_t flags = collide_ordered(b, pose_b, a, pose_a, settings, known, chosen, out);

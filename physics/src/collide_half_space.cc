@@ -48,6 +48,7 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
       break;
     }
     case ShapeType::kHalfSpace:
+    case ShapeType::kHeightField:
       return kCollisionOk;
   }
   out->depth = -std::numeric_limits<double>::infinity();

@@ -96,19 +96,27 @@ std::uint32_t collide_capsules(const Shape& a, const Shape& b, const Mat3& rotat
 std::uint32_t collide_round_polytope(const Vec3& p, const Vec3& q, double radius,
                                      const Shape& polytope_b, const CollisionSettings& settings,
                                      ContactManifold* out) {
+  const bool box = polytope_b.type() == ShapeType::kBox;
+  return collide_round_polyhedron(p, q, radius, *polytope_b.polyhedron(), polytope_b.size(),
+                                  box ? &polytope_b.half_extents() : nullptr, settings, out);
+}
+
+std::uint32_t collide_round_polyhedron(const Vec3& p, const Vec3& q, double radius,
+                                       const ConvexPolyhedron& poly, double size,
+                                       const Vec3* box_half_extents,
+                                       const CollisionSettings& settings, ContactManifold* out) {
   out->count = 0;
-  const ConvexPolyhedron& poly = *polytope_b.polyhedron();
   const double margin = settings.margin;
-  const double tolerance = 1e-12 * (polytope_b.size() + radius + (q - p).norm());
+  const double tolerance = 1e-12 * (size + radius + (q - p).norm());
   const bool is_point = p == q;
   std::uint32_t flags = kCollisionOk;
   Vec3 normal;        // A to B
   Vec3 core_point;    // deepest point of A's core
   double core_depth;  // how far the core reaches into B (negative: its distance from B)
 
-  if (is_point && polytope_b.type() == ShapeType::kBox) {
+  if (is_point && box_half_extents != nullptr) {
     // Closed form: clamp to the box, or push out through the nearest face from inside.
-    const Vec3& h = polytope_b.half_extents();
+    const Vec3& h = *box_half_extents;
     const Vec3 clamped = p.cwiseMax(-h).cwiseMin(h);
     if (clamped != p) {
       double distance;

@@ -44,6 +44,10 @@ ShapeSpan span_of(const Shape& shape) {
       return {"shape.half_extents", shape.half_extents().minCoeff(), "shape.half_extents"};
     case ShapeType::kHull:
       return {"shape.points", shape.local_bounds().extent().minCoeff() / 2, "shape.points"};
+    case ShapeType::kHeightField: {
+      const HeightFieldDef& def = shape.height_field()->def();
+      return {"shape.spacing", std::min(def.spacing_x, def.spacing_y), "shape.heights"};
+    }
     case ShapeType::kHalfSpace:
       break;
   }

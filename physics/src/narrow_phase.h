@@ -2,6 +2,8 @@
 // writes its manifold (normal from A to B) in that frame; collide() moves it to the world.
 #pragma once
 
+#include <array>
+
 #include "physics/collision.h"
 
 namespace tumble {
@@ -42,8 +44,38 @@ std::uint32_t collide_capsules(const Shape& a, const Shape& b, const Mat3& rotat
 std::uint32_t collide_round_polytope(const Vec3& p, const Vec3& q, double radius,
                                      const Shape& polytope_b, const CollisionSettings& settings,
                                      ContactManifold* out);
+// The same against any convex polyhedron of that size; `box_half_extents` (or null) says it is
+// that box, for the closed form of a point.
+std::uint32_t collide_round_polyhedron(const Vec3& p, const Vec3& q, double radius,
+                                       const ConvexPolyhedron& poly, double size,
+                                       const Vec3* box_half_extents,
+                                       const CollisionSettings& settings, ContactManifold* out);
 // Any shape A placed in the half-space's frame (solid z <= 0). Result in the half-space's frame.
 std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec3& translation,
                                  double margin, ContactManifold* out);
+
+// A heightfield's contacts with one convex body: one manifold for each normal it pushes the body
+// along (a box on a ridge touches two slopes), at most kMaxTerrainManifolds; a body on a flat
+// stretch has one, the one it has on a plane. Cells visited per pair are bounded by
+// kMaxTerrainCells (kTerrainCellLimit when cut).
+constexpr int kMaxTerrainManifolds = 4;
+constexpr std::size_t kMaxTerrainCells = 1 << 16;
+struct TerrainContacts {
+  std::array<ContactManifold, kMaxTerrainManifolds> manifolds;
+  int count = 0;
+};
+// A, any convex shape, placed in the heightfield's frame by (rotation, translation). Manifolds in
+// the heightfield's frame, normals from A into the terrain.
+std::uint32_t collide_height_field(const Shape& a, const Mat3& rotation, const Vec3& translation,
+                                   const HeightField& field, const CollisionSettings& settings,
+                                   TerrainContacts* out);
+// Whether a pair must go through collide_terrain (one of them is terrain).
+inline bool is_terrain_pair(const Shape& a, const Shape& b) {
+  return a.type() == ShapeType::kHeightField || b.type() == ShapeType::kHeightField;
+}
+// Every manifold of a terrain pair, in the world, normals from a to b.
+std::uint32_t collide_terrain(const Shape& a, const Pose& pose_a, const Shape& b,
+                              const Pose& pose_b, const CollisionSettings& settings,
+                              TerrainContacts* out);
 
 }  // namespace tumble

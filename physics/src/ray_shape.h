@@ -3,6 +3,7 @@
 // hull's face planes, 1978).
 #pragma once
 
+#include "physics/height_field.h"
 #include "physics/math.h"
 #include "physics/shape.h"
 
@@ -18,5 +19,9 @@ struct ShapeRayHit {
 // normal against the direction (as Jolt reports it: the query is already touching).
 bool ray_shape(const Shape& shape, const Vec3& origin, const Vec3& direction, double max_t,
                ShapeRayHit* hit);
+
+// The same against a heightfield's surface and the solid below it (ray_height_field.cc).
+bool ray_height_field(const HeightField& field, const Vec3& origin, const Vec3& direction,
+                      double max_t, ShapeRayHit* hit);
 
 }  // namespace tumble

@@ -31,6 +31,8 @@ const char* shape_type_name(ShapeType type) {
       return "hull";
     case ShapeType::kHalfSpace:
       return "half_space";
+    case ShapeType::kHeightField:
+      return "heightfield";
   }
   return "unknown";
 }
@@ -66,6 +68,11 @@ Result<Shape> Shape::create(const ShapeDef& def) {
     shape.polyhedron_ = std::make_shared<ConvexPolyhedron>(std::move(built).value());
     const Aabb bounds = shape.local_bounds();
     shape.half_extents_ = 0.5 * bounds.extent();
+  } else if (const auto* field = std::get_if<HeightFieldDef>(&def)) {
+    Result<HeightField> built = HeightField::create(*field);
+    if (!built) return built.status();
+    shape.type_ = ShapeType::kHeightField;
+    shape.height_field_ = std::make_shared<HeightField>(std::move(built).value());
   } else {
     shape.type_ = ShapeType::kHalfSpace;
   }
@@ -91,6 +98,8 @@ Aabb Shape::local_bounds() const {
     }
     case ShapeType::kHalfSpace:
       return Aabb::infinite();
+    case ShapeType::kHeightField:
+      return height_field_->bounds();
   }
   return Aabb::infinite();
 }
@@ -107,6 +116,7 @@ double Shape::volume() const {
     case ShapeType::kHull:
       return polyhedron_->volume;
     case ShapeType::kHalfSpace:
+    case ShapeType::kHeightField:
       return std::numeric_limits<double>::infinity();
   }
   return 0;
@@ -147,6 +157,7 @@ MassProperties Shape::mass_properties(double density) const {
       break;
     }
     case ShapeType::kHalfSpace:
+    case ShapeType::kHeightField:
       props.mass = std::numeric_limits<double>::infinity();
       break;
   }
@@ -164,6 +175,8 @@ double Shape::size() const {
       return half_extents_.maxCoeff();
     case ShapeType::kHalfSpace:
       return 1.0;
+    case ShapeType::kHeightField:
+      return std::max(height_field_->def().spacing_x, height_field_->def().spacing_y);
   }
   return 1.0;
 }
@@ -173,6 +186,8 @@ namespace {
 double compute_inner_radius(ShapeType type, double radius, const Vec3& half_extents,
                             const ConvexPolyhedron* polyhedron) {
   switch (type) {
+    case ShapeType::kHeightField:
+      return 0;
     case ShapeType::kSphere:
     case ShapeType::kCapsule:
       return radius;
@@ -191,8 +206,13 @@ double compute_inner_radius(ShapeType type, double radius, const Vec3& half_exte
 }
 
 double compute_outer_radius(ShapeType type, double radius, double half_height,
-                            const Vec3& half_extents, const ConvexPolyhedron* polyhedron) {
+                            const Vec3& half_extents, const ConvexPolyhedron* polyhedron,
+                            const HeightField* height_field) {
   switch (type) {
+    case ShapeType::kHeightField: {
+      const Aabb box = height_field->bounds();
+      return box.min.cwiseAbs().cwiseMax(box.max.cwiseAbs()).norm();
+    }
     case ShapeType::kSphere:
       return radius;
     case ShapeType::kCapsule:
@@ -216,7 +236,8 @@ double compute_outer_radius(ShapeType type, double radius, double half_height,
 void Shape::update_radii() {
   inner_radius_ = compute_inner_radius(type_, radius_, half_extents_, polyhedron_.get());
   outer_radius_ =
-      compute_outer_radius(type_, radius_, half_height_, half_extents_, polyhedron_.get());
+      compute_outer_radius(type_, radius_, half_height_, half_extents_, polyhedron_.get(),
+                           height_field_.get());
 }
 
 Vec3 Shape::support(const Vec3& d) const {
@@ -237,9 +258,10 @@ Vec3 Shape::support(const Vec3& d) const {
     case ShapeType::kHull:
       return polyhedron_->support(d);
     case ShapeType::kHalfSpace:
+    case ShapeType::kHeightField:
       break;
   }
-  TUMBLE_ASSERT(false && "a half-space has no support point");
+  TUMBLE_ASSERT(false && "a half-space or heightfield has no support point");
   return Vec3::Zero();
 }
 
@@ -258,8 +280,10 @@ Shape Shape::recentred(const Vec3& offset) const {
 }
 
 ShapeState Shape::state() const {
-  ShapeState state{type_, radius_, half_height_, half_extents_, nullptr};
+  ShapeState state{type_, radius_, half_height_, half_extents_, nullptr, nullptr};
   if (type_ == ShapeType::kHull) state.polyhedron = polyhedron_;
+  if (type_ == ShapeType::kHeightField)  // the definition, owned with the field
+    state.height_field = std::shared_ptr<const HeightFieldDef>(height_field_, &height_field_->def());
   return state;
 }
 
@@ -359,6 +383,12 @@ Result<Shape> Shape::from_state(const ShapeState& state) {
     case ShapeType::kHalfSpace:
       def = HalfSpaceDef{};
       break;
+    case ShapeType::kHeightField: {
+      if (state.height_field == nullptr)
+        return Status::error("height_field: required for a heightfield");
+      // Built again from its definition: the checks and the derived edges are create()'s.
+      return create(*state.height_field);
+    }
     case ShapeType::kHull: {
       if (state.polyhedron == nullptr) return Status::error("polyhedron: required for a hull");
       if (Status s = check_polyhedron(*state.polyhedron); !s) return s;

@@ -17,6 +17,7 @@ struct ShapeState {
   double radius = 0, half_height = 0;
   Vec3 half_extents = Vec3::Zero();
   std::shared_ptr<const ConvexPolyhedron> polyhedron;  // hulls only (a box rebuilds its own)
+  std::shared_ptr<const HeightFieldDef> height_field;  // heightfields only
 };
 
 }  // namespace tumble

@@ -110,6 +110,17 @@ void put_shape(Writer& w, const Shape& shape) {
   w.put(s.radius);
   w.put(s.half_height);
   w.put(s.half_extents);
+  if (s.type == ShapeType::kHeightField) {
+    const HeightFieldDef& def = *s.height_field;
+    w.put(def.samples_x);
+    w.put(def.samples_y);
+    w.put(def.spacing_x);
+    w.put(def.spacing_y);
+    w.put(static_cast<std::uint32_t>(def.heights.size()));
+    for (double h : def.heights)
+      w.put(h);
+    return;
+  }
   if (s.type != ShapeType::kHull) return;
   const ConvexPolyhedron& p = *s.polyhedron;
   w.put(static_cast<std::uint32_t>(p.vertices.size()));
@@ -140,7 +151,7 @@ Result<Shape> take_shape(Reader& r) {
   s.half_height = r.take<double>("half_height");
   s.half_extents = r.vec3("half_extents");
   if (!r.ok()) return r.status();
-  if (type > static_cast<std::uint8_t>(ShapeType::kHalfSpace))
+  if (type > static_cast<std::uint8_t>(ShapeType::kHeightField))
     return Status::error("type: unknown shape type " + std::to_string(type));
   s.type = static_cast<ShapeType>(type);
   if (s.type == ShapeType::kHull) {
@@ -166,6 +177,18 @@ Result<Shape> take_shape(Reader& r) {
     p->volume = r.take<double>("polyhedron.volume");
     if (!r.ok()) return r.status();
     s.polyhedron = std::move(p);
+  }
+  if (s.type == ShapeType::kHeightField) {
+    HeightFieldDef def;
+    def.samples_x = r.take<std::uint32_t>("height_field.samples_x");
+    def.samples_y = r.take<std::uint32_t>("height_field.samples_y");
+    def.spacing_x = r.take<double>("height_field.spacing_x");
+    def.spacing_y = r.take<double>("height_field.spacing_y");
+    def.heights.resize(r.count("height_field.heights", 8));
+    for (double& h : def.heights)
+      h = r.take<double>("height_field.heights");
+    if (!r.ok()) return r.status();
+    s.height_field = std::make_shared<const HeightFieldDef>(std::move(def));
   }
   return Shape::from_state(s);  // checks every number and index
 }

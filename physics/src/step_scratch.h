@@ -142,6 +142,17 @@ struct StepScratch {
   std::vector<double> manifold_depth;         // each manifold's depth, for the step's deepest
   std::vector<std::uint32_t> previous_pair;
   std::vector<std::uint8_t> reused;
+  // Pairs with terrain, which may touch along several normals: each such broad-phase pair's
+  // place in terrain_found (kNoTerrain for the others). Its first manifold goes where any pair's
+  // goes, the others after it; their records follow one another in `pairs`, in the same order.
+  struct TerrainFound {
+    TerrainContacts contacts;
+    std::array<ContactPairRecord, kMaxTerrainManifolds> records;
+    std::array<std::uint32_t, kMaxTerrainManifolds> previous;
+  };
+  static constexpr std::uint32_t kNoTerrain = UINT32_MAX;
+  std::vector<std::uint32_t> terrain_slot;
+  std::vector<TerrainFound> terrain_found;
 };
 
 }  // namespace tumble

@@ -211,6 +211,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     // A moving body joins the moving set, which every step visits anyway; only a resting one
     // changes what the broad phase keeps.
     if (slot.body.is_kinematic()) kinematic_.push_back(index);
+    if (slot.body.shape.type() == ShapeType::kHeightField) ++terrain_count_;
     if (slot.body.is_moving())
       join_awake(index);
     else if (!slot.body.carries())  // a carrier's bounds are made every step, as a moving body's
@@ -234,6 +235,7 @@ Status World::remove_body(BodyId id) {
   else
     resting_changed(id.index);
   if (slot.body.is_kinematic()) std::erase(kinematic_, id.index);
+  if (slot.body.shape.type() == ShapeType::kHeightField) --terrain_count_;
   // The step's per-slot data forget it (bounds kept for moving bodies are not visited again).
   if (id.index < bounds_.size()) {
     bounds_[id.index] = Aabb();
@@ -780,6 +782,17 @@ void World::find_contacts(double dt) {
   const double gravity = settings_.gravity.norm();
   const int threads = thread_count(settings_.threads);
   match_pair_records(pairs_, s.pairs, s.found_previous);
+  // Pairs with terrain get room for several manifolds, numbered in pair order.
+  if (terrain_count_ > 0) {
+    resize_reusing(s.terrain_slot, pairs_.size());
+    std::uint32_t terrain_pairs = 0;
+    for (std::size_t i = 0; i < pairs_.size(); ++i) {
+      const bool terrain =
+          is_terrain_pair(bodies_[pairs_[i].a].body.shape, bodies_[pairs_[i].b].body.shape);
+      s.terrain_slot[i] = terrain ? terrain_pairs++ : StepScratch::kNoTerrain;
+    }
+    if (s.terrain_found.size() < terrain_pairs) s.terrain_found.resize(terrain_pairs);
+  }
   const std::uint32_t flags =
       or_over_indices(threads, n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
         const Body& a = bodies_[pairs_[i].a].body;
@@ -812,6 +825,32 @@ void World::find_contacts(double dt) {
           settings.feature_slack = std::max(settings.feature_slack, settings_.solver.slop);
           settings.feature_slack_relative = std::max(settings.feature_slack_relative, 0.05);
           settings.face_angle = std::max(settings.face_angle, 0.02);
+        }
+        if (terrain_count_ > 0 && s.terrain_slot[i] != StepScratch::kNoTerrain) {
+          StepScratch::TerrainFound& found = s.terrain_found[s.terrain_slot[i]];
+          std::uint32_t pair_flags =
+              collide_terrain(a.shape, pose_a, b.shape, pose_b, settings, &found.contacts);
+          if (dt > 0 && found.contacts.count > 0 && fast) {  // as for any pair, below
+            settings.margin =
+                settings_.collision.margin + rest + motion_[pairs_[i].a] + motion_[pairs_[i].b];
+            pair_flags |=
+                collide_terrain(a.shape, pose_a, b.shape, pose_b, settings, &found.contacts);
+          }
+          if (found.contacts.count == 0) return pair_flags;
+          s.found_flags[i] = StepScratch::kPairTouches;
+          // The pair's records of the last step follow one another, manifold by manifold.
+          for (int c = 0; c < found.contacts.count; ++c) {
+            record_manifold(found.contacts.manifolds[c], PolytopeFeature{}, contact.a, pose_a,
+                            contact.b, pose_b, &found.records[c]);
+            const std::size_t last = static_cast<std::size_t>(previous) + c;
+            found.previous[c] = previous != kNoRecord && last < s.pairs.size() &&
+                                        s.pairs[last].a == contact.a && s.pairs[last].b == contact.b
+                                    ? static_cast<std::uint32_t>(last)
+                                    : kNoRecord;
+          }
+          contact.manifold = found.contacts.manifolds[0];
+          s.found_records[i] = found.records[0];
+          return pair_flags;
         }
         // A pair of polytopes that has barely moved since its feature was searched for clips
         // that feature again (ContactPairRecord).
@@ -858,7 +897,9 @@ void World::find_contacts(double dt) {
   std::uint32_t kept = 0;
   for (std::size_t i = 0; i < pairs_.size(); ++i) {
     s.kept_index[i] = kept;
-    kept += (s.found_flags[i] & StepScratch::kPairTouches) != 0;
+    if ((s.found_flags[i] & StepScratch::kPairTouches) == 0) continue;
+    const bool terrain = terrain_count_ > 0 && s.terrain_slot[i] != StepScratch::kNoTerrain;
+    kept += terrain ? s.terrain_found[s.terrain_slot[i]].contacts.count : 1;
   }
   resize_reusing(contacts_, kept);
   resize_reusing(s.next_pairs, kept);
@@ -871,6 +912,14 @@ void World::find_contacts(double dt) {
     s.next_pairs[k] = s.found_records[i];
     s.previous_pair[k] = s.found_previous[i];
     s.reused[k] = (s.found_flags[i] & StepScratch::kPairKeptFeature) != 0;
+    if (terrain_count_ == 0 || s.terrain_slot[i] == StepScratch::kNoTerrain) return;
+    const StepScratch::TerrainFound& found = s.terrain_found[s.terrain_slot[i]];
+    for (int c = 1; c < found.contacts.count; ++c) {
+      contacts_[k + c] = {contacts_[k].a, contacts_[k].b, found.contacts.manifolds[c]};
+      s.next_pairs[k + c] = found.records[c];
+      s.previous_pair[k + c] = found.previous[c];
+      s.reused[k + c] = 0;
+    }
   });
   collision_flags_ = flags;
 }

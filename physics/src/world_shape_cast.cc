@@ -22,6 +22,8 @@ namespace tumble {
 Status validate(const ShapeCast& cast) {
   if (std::holds_alternative<HalfSpaceDef>(cast.shape))
     return Status::error("shape: a half-space holds half the world and cannot be swept");
+  if (std::holds_alternative<HeightFieldDef>(cast.shape))
+    return Status::error("shape: a heightfield is terrain and cannot be swept");
   if (Status s = validate_placement(cast.pose); !s) return s;
   if (!is_finite(cast.translation)) return Status::error("translation: must be finite");
   if (!(cast.translation.norm() <= kMaxRayLength))

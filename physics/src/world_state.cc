@@ -27,6 +27,9 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
   if (!body.inertia_body.allFinite() || !body.inverse_inertia_body.allFinite() ||
       !body.inverse_inertia_world.allFinite())
     return Status::error("inertia: must be finite");
+  if (is_static_only(body.shape.type()) && !body.is_static())
+    return Status::error(std::string("shape: a ") + shape_type_name(body.shape.type()) +
+                         " must be static");
   if (!body.is_dynamic()) {
     if (body.inverse_mass != 0 || !body.inverse_inertia_body.isZero(0))
       return Status::error("inverse_mass: must be 0 for a static or kinematic body");
@@ -35,8 +38,6 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
     if (!(body.mass > 0) || !std::isfinite(body.mass) || !(body.inverse_mass > 0) ||
         !std::isfinite(body.inverse_mass))
       return Status::error("mass: must be finite and > 0 for a dynamic body");
-    if (body.shape.type() == ShapeType::kHalfSpace)
-      return Status::error("shape: a half-space must be static");
     // The inverses are stored too (a restored world steps bit for bit), so a crafted state could
     // pair a mass with any inverse: they must agree, and the inertia must be positive definite.
     if (std::abs(body.mass * body.inverse_mass - 1) > 1e-9)
@@ -206,16 +207,27 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
   }
   if (state.free_slots.size() != slot_count - live)
     return Status::error("free_slots: must list every dead slot");
+  // A pair with terrain has a record for each of its manifolds, one after another.
+  std::size_t repeats = 0;
   for (std::size_t k = 0; k < state.contact_pairs.size(); ++k) {
     if (Status s = check_contact_pair(state.contact_pairs[k], state.slots); !s)
       return s.within("contact_pairs[" + std::to_string(k) + "].");
-    if (k > 0) {
-      const ContactPairRecord& p = state.contact_pairs[k - 1];
-      const ContactPairRecord& r = state.contact_pairs[k];
-      if (p.a.index != r.a.index ? p.a.index > r.a.index : p.b.index >= r.b.index)
-        return Status::error("contact_pairs[" + std::to_string(k) +
-                             "]: not sorted by body pair, or repeated");
-    }
+    if (k == 0) continue;
+    const ContactPairRecord& p = state.contact_pairs[k - 1];
+    const ContactPairRecord& r = state.contact_pairs[k];
+    const bool same = p.a.index == r.a.index && p.b.index == r.b.index;
+    repeats = same ? repeats + 1 : 0;
+    // (A record of a body removed since is never matched: nothing to check of it.)
+    const BodySlotState& a = state.slots[r.a.index];
+    const BodySlotState& b = state.slots[r.b.index];
+    const bool current = a.alive && b.alive && a.generation == r.a.generation &&
+                         b.generation == r.b.generation;
+    const bool terrain = !current || is_terrain_pair(a.body.shape, b.body.shape);
+    const bool repeat_allowed = same && terrain && repeats < kMaxTerrainManifolds;
+    if (!repeat_allowed &&
+        (p.a.index != r.a.index ? p.a.index > r.a.index : p.b.index >= r.b.index))
+      return Status::error("contact_pairs[" + std::to_string(k) +
+                           "]: not sorted by body pair, or repeated");
   }
 
   if (state.joints.size() > World::kMaxJoints)
@@ -250,6 +262,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     if (world.bodies_[i].body.asleep) world.link_sleeper(i, world.bodies_[i].body.sleep_island);
     if (world.bodies_[i].body.is_moving()) world.awake_.push_back(i);
     if (world.bodies_[i].body.is_kinematic()) world.kinematic_.push_back(i);
+    if (world.bodies_[i].body.shape.type() == ShapeType::kHeightField) ++world.terrain_count_;
     world.filters_used_ = world.filters_used_ || world.bodies_[i].body.filter != CollisionFilter{};
   }
   world.live_count_ = live;

@@ -109,9 +109,47 @@ double positive(ObjectReader& r, const std::string& key, double fallback) {
   return v;
 }
 
+// "samples": [nx, ny], "spacing": [sx, sy] (m), "heights": nx * ny numbers, x fastest.
+HeightFieldDef read_height_field(ObjectReader& r) {
+  HeightFieldDef def;
+  const Json* samples = r.find("samples");
+  if (samples == nullptr || !samples->is_array() || samples->size() != 2 ||
+      !(*samples)[0].is_number_unsigned() || !(*samples)[1].is_number_unsigned())
+    fail(r.child("samples"), "must be [samples along x, samples along y], whole numbers");
+  const auto side = [&](int k) {
+    const std::uint64_t n = (*samples)[k].get<std::uint64_t>();
+    if (n < 2 || n > kMaxHeightFieldSide)
+      fail(r.child("samples") + "[" + std::to_string(k) + "]",
+           "must be 2 to " + std::to_string(kMaxHeightFieldSide));
+    return static_cast<std::uint32_t>(n);
+  };
+  def.samples_x = side(0);
+  def.samples_y = side(1);
+  const Json* spacing = r.find("spacing");
+  if (spacing == nullptr || !spacing->is_array() || spacing->size() != 2)
+    fail(r.child("spacing"), "must be [spacing along x, spacing along y] in m");
+  for (int k = 0; k < 2; ++k) {
+    const std::string path = r.child("spacing") + "[" + std::to_string(k) + "]";
+    const double value = ObjectReader::read_number((*spacing)[k], path);
+    if (!(value > 0)) fail(path, "must be > 0");
+    (k == 0 ? def.spacing_x : def.spacing_y) = value;
+  }
+  const Json* heights = r.find("heights");
+  const std::size_t expected = std::size_t{def.samples_x} * def.samples_y;
+  if (heights == nullptr || !heights->is_array() || heights->size() != expected)
+    fail(r.child("heights"), "must be an array of samples[0] * samples[1] = " +
+                                 std::to_string(expected) + " heights in m, x fastest");
+  def.heights.reserve(expected);
+  for (std::size_t i = 0; i < expected; ++i)
+    def.heights.push_back(
+        ObjectReader::read_number((*heights)[i], r.child("heights") + "[" + std::to_string(i) + "]"));
+  return def;
+}
+
 ShapeDef read_shape(ObjectReader& r) {
   const std::string type = r.string("shape", "");
-  if (type.empty()) fail(r.child("shape"), "missing (box, sphere, capsule, hull or plane)");
+  if (type.empty())
+    fail(r.child("shape"), "missing (box, sphere, capsule, hull, plane or heightfield)");
   if (type == "box") {
     const Json* size = r.find("size");
     if (size == nullptr) fail(r.child("size"), "missing (full extents x, y, z in m)");
@@ -141,7 +179,9 @@ ShapeDef read_shape(ObjectReader& r) {
     return hull;
   }
   if (type == "plane") return HalfSpaceDef{};
-  fail(r.child("shape"), "unknown shape '" + type + "' (box, sphere, capsule, hull or plane)");
+  if (type == "heightfield") return read_height_field(r);
+  fail(r.child("shape"),
+       "unknown shape '" + type + "' (box, sphere, capsule, hull, plane or heightfield)");
 }
 
 void read_limits(const Json& json, WorldLimits* limits) {
@@ -163,8 +203,9 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   ObjectReader r(json, path);
   BodyDef def;
   def.shape = read_shape(r);
-  const bool plane = std::holds_alternative<HalfSpaceDef>(def.shape);
-  const bool is_static = r.boolean("static", plane);
+  const bool ground = std::holds_alternative<HalfSpaceDef>(def.shape) ||
+                     std::holds_alternative<HeightFieldDef>(def.shape);
+  const bool is_static = r.boolean("static", ground);
   const bool kinematic = r.boolean("kinematic", false);
   if (is_static && kinematic) fail(r.child("kinematic"), "a body is static or kinematic, not both");
   def.type = is_static ? BodyType::kStatic
@@ -384,6 +425,11 @@ Json body_json(const BodyDef& def) {
           out["points"] = Json::array();
           for (const Vec3& p : shape.points)
             out["points"].push_back(vector_json(p));
+        } else if constexpr (std::is_same_v<T, HeightFieldDef>) {
+          out["shape"] = "heightfield";
+          out["samples"] = Json::array({shape.samples_x, shape.samples_y});
+          out["spacing"] = Json::array({shape.spacing_x, shape.spacing_y});
+          out["heights"] = shape.heights;
         } else {
           out["shape"] = "plane";
         }

@@ -54,6 +54,27 @@ SceneDef pile_scene(int count) {
   return scene;
 }
 
+SceneDef terrain_pile_scene(int count) {
+  SceneDef scene = pile_scene(count);
+  scene.name = "terrain-" + std::to_string(count);
+  // Rolling hills under the pile, 0.5 m cells, up to about 0.55 m high: below the lowest box
+  // (its centre 2 m up), and wide enough (60 m for 1000 boxes) that no box slides off.
+  const int side = static_cast<int>(std::ceil(std::cbrt(static_cast<double>(count)) - 1e-9));
+  const double half_width = 1.5 * side + 15;
+  HeightFieldDef terrain;
+  terrain.spacing_x = terrain.spacing_y = 0.5;
+  terrain.samples_x = terrain.samples_y = static_cast<std::uint32_t>(2 * half_width / 0.5) + 1;
+  for (std::uint32_t j = 0; j < terrain.samples_y; ++j)
+    for (std::uint32_t i = 0; i < terrain.samples_x; ++i) {
+      const double x = (i - 0.5 * (terrain.samples_x - 1)) * 0.5;
+      const double y = (j - 0.5 * (terrain.samples_y - 1)) * 0.5;
+      terrain.heights.push_back(0.4 * std::sin(0.35 * x) * std::cos(0.3 * y) +
+                                0.15 * std::sin(0.9 * x + 0.7 * y));
+    }
+  scene.bodies.front().shape = std::move(terrain);
+  return scene;
+}
+
 SceneDef pyramid_scene(int base) {
   SceneDef scene = base_scene("pyramid-" + std::to_string(base), 20);
   scene.bodies.push_back(ground());
@@ -462,9 +483,11 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   // Counted, ground included, before anything is built, so a request for a huge scene costs
   // nothing.
-  if (name == "pile" || name == "pyramid" || name == "tower" || name == "chain" ||
+  if (name == "pile" || name == "terrain" || name == "pyramid" || name == "tower" ||
+      name == "chain" ||
       name == "rope-bridge" || name == "ragdolls") {
-    const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(name == "pile" ? 1000 : 20));
+    const bool piled = name == "pile" || name == "terrain";
+    const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(piled ? 1000 : 20));
     const std::uint64_t bodies = (name == "pyramid"    ? n * (n + 1) / 2
                                   : name == "ragdolls" ? 11 * n
                                                        : n) +
@@ -479,6 +502,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     return Status::ok();
   };
   if (name == "pile") return pile_scene(size.value_or(1000));
+  if (name == "terrain") return terrain_pile_scene(size.value_or(1000));
   if (name == "pyramid") return pyramid_scene(size.value_or(20));
   if (name == "tower") return tower_scene(size.value_or(20));
   if (name == "mass-ratio" || name == "mass-ratio-inv") {
@@ -533,7 +557,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     return parse_scene(default_scene_json());
   }
   return Status::error("scene '" + shown(spec) +
-                       "': unknown; the standard scenes are pile, pyramid, tower, mass-ratio, "
+                       "': unknown; the standard scenes are pile, terrain, pyramid, tower, mass-ratio, "
                        "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
                        "chain, cradle, door, rope-bridge, arm, ragdolls, carousel, default");
 }

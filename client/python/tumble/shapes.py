@@ -68,7 +68,34 @@ class Plane:
         return shape
 
 
-SHAPES = (Box, Sphere, Capsule, Hull, Plane)
+@dataclass(frozen=True)
+class HeightField:
+    """Terrain (static bodies only): `heights`, an array of shape (samples along y, samples
+    along x) in m, row j at y = (j - (rows - 1) / 2) * spacing[1] and column i at
+    x = (i - (columns - 1) / 2) * spacing[0]; the grid is centred on the body's origin and the
+    solid lies below its surface. Each cell is two triangles split along its diagonal from
+    (i, j) to (i + 1, j + 1)."""
+
+    heights: np.ndarray = field(default_factory=lambda: np.zeros((2, 2)))
+    spacing: tuple = (1.0, 1.0)
+
+    def to_proto(self):
+        heights = np.asarray(self.heights, dtype=float)
+        if heights.ndim != 2 or heights.shape[0] < 2 or heights.shape[1] < 2:
+            raise ArgumentError(f"heights: expected a 2-D array of at least 2 x 2 samples, got "
+                                f"shape {heights.shape}")
+        if not np.all(np.isfinite(heights)):
+            raise ArgumentError("heights: must be finite")
+        spacing = convert.array(self.spacing, 2, "spacing")
+        shape = pb.Shape()
+        shape.heightfield.samples_y, shape.heightfield.samples_x = heights.shape
+        shape.heightfield.spacing_x = float(spacing[0])
+        shape.heightfield.spacing_y = float(spacing[1])
+        shape.heightfield.heights.extend(heights.ravel().tolist())
+        return shape
+
+
+SHAPES = (Box, Sphere, Capsule, Hull, Plane, HeightField)
 
 
 def from_proto(shape):
@@ -84,4 +111,8 @@ def from_proto(shape):
         return Hull(np.array(shape.hull.points, dtype=float).reshape(-1, 3))
     if kind == "plane":
         return Plane()
+    if kind == "heightfield":
+        field_ = shape.heightfield
+        heights = np.array(field_.heights, dtype=float).reshape(field_.samples_y, field_.samples_x)
+        return HeightField(heights, (field_.spacing_x, field_.spacing_y))
     raise ArgumentError(f"shape: unknown kind {kind!r}")

@@ -15,7 +15,7 @@ from tumble import convert, shapes
 from tumble.bodies import Body, BodySpec, aliased, bits
 from tumble.errors import ArgumentError, Error, from_rpc
 from tumble.frames import FrameStream, plain
-from tumble.shapes import Box, Capsule, Hull, Plane, Sphere
+from tumble.shapes import Box, Capsule, HeightField, Hull, Plane, Sphere
 from tumble.v1 import world_pb2 as pb
 from tumble.v1 import world_pb2_grpc as pb_grpc
 
@@ -157,7 +157,8 @@ class WorldCalls:
     # --- bodies -------------------------------------------------------------------------------
 
     def spawn(self, shape, position=None, linear_velocity=None, **options):
-        """Spawns one body of `shape` (Box, Sphere, Capsule, Hull or Plane); returns its id.
+        """Spawns one body of `shape` (Box, Sphere, Capsule, Hull, Plane or HeightField); returns
+        its id.
         Options are BodySpec's: orientation, angular_velocity, mass, density, friction,
         restitution, color, static, kinematic (moved only by its velocity: linear_velocity,
         angular_velocity, and set_state's), gravity_scale, linear_damping, angular_damping,
@@ -197,6 +198,12 @@ class WorldCalls:
     def spawn_ground(self, height=0.0, **options):
         """A static ground: the half-space below z = height."""
         return self.spawn(Plane(), (0.0, 0.0, height), static=True, **options)
+
+    def spawn_heightfield(self, heights, spacing, position=None, **options):
+        """Static terrain: `heights` ((rows along y, columns along x), m) on a grid of `spacing`
+        (x, y, m), centred on `position`; see HeightField."""
+        return self.spawn(HeightField(np.asarray(heights, dtype=float), tuple(spacing)), position,
+                          static=True, **options)
 
     def remove(self, ids):
         """Removes a body or a list of them, all or nothing (one unknown id: NOT_FOUND)."""

@@ -58,10 +58,13 @@ enum CollisionFlags : std::uint32_t {
   kGjkIterationLimit = 1u << 0,
   kEpaIterationLimit = 1u << 1,
   kEpaDegenerate = 1u << 2,
+  kTerrainCellLimit = 1u << 3,  // a body over more terrain cells than a pair may visit
 };
 
 // Contacts between shape `a` at `pose_a` and shape `b` at `pose_b`. Returns the flags; `out->count`
-// is 0 when the shapes are farther apart than the margin. Two half-spaces never collide.
+// is 0 when the shapes are farther apart than the margin. Two static-only shapes (half-spaces,
+// heightfields) never collide. Against a heightfield, where a body can touch along several
+// normals, this is the deepest of its manifolds (World's contacts keep them all).
 std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
                       const CollisionSettings& settings, ContactManifold* out);
 

@@ -6,6 +6,7 @@
 #include <variant>
 #include <vector>
 
+#include "physics/height_field.h"
 #include "physics/math.h"
 #include "physics/polyhedron.h"
 #include "physics/status.h"
@@ -39,11 +40,17 @@ struct HullDef {
 // The solid region z <= 0 of its frame (an infinite ground); its surface normal is the frame's +z.
 // Only static bodies may use it.
 struct HalfSpaceDef {};
+// HeightFieldDef (physics/height_field.h): terrain; only static bodies may use it.
 
-using ShapeDef = std::variant<SphereDef, CapsuleDef, BoxDef, HullDef, HalfSpaceDef>;
+using ShapeDef = std::variant<SphereDef, CapsuleDef, BoxDef, HullDef, HalfSpaceDef, HeightFieldDef>;
 
-// Ordered so that collision dispatch can always put the lower type first.
-enum class ShapeType : std::uint8_t { kSphere, kCapsule, kBox, kHull, kHalfSpace };
+// Ordered so that collision dispatch can always put the lower type first (the values are the
+// state format's: a new type goes last).
+enum class ShapeType : std::uint8_t { kSphere, kCapsule, kBox, kHull, kHalfSpace, kHeightField };
+// Shapes only static bodies may have: the ground and terrain.
+inline bool is_static_only(ShapeType type) {
+  return type == ShapeType::kHalfSpace || type == ShapeType::kHeightField;
+}
 const char* shape_type_name(ShapeType type);
 
 struct MassProperties {
@@ -65,13 +72,16 @@ class Shape {
   const Vec3& half_extents() const { return half_extents_; }  // box
   // The polyhedron of a box or hull; null for the other shapes.
   const ConvexPolyhedron* polyhedron() const { return polyhedron_.get(); }
+  // The heightfield of a heightfield shape; null for the other shapes.
+  const HeightField* height_field() const { return height_field_.get(); }
 
-  // Bounds in the shape frame; infinite for a half-space.
+  // Bounds in the shape frame; infinite for a half-space. A heightfield's reach down to its base.
   Aabb local_bounds() const;
-  double volume() const;  // m^3; infinite for a half-space
+  double volume() const;  // m^3; infinite for a half-space and a heightfield
   // Mass properties for a uniform density (kg/m^3).
   MassProperties mass_properties(double density) const;
-  // A length that sets the scale of numerical tolerances: the largest half extent.
+  // A length that sets the scale of numerical tolerances: the largest half extent (a
+  // heightfield's: its larger spacing, the size of its features).
   double size() const;
   // m: the radius of the largest sphere about the shape's origin that fits inside it (the
   // smallest half extent of a box); a body moving less than this per step cannot jump over a
@@ -79,7 +89,7 @@ class Shape {
   double inner_radius() const { return inner_radius_; }
   // m: the largest distance of a point of the shape from its origin; infinite for a half-space.
   double outer_radius() const { return outer_radius_; }
-  // The point of the shape farthest along `direction` (shape frame).
+  // The point of the shape farthest along `direction` (shape frame); convex shapes only.
   Vec3 support(const Vec3& direction) const;
   // The same shape moved so that `offset` (shape frame) becomes the origin.
   Shape recentred(const Vec3& offset) const;
@@ -96,6 +106,7 @@ class Shape {
   double half_height_ = 0;
   Vec3 half_extents_ = Vec3::Zero();
   std::shared_ptr<const ConvexPolyhedron> polyhedron_;
+  std::shared_ptr<const HeightField> height_field_;
   double inner_radius_ = 0, outer_radius_ = 0;
   void update_radii();
 };

@@ -332,6 +332,9 @@ class World {
   // The kinematic bodies' slots, in no order: the step moves those with a velocity (carries()),
   // which are few, and treats the rest as statics. A world without pays one test of emptiness.
   std::vector<std::uint32_t> kinematic_;
+  // How many live bodies are terrain (heightfields): their pairs may give several manifolds
+  // (find_contacts); a world without pays one test of zero.
+  std::size_t terrain_count_ = 0;
   // The broad phase's moving bodies: awake_ and the kinematic bodies with a velocity, ascending
   // (awake_ itself where there are none).
   std::vector<std::uint32_t> moving_scratch_;
