@@ -8,8 +8,13 @@
 // each of Tumble's answers checked on a sample against a reference of our own that needs no GJK
 // (the distance from the swept centre to each box, exact, is convex along the path: its first
 // fall below the radius by bisection).
-// Usage: bench_rays [--rays N] [--boxes N] [--casts N]
+// With --terrain 1 the ground is a heightfield of 100,352 triangles (225 x 225 samples over the
+// same 200 m, rolling hills up to about 1.1 m) under the boxes, beside Bullet's
+// btHeightfieldTerrainShape (its quads split along the same diagonal); the brute force then meets
+// every triangle too, and the sphere casts are left out.
+// Usage: bench_rays [--rays N] [--boxes N] [--casts N] [--terrain 0|1]
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +28,7 @@
 #include "ray_shape.h"
 
 #ifdef TUMBLE_HAVE_BULLET
+#include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
 #include <btBulletCollisionCommon.h>
 #endif
 
@@ -35,14 +41,30 @@ struct Scene {
   std::vector<Pose> pose;
 };
 
-Scene make_scene(int boxes, std::mt19937_64* rng) {
+// The hills of --terrain: 225 x 225 samples over 200 m x 200 m.
+HeightFieldDef hills() {
+  HeightFieldDef def;
+  def.samples_x = def.samples_y = 225;
+  def.spacing_x = def.spacing_y = 200.0 / 224;
+  for (std::uint32_t j = 0; j < def.samples_y; ++j)
+    for (std::uint32_t i = 0; i < def.samples_x; ++i) {
+      const double x = (i - 112.0) * def.spacing_x, y = (j - 112.0) * def.spacing_y;
+      def.heights.push_back(0.8 * std::sin(0.07 * x) * std::cos(0.05 * y) +
+                            0.3 * std::sin(0.31 * x + 0.23 * y));
+    }
+  return def;
+}
+
+Scene make_scene(int boxes, std::mt19937_64* rng, const HeightField* ground) {
   std::uniform_real_distribution<double> u(0, 1);
   Scene scene;
   for (int i = 0; i < boxes; ++i) {
     scene.half.push_back(Vec3(0.1 + 0.4 * u(*rng), 0.1 + 0.4 * u(*rng), 0.1 + 0.9 * u(*rng)));
     const Quat q(Eigen::AngleAxisd(2 * M_PI * u(*rng), Vec3::UnitZ()) *
                  Eigen::AngleAxisd(0.3 * (u(*rng) - 0.5), Vec3::UnitX()));
-    scene.pose.push_back({Vec3(200 * u(*rng) - 100, 200 * u(*rng) - 100, scene.half.back().z()), q});
+    const double x = 200 * u(*rng) - 100, y = 200 * u(*rng) - 100;
+    const double base = ground != nullptr ? ground->height_at(x, y) : 0.0;
+    scene.pose.push_back({Vec3(x, y, base + scene.half.back().z()), q});
   }
   return scene;
 }
@@ -79,18 +101,25 @@ double rays_per_second(std::size_t rays, Run&& run) {
 
 int main(int argc, char** argv) {
   int ray_count = 100000, box_count = 10000, cast_count = 10000;
+  bool terrain = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rays")) ray_count = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--boxes")) box_count = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--casts")) cast_count = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--terrain")) terrain = std::atoi(argv[i + 1]) != 0;
   }
+  const HeightFieldDef hills_def = hills();
+  const HeightField hills_field = HeightField::create(hills_def).value();
+  const HeightField* field = terrain ? &hills_field : nullptr;
+  if (terrain) cast_count = 0;
   std::mt19937_64 rng(2026);
-  const Scene scene = make_scene(box_count, &rng);
+  const Scene scene = make_scene(box_count, &rng, field);
   const std::vector<RayCast> rays = make_rays(ray_count, &rng);
 
   World world;
   BodyDef ground;
   ground.shape = HalfSpaceDef{};
+  if (terrain) ground.shape = hills_def;
   ground.type = BodyType::kStatic;
   world.create_body(ground).value();
   for (std::size_t i = 0; i < scene.half.size(); ++i) {
@@ -102,7 +131,8 @@ int main(int argc, char** argv) {
     world.create_body(def).value();
   }
   std::vector<RayHit> hits(rays.size());
-  std::printf("%d boxes on a plane, %d rays\n", box_count, ray_count);
+  std::printf("%d boxes on %s, %d rays\n", box_count,
+              terrain ? "hills of 100,352 triangles" : "a plane", ray_count);
   {
     // The query tree is built by the first query after a change: one ray times it.
     std::vector<double> builds;
@@ -139,6 +169,23 @@ int main(int argc, char** argv) {
   auto brute_force = [&](const RayCast& ray) {
     const Vec3 d = ray.direction.normalized();
     double best = ray.origin.z() > 0 && d.z() < 0 ? -ray.origin.z() / d.z() : INFINITY;
+    if (terrain) {
+      // Every triangle's upper side, by its plane and the three edges' sides.
+      best = INFINITY;
+      for (std::size_t t = 0; t < field->triangle_count(); ++t) {
+        const std::array<Vec3, 3> v = field->triangle(t);
+        const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
+        const double along = n.dot(d);
+        if (along >= 0) continue;
+        const double s = n.dot(v[0] - ray.origin) / along;
+        if (s < 0 || s >= best) continue;
+        const Vec3 p = ray.origin + s * d;
+        bool inside = true;
+        for (int e = 0; e < 3 && inside; ++e)
+          inside = (v[(e + 1) % 3] - v[e]).cross(p - v[e]).dot(n) >= -1e-12 * n.squaredNorm();
+        if (inside) best = s;
+      }
+    }
     if (best > ray.max_distance) best = INFINITY;
     for (std::size_t b = 0; b < scene.half.size(); ++b) {
       const Quat inverse = scene.pose[b].orientation.conjugate();
@@ -161,18 +208,20 @@ int main(int argc, char** argv) {
   std::printf("  brute force, %d rays: %d disagreements (closest hit within 1e-9 m), worst %.3g m\n",
               sample, disagreements, worst);
 
-  // Sphere casts: a ball of 0.3 m along the rays (their full length).
+  // Sphere casts: a ball of 0.3 m along the rays (their full length); none over terrain.
   constexpr double kBall = 0.3;
   cast_count = std::min(cast_count, ray_count);
   std::vector<ShapeCast> casts(cast_count);
+  std::vector<ShapeHit> cast_hits(cast_count);
   for (int i = 0; i < cast_count; ++i) {
     casts[i].shape = SphereDef{kBall};
     casts[i].pose.position = rays[i].origin;
     casts[i].translation = rays[i].max_distance * rays[i].direction.normalized();
   }
-  std::vector<ShapeHit> cast_hits(casts.size());
-  std::printf("%d sphere casts (a ball of %.1f m along the first rays)\n", cast_count, kBall);
+  if (!terrain)
+    std::printf("%d sphere casts (a ball of %.1f m along the first rays)\n", cast_count, kBall);
   for (int threads : {1, 2}) {
+    if (terrain) break;
     WorldSettings settings = world.settings();
     settings.threads = threads;
     (void)world.set_settings(settings);
@@ -186,8 +235,9 @@ int main(int argc, char** argv) {
     cast_hit_count += hit.hit();
     unconverged += hit.hit() && !hit.converged;
   }
-  std::printf("  %d of %d casts hit something, %d stopped at the iteration bound\n",
-              cast_hit_count, cast_count, unconverged);
+  if (!terrain)
+    std::printf("  %d of %d casts hit something, %d stopped at the iteration bound\n",
+                cast_hit_count, cast_count, unconverged);
   // The reference: the exact distance from a point to a turned box, and for each box the swept
   // centre's first fall within the ball's radius (the distance is convex along the path: its
   // minimum by golden-section search, then the first crossing by bisection, to 1e-12 of the path).
@@ -256,10 +306,12 @@ int main(int argc, char** argv) {
         hit.fraction > reference + 1e-12 || !hit.converged)
       ++cast_wrong;
   }
-  std::printf("  reference, %d casts: %d wrong (a miss that hits, a hit beyond the first contact "
-              "or not within %.0e m of a body); the gap at the answers at most %.2g m, the answers "
-              "at most %.2g m before the first contact along the path\n",
-              cast_sample, cast_wrong, kShapeCastTolerance, worst_gap, worst_early);
+  if (!terrain)
+    std::printf(
+        "  reference, %d casts: %d wrong (a miss that hits, a hit beyond the first contact "
+        "or not within %.0e m of a body); the gap at the answers at most %.2g m, the answers "
+        "at most %.2g m before the first contact along the path\n",
+        cast_sample, cast_wrong, kShapeCastTolerance, worst_gap, worst_early);
   disagreements += cast_wrong;
 
 #ifdef TUMBLE_HAVE_BULLET
@@ -280,7 +332,17 @@ int main(int argc, char** argv) {
     bullet.addCollisionObject(object.get());
     objects.push_back(std::move(object));
   };
-  add(&plane, Pose{});
+  // Bullet's heightfield is centred on its bounds, the up axis included; its quads split along
+  // (x, y)-(x + 1, y + 1), as ours, with flipQuadEdges.
+  btHeightfieldTerrainShape bullet_hills(
+      static_cast<int>(hills_def.samples_x), static_cast<int>(hills_def.samples_y),
+      hills_def.heights.data(), hills_field.min_height(), hills_field.max_height(), 2, true);
+  bullet_hills.setLocalScaling(btVector3(hills_def.spacing_x, hills_def.spacing_y, 1));
+  if (terrain)
+    add(&bullet_hills, Pose{Vec3(0, 0, 0.5 * (hills_field.min_height() + hills_field.max_height())),
+                            Quat::Identity()});
+  else
+    add(&plane, Pose{});
   for (std::size_t b = 0; b < scene.half.size(); ++b) {
     const Vec3& h = scene.half[b];
     shapes.push_back(std::make_unique<btBoxShape>(btVector3(h.x(), h.y(), h.z())));
@@ -322,6 +384,7 @@ int main(int argc, char** argv) {
               gaps.empty() ? 0.0 : gaps[gaps.size() * 99 / 100], gaps.empty() ? 0.0 : gaps.back());
   std::printf("  of the first %d rays where they differ, the brute force sides with Bullet on %d\n",
               std::min(differ, 200), tumble_wrong);
+  if (terrain) return disagreements == 0 ? 0 : 1;
   btSphereShape ball(kBall);
   std::vector<double> bullet_fraction(casts.size());
   const double bullet_cast_rate = rays_per_second(casts.size(), [&] {

@@ -3,9 +3,11 @@
 //   tumble --server 127.0.0.1:50051 spawn box --size 1,1,1 --mass 2 --pos 0,0,5
 //   tumble stream --format jsonl --frames 100
 // `tumble COMMAND --help` describes each command.
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -56,6 +58,9 @@ struct SpawnOptions {
   std::uint32_t colour = 0;
   bool is_static = false;
   bool is_kinematic = false;
+  std::string heights_file;  // heightfield: rows of heights (read by read_heights)
+  std::vector<double> spacing{1, 1};
+  v1::HeightField height_field;
   std::optional<double> gravity_scale, linear_damping, angular_damping;
   std::vector<double> force, torque;
   std::optional<std::uint32_t> layers, mask;
@@ -66,6 +71,11 @@ struct SpawnOptions {
       set_vec(size, spec.mutable_shape()->mutable_box()->mutable_size());
     } else if (shape == "sphere") {
       spec.mutable_shape()->mutable_sphere()->set_radius(radius);
+    } else if (shape == "heightfield") {
+      *spec.mutable_shape()->mutable_heightfield() = height_field;
+      spec.mutable_shape()->mutable_heightfield()->set_spacing_x(spacing[0]);
+      spec.mutable_shape()->mutable_heightfield()->set_spacing_y(spacing[1]);
+      spec.set_type(v1::BODY_TYPE_STATIC);
     } else {
       spec.mutable_shape()->mutable_capsule()->set_radius(radius);
       spec.mutable_shape()->mutable_capsule()->set_half_height(half_height);
@@ -88,11 +98,66 @@ struct SpawnOptions {
   }
 };
 
-// The shape's options spawn and overlap share.
-void add_shape_options(CLI::App* command, SpawnOptions* options) {
-  command->add_option("shape", options->shape, "box, sphere or capsule")
+// The most samples a heightfield may have (the engine's kMaxHeightFieldSamples: the server refuses
+// more); reading stops there, so a huge file is not read whole.
+constexpr int kMaxHeightSamples = 1 << 22;
+
+// A heightfield's heights from a text file: one row of samples along x per line, the rows along
+// y from the lowest y up, numbers parted by spaces or commas; blank lines and lines starting with
+// '#' skipped. The message names the file and the line.
+Status read_heights(const std::string& path, v1::HeightField* out) {
+  std::ifstream file(path);
+  if (!file) return Status::error(path + ": cannot open");
+  std::string line;
+  int number = 0;
+  while (std::getline(file, line)) {
+    ++number;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    std::istringstream words(line);
+    std::string word;
+    std::uint32_t count = 0;
+    while (words >> word) {
+      char* end = nullptr;
+      const double value = std::strtod(word.c_str(), &end);
+      if (end == word.c_str() || *end != '\0')
+        return Status::error(path + ":" + std::to_string(number) + ": '" + word +
+                             "' is not a number");
+      out->add_heights(value);
+      ++count;
+      if (out->heights_size() > kMaxHeightSamples)
+        return Status::error(path + ": more than the " + std::to_string(kMaxHeightSamples) +
+                             " samples a heightfield may have");
+    }
+    if (out->samples_y() == 0) out->set_samples_x(count);
+    if (count != out->samples_x())
+      return Status::error(path + ":" + std::to_string(number) + ": " + std::to_string(count) +
+                           " heights, the first row has " + std::to_string(out->samples_x()));
+    out->set_samples_y(out->samples_y() + 1);
+  }
+  return Status::ok();
+}
+
+// The shape's options spawn and overlap share; spawn also takes terrain.
+void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = false) {
+  const std::vector<std::string> shapes =
+      terrain ? std::vector<std::string>{"box", "sphere", "capsule", "heightfield"}
+              : std::vector<std::string>{"box", "sphere", "capsule"};
+  command
+      ->add_option("shape", options->shape,
+                   terrain ? "box, sphere, capsule or heightfield" : "box, sphere or capsule")
       ->required()
-      ->check(CLI::IsMember({"box", "sphere", "capsule"}));
+      ->check(CLI::IsMember(shapes));
+  if (terrain) {
+    command
+        ->add_option("--heights", options->heights_file,
+                     "heightfield: a text file of heights (m), one row along x a line, rows "
+                     "from the lowest y up")
+        ->check(cli::existing_file);
+    command->add_option("--spacing", options->spacing, "heightfield: x,y between samples (m)")
+        ->delimiter(',')
+        ->expected(2);
+  }
   command->add_option("--size", options->size, "box: full extents x,y,z (m)")
       ->delimiter(',')
       ->expected(3);
@@ -221,7 +286,7 @@ int main(int argc, char** argv) {
 
   CLI::App* spawn = app.add_subcommand("spawn", "add one body; prints its id");
   SpawnOptions body;
-  add_shape_options(spawn, &body);
+  add_shape_options(spawn, &body, true);
   spawn->add_option("--mass", body.mass, "kg (default: from a density of 1000 kg/m^3)");
   spawn->add_option("--position,--pos", body.position, "x,y,z (m)")->delimiter(',')->expected(3);
   spawn->add_option("--linear-velocity,--vel", body.velocity, "x,y,z (m/s)")
@@ -503,6 +568,12 @@ int main(int argc, char** argv) {
     print_line(serving.value() ? "SERVING" : "NOT_SERVING");
     return serving.value() ? 0 : 1;
   } else if (*spawn) {
+    if (body.shape == "heightfield") {
+      if (body.heights_file.empty())
+        return fail("spawn", Status::error("--heights: required for a heightfield"));
+      if (Status s = read_heights(body.heights_file, &body.height_field); !s)
+        return fail("spawn", s);
+    }
     Result<std::vector<std::uint64_t>> made = client.spawn({body.spec()});
     if (!made) return fail("spawn", made.status());
     print_line(std::to_string(made.value()[0]));

@@ -200,7 +200,8 @@ TEST(HeightField, RaysMeetTheNearestTriangleAsBruteForceDoes) {
   int hits = 0;
   for (int k = 0; k < 2000; ++k) {
     const Vec3 origin(5 * unit(random), 4 * unit(random), 2 + unit(random));
-    const Vec3 direction = Vec3(unit(random), unit(random), -1 - std::abs(unit(random))).normalized();
+    const Vec3 direction =
+        Vec3(unit(random), unit(random), -1 - std::abs(unit(random))).normalized();
     RayCast ray;
     ray.origin = origin + at;
     ray.direction = direction;
@@ -262,13 +263,16 @@ void drop_pile(bool boxes_only) {
   }
 }
 
-TEST(HeightField, PileOfMixedShapesStaysAboveIt) { drop_pile(false); }
-TEST(HeightField, PileOfBoxesComesToRestOnIt) { drop_pile(true); }
+TEST(HeightField, PileOfMixedShapesStaysAboveIt) {
+  drop_pile(false);
+}
+TEST(HeightField, PileOfBoxesComesToRestOnIt) {
+  drop_pile(true);
+}
 
 TEST(HeightField, SnapshotsStepBitForBit) {
-  const HeightFieldDef def = field_of(17, 13, 0.6, [](double x, double y) {
-    return 0.2 * std::sin(x) * std::cos(y);
-  });
+  const HeightFieldDef def =
+      field_of(17, 13, 0.6, [](double x, double y) { return 0.2 * std::sin(x) * std::cos(y); });
   World world;
   add_static(&world, def, Vec3(0.5, 0, -0.2));
   for (int k = 0; k < 12; ++k)

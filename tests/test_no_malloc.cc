@@ -107,6 +107,14 @@ TEST(NoMalloc, TwoThreadStepsOfALandedPileCallNoAllocator) {
   EXPECT_EQ(allocations_in_steps(pile, 20, 2, 150), 0);
 }
 
+// Terrain: the pairs with a heightfield keep each thread's contact room (its manifolds' points)
+// and their extra manifolds' slots from step to step.
+TEST(NoMalloc, StepsOnTerrainCallNoAllocator) {
+  SceneDef pile = terrain_pile_scene(64);
+  pile.world.solver.sleeping = false;
+  EXPECT_EQ(allocations_in_steps(pile, 20, 1, 200), 0);
+}
+
 // Jointed islands: the direct solve of a double pendulum and of an arm on its motors (auto),
 // ragdolls in a pile on the ground (auto: the tree with soft contacts), and a ragdoll whose
 // contacts, limits and cones are one LCP (exact, exact_joints.h; Lemke's pivots allocated until

@@ -261,6 +261,32 @@ TEST(ServerProcess, CliCastsAShape) {
   EXPECT_NE(refused.text.find("shape_casts[0].shape.sphere.radius"), std::string::npos) << refused.text;
 }
 
+// Terrain from a text file of heights: spawned static, seen by a ray down onto it; a ragged file is
+// refused naming its line.
+TEST(ServerProcess, CliSpawnsAHeightfieldFromAFile) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  TempDir dir;
+  // Three rows along x of four samples: a slope rising 0.5 m per 1 m sample along y.
+  std::ofstream(dir / "hills.txt") << "# y = -1\n0 0 0 0\n0.5, 0.5, 0.5, 0.5\n1 1 1 1\n";
+  const Output spawned = run(tumble + "spawn heightfield --heights " + (dir / "hills.txt") +
+                             " --spacing 1,1 --pos 100,0,0");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  const std::string field = spawned.text.substr(0, spawned.text.find('\n'));
+  const Output bodies = run(tumble + "bodies " + field);
+  ASSERT_EQ(bodies.code, 0) << bodies.text;
+  EXPECT_NE(bodies.text.find("\"static\":true"), std::string::npos) << bodies.text;
+  const Output hit = run(tumble + "ray --from 100.2,0.5,5 --dir 0,0,-1");
+  ASSERT_EQ(hit.code, 0) << hit.text;
+  EXPECT_NE(hit.text.find(field), std::string::npos) << hit.text;
+  std::ofstream(dir / "ragged.txt") << "0 0 0\n0 0\n";
+  const Output refused = run(tumble + "spawn heightfield --heights " + (dir / "ragged.txt"));
+  EXPECT_NE(refused.code, 0);
+  EXPECT_NE(refused.text.find("ragged.txt:2: 2 heights, the first row has 3"), std::string::npos)
+      << refused.text;
+}
+
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--max-message-mb", "1"}));

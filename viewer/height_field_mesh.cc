@@ -43,8 +43,7 @@ Mesh height_field_mesh(std::uint32_t samples_x, std::uint32_t samples_y, double 
   const auto columns = static_cast<std::uint32_t>(xs.size());
   for (std::uint32_t b = 0; b + 1 < ys.size(); ++b)
     for (std::uint32_t a = 0; a + 1 < columns; ++a) {
-      const std::uint32_t v00 = b * columns + a, v10 = v00 + 1, v01 = v00 + columns,
-                          v11 = v01 + 1;
+      const std::uint32_t v00 = b * columns + a, v10 = v00 + 1, v01 = v00 + columns, v11 = v01 + 1;
       // Split along (i, j)-(i + 1, j + 1), as the engine's cells are.
       for (std::uint32_t v : {v00, v10, v11, v00, v11, v01})
         mesh.indices.push_back(v);

@@ -161,14 +161,14 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
         auto mesh = height_field_meshes_.find(id);
         if (mesh == height_field_meshes_.end()) {
           const v1::HeightField& f = shape.heightfield();
-          mesh = height_field_meshes_
-                     .emplace(id, renderer.add_mesh(height_field_mesh(
-                                      f.samples_x(), f.samples_y(), f.spacing_x(),
-                                      f.spacing_y(),
-                                      std::span<const double>(
-                                          f.heights().data(),
-                                          static_cast<std::size_t>(f.heights_size())))))
-                     .first;
+          mesh =
+              height_field_meshes_
+                  .emplace(
+                      id, renderer.add_mesh(height_field_mesh(
+                              f.samples_x(), f.samples_y(), f.spacing_x(), f.spacing_y(),
+                              std::span<const double>(f.heights().data(),
+                                                      static_cast<std::size_t>(f.heights_size())))))
+                  .first;
         }
         instance.model = model.matrix();
         add(mesh->second, instance);

@@ -290,9 +290,10 @@ std::uint32_t collide_terrain(const Shape& a, const Pose& pose_a, const Shape& b
   const Pose& terrain_pose = b_is_terrain ? pose_b : pose_a;
   const Mat3 terrain_rotation = terrain_pose.orientation.toRotationMatrix();
   const Mat3 rotation = terrain_rotation.transpose() * body_pose.orientation.toRotationMatrix();
-  const Vec3 translation = terrain_rotation.transpose() * (body_pose.position - terrain_pose.position);
-  const std::uint32_t flags = collide_height_field(body, rotation, translation,
-                                                   *terrain.height_field(), settings, out);
+  const Vec3 translation =
+      terrain_rotation.transpose() * (body_pose.position - terrain_pose.position);
+  const std::uint32_t flags =
+      collide_height_field(body, rotation, translation, *terrain.height_field(), settings, out);
   for (int c = 0; c < out->count; ++c) {
     ContactManifold& m = out->manifolds[c];
     manifold_to_world(terrain_rotation, terrain_pose.position, &m);

@@ -235,9 +235,8 @@ double compute_outer_radius(ShapeType type, double radius, double half_height,
 
 void Shape::update_radii() {
   inner_radius_ = compute_inner_radius(type_, radius_, half_extents_, polyhedron_.get());
-  outer_radius_ =
-      compute_outer_radius(type_, radius_, half_height_, half_extents_, polyhedron_.get(),
-                           height_field_.get());
+  outer_radius_ = compute_outer_radius(type_, radius_, half_height_, half_extents_,
+                                       polyhedron_.get(), height_field_.get());
 }
 
 Vec3 Shape::support(const Vec3& d) const {
@@ -283,7 +282,8 @@ ShapeState Shape::state() const {
   ShapeState state{type_, radius_, half_height_, half_extents_, nullptr, nullptr};
   if (type_ == ShapeType::kHull) state.polyhedron = polyhedron_;
   if (type_ == ShapeType::kHeightField)  // the definition, owned with the field
-    state.height_field = std::shared_ptr<const HeightFieldDef>(height_field_, &height_field_->def());
+    state.height_field =
+        std::shared_ptr<const HeightFieldDef>(height_field_, &height_field_->def());
   return state;
 }
 

@@ -220,8 +220,8 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     // (A record of a body removed since is never matched: nothing to check of it.)
     const BodySlotState& a = state.slots[r.a.index];
     const BodySlotState& b = state.slots[r.b.index];
-    const bool current = a.alive && b.alive && a.generation == r.a.generation &&
-                         b.generation == r.b.generation;
+    const bool current =
+        a.alive && b.alive && a.generation == r.a.generation && b.generation == r.b.generation;
     const bool terrain = !current || is_terrain_pair(a.body.shape, b.body.shape);
     const bool repeat_allowed = same && terrain && repeats < kMaxTerrainManifolds;
     if (!repeat_allowed &&

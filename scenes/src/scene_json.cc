@@ -141,8 +141,8 @@ HeightFieldDef read_height_field(ObjectReader& r) {
                                  std::to_string(expected) + " heights in m, x fastest");
   def.heights.reserve(expected);
   for (std::size_t i = 0; i < expected; ++i)
-    def.heights.push_back(
-        ObjectReader::read_number((*heights)[i], r.child("heights") + "[" + std::to_string(i) + "]"));
+    def.heights.push_back(ObjectReader::read_number(
+        (*heights)[i], r.child("heights") + "[" + std::to_string(i) + "]"));
   return def;
 }
 
@@ -204,7 +204,7 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   BodyDef def;
   def.shape = read_shape(r);
   const bool ground = std::holds_alternative<HalfSpaceDef>(def.shape) ||
-                     std::holds_alternative<HeightFieldDef>(def.shape);
+                      std::holds_alternative<HeightFieldDef>(def.shape);
   const bool is_static = r.boolean("static", ground);
   const bool kinematic = r.boolean("kinematic", false);
   if (is_static && kinematic) fail(r.child("kinematic"), "a body is static or kinematic, not both");

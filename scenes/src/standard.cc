@@ -484,8 +484,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   // Counted, ground included, before anything is built, so a request for a huge scene costs
   // nothing.
   if (name == "pile" || name == "terrain" || name == "pyramid" || name == "tower" ||
-      name == "chain" ||
-      name == "rope-bridge" || name == "ragdolls") {
+      name == "chain" || name == "rope-bridge" || name == "ragdolls") {
     const bool piled = name == "pile" || name == "terrain";
     const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(piled ? 1000 : 20));
     const std::uint64_t bodies = (name == "pyramid"    ? n * (n + 1) / 2
@@ -556,10 +555,11 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
     if (Status s = sized("default"); !s) return s;
     return parse_scene(default_scene_json());
   }
-  return Status::error("scene '" + shown(spec) +
-                       "': unknown; the standard scenes are pile, terrain, pyramid, tower, mass-ratio, "
-                       "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
-                       "chain, cradle, door, rope-bridge, arm, ragdolls, carousel, default");
+  return Status::error(
+      "scene '" + shown(spec) +
+      "': unknown; the standard scenes are pile, terrain, pyramid, tower, mass-ratio, "
+      "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
+      "chain, cradle, door, rope-bridge, arm, ragdolls, carousel, default");
 }
 
 }  // namespace

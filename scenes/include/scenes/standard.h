@@ -28,7 +28,7 @@ class SceneRandom {
 // Every scene has the conventions of SCENES.md: unit boxes of 1 kg, mu = 0.5, restitution 0,
 // dt = 1/60, gravity -9.81 z (none in bullet and spin), the ground a static plane z = 0.
 SceneDef pile_scene(int count = 1000);             // S1: a lattice of tilted boxes falling, 10 s
-SceneDef terrain_pile_scene(int count = 1000);     // the same pile onto rolling hills (a heightfield)
+SceneDef terrain_pile_scene(int count = 1000);  // the same pile onto rolling hills (a heightfield)
 SceneDef pyramid_scene(int base = 20);             // S2: base boxes at the bottom, 20 s
 SceneDef tower_scene(int height = 20);             // S3: 20 s
 SceneDef mass_ratio_scene(bool inverted = false);  // S4: 1, 1, 1000 kg bottom to top (inverted:
