@@ -270,6 +270,25 @@ TEST(HeightField, PileOfBoxesComesToRestOnIt) {
   drop_pile(true);
 }
 
+// A body over more cells than a pair may visit is met on the first kMaxTerrainCells of them, and
+// the narrow phase says so; a body over fewer is met whole and raises nothing.
+TEST(HeightField, AHugeBodyVisitsABoundedNumberOfCellsAndSaysSo) {
+  const Shape field =
+      Shape::create(field_of(401, 401, 0.5, [](double, double) { return 0.0; })).value();
+  const Shape huge = Shape::create(BoxDef{Vec3(90, 90, 1)}).value();
+  const Shape small = Shape::create(BoxDef{Vec3(1, 1, 1)}).value();
+  ContactManifold manifold;
+  const Pose ground;
+  const Pose resting{Vec3(0, 0, 0.999), Quat::Identity()};
+  EXPECT_NE(collide(huge, resting, field, ground, CollisionSettings{}, &manifold) &
+                kTerrainCellLimit,
+            0u);
+  EXPECT_GT(manifold.count, 0);  // the cells it did visit still hold it
+  EXPECT_EQ(collide(small, resting, field, ground, CollisionSettings{}, &manifold), 0u);
+  EXPECT_EQ(manifold.count, 4);
+  EXPECT_NEAR(manifold.depth, 0.001, 1e-12);
+}
+
 TEST(HeightField, SnapshotsStepBitForBit) {
   const HeightFieldDef def =
       field_of(17, 13, 0.6, [](double x, double y) { return 0.2 * std::sin(x) * std::cos(y); });
