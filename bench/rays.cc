@@ -11,8 +11,10 @@
 // With --terrain 1 the ground is a heightfield of 100,352 triangles (225 x 225 samples over the
 // same 200 m, rolling hills up to about 1.1 m) under the boxes, beside Bullet's
 // btHeightfieldTerrainShape (its quads split along the same diagonal); the brute force then meets
-// every triangle too, and the sphere casts are left out.
-// Usage: bench_rays [--rays N] [--boxes N] [--casts N] [--terrain 0|1]
+// every triangle too, and the sphere casts are left out. With --terrain 2 the same triangles are a
+// triangle mesh (ours, its bounding-volume tree) beside Bullet's btBvhTriangleMeshShape (its
+// quantized tree), rays meeting the triangles' fronts only in both.
+// Usage: bench_rays [--rays N] [--boxes N] [--casts N] [--terrain 0|1|2]
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -21,6 +23,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -29,7 +32,10 @@
 
 #ifdef TUMBLE_HAVE_BULLET
 #include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
 #include <btBulletCollisionCommon.h>
+
+#include "bullet_triangles.h"
 #endif
 
 using namespace tumble;
@@ -101,13 +107,19 @@ double rays_per_second(std::size_t rays, Run&& run) {
 
 int main(int argc, char** argv) {
   int ray_count = 100000, box_count = 10000, cast_count = 10000;
-  bool terrain = false;
+  int terrain_kind = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rays")) ray_count = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--boxes")) box_count = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--casts")) cast_count = std::atoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--terrain")) terrain = std::atoi(argv[i + 1]) != 0;
+    if (!std::strcmp(argv[i], "--terrain")) terrain_kind = std::atoi(argv[i + 1]);
   }
+  if (terrain_kind < 0 || terrain_kind > 2) {
+    std::fprintf(stderr,
+                 "bench_rays: --terrain must be 0 (a plane), 1 (a heightfield) or 2 (a mesh)\n");
+    return 2;
+  }
+  const bool terrain = terrain_kind != 0, mesh = terrain_kind == 2;
   const HeightFieldDef hills_def = hills();
   const HeightField hills_field = HeightField::create(hills_def).value();
   const HeightField* field = terrain ? &hills_field : nullptr;
@@ -120,6 +132,7 @@ int main(int argc, char** argv) {
   BodyDef ground;
   ground.shape = HalfSpaceDef{};
   if (terrain) ground.shape = hills_def;
+  if (mesh) ground.shape = mesh_of_height_field(hills_field);
   ground.type = BodyType::kStatic;
   world.create_body(ground).value();
   for (std::size_t i = 0; i < scene.half.size(); ++i) {
@@ -132,7 +145,10 @@ int main(int argc, char** argv) {
   }
   std::vector<RayHit> hits(rays.size());
   std::printf("%d boxes on %s, %d rays\n", box_count,
-              terrain ? "hills of 100,352 triangles" : "a plane", ray_count);
+              mesh      ? "hills of 100,352 triangles as a mesh"
+              : terrain ? "hills of 100,352 triangles as a heightfield"
+                        : "a plane",
+              ray_count);
   {
     // The query tree is built by the first query after a change: one ray times it.
     std::vector<double> builds;
@@ -338,7 +354,13 @@ int main(int argc, char** argv) {
       static_cast<int>(hills_def.samples_x), static_cast<int>(hills_def.samples_y),
       hills_def.heights.data(), hills_field.min_height(), hills_field.max_height(), 2, true);
   bullet_hills.setLocalScaling(btVector3(hills_def.spacing_x, hills_def.spacing_y, 1));
-  if (terrain)
+  // The mesh: the same vertices and triangles (Bullet's mesh interface in single precision).
+  const BulletTriangles mesh_arrays(mesh_of_height_field(hills_field));
+  std::unique_ptr<btBvhTriangleMeshShape> bullet_mesh;
+  if (mesh) {
+    bullet_mesh = std::make_unique<btBvhTriangleMeshShape>(mesh_arrays.arrays.get(), true);
+    add(bullet_mesh.get(), Pose{});
+  } else if (terrain)
     add(&bullet_hills, Pose{Vec3(0, 0, 0.5 * (hills_field.min_height() + hills_field.max_height())),
                             Quat::Identity()});
   else
@@ -357,6 +379,7 @@ int main(int argc, char** argv) {
       const Vec3 to = from + rays[i].max_distance * rays[i].direction.normalized();
       const btVector3 a(from.x(), from.y(), from.z()), b(to.x(), to.y(), to.z());
       btCollisionWorld::ClosestRayResultCallback closest(a, b);
+      closest.m_flags |= btTriangleRaycastCallback::kF_FilterBackfaces;
       bullet.rayTest(a, b, closest);
       bullet_distance[i] =
           closest.hasHit() ? closest.m_closestHitFraction * rays[i].max_distance : INFINITY;

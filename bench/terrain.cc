@@ -1,6 +1,7 @@
-// The standard pile dropped on rolling hills (a heightfield: the standard scene terrain:N) beside
-// the same pile on the plane (pile:N): the whole 10 s run of each, alternated round by round, its
-// median time per step and the ratio; and whether the pile came through the ground, sampled every
+// The standard pile dropped on rolling hills, as a heightfield (the standard scene terrain:N) and
+// as a triangle mesh of the same triangles (terrain-mesh:N), beside the same pile on the plane
+// (pile:N): the whole 10 s run of each, alternated round by round, its median time per step and
+// the ratios; and whether the pile came through the ground, sampled every
 // tenth step: the boxes whose centre was ever under the surface (through it), those with a vertex
 // ever more than 1 cm under it (dipped), and the deepest any vertex went.
 //
@@ -39,14 +40,15 @@ struct Run {
   std::size_t points = 0;  // contact points in the last step
 };
 
-// How far below the ground (the plane z = 0, or the heightfield at its pose) a point lies.
+// How far below the ground (the plane z = 0, or the hills at the ground's pose) a point lies.
 double under(const HeightField* field, const Pose& pose, const Vec3& p) {
   if (field == nullptr) return -p.z();
   const Vec3 local = pose.inverse_transform(p);
   return field->height_at(local.x(), local.y()) - local.z();
 }
 
-Run run(const std::string& name, int threads) {
+// hills: the hills' surface (the mesh's triangles are the heightfield's).
+Run run(const std::string& name, int threads, const HeightField& hills) {
   SceneDef scene = standard_scene(name).value();
   scene.world.threads = threads;
   World world = make_world(scene).value();
@@ -61,7 +63,7 @@ Run run(const std::string& name, int threads) {
     else
       ids.push_back(id);
   }
-  const bool terrain = world.body(ground_id).shape().type() == ShapeType::kHeightField;
+  const bool terrain = is_terrain(world.body(ground_id).shape().type());
   std::vector<std::uint8_t> through(ids.size(), 0), dipped(ids.size(), 0);
   Run out;
   double seconds = 0;
@@ -71,7 +73,7 @@ Run run(const std::string& name, int threads) {
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (step % 10 != 9) continue;  // sampled, untimed
     const BodyView ground = world.body(ground_id);
-    const HeightField* field = terrain ? ground.shape().height_field() : nullptr;
+    const HeightField* field = terrain ? &hills : nullptr;
     const Pose pose{ground.position(), ground.orientation()};
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const BodyView body = world.body(ids[k]);
@@ -108,23 +110,31 @@ int main(int argc, char** argv) {
   const int rounds = argument(argc, argv, 2, 3, 1, 100);
   const int threads = argument(argc, argv, 3, 1, 1, 256);
   const std::string plane = "pile:" + std::to_string(boxes);
-  const std::string hills = "terrain:" + std::to_string(boxes);
+  const std::string field = "terrain:" + std::to_string(boxes);
+  const std::string mesh = "terrain-mesh:" + std::to_string(boxes);
+  const HeightField hills =
+      HeightField::create(std::get<HeightFieldDef>(terrain_pile_scene(boxes).bodies[0].shape))
+          .value();
   std::printf(
-      "%d boxes dropped on the plane and on rolling hills (0.5 m cells), 10 s at 60 Hz, "
-      "%d thread(s)\n",
+      "%d boxes dropped on the plane and on rolling hills (0.5 m cells; a heightfield, then the "
+      "same triangles as a mesh), 10 s at 60 Hz, %d thread(s)\n",
       boxes, threads);
   std::printf(
-      "round  scene          ms/step  through  dipped  deepest(m)  fastest(m/s)  points\n");
-  std::vector<double> on_plane, on_hills;
+      "round  scene               ms/step  through  dipped  deepest(m)  fastest(m/s)  points\n");
+  std::vector<double> times[3];
+  const std::string names[3] = {plane, field, mesh};
   for (int round = 0; round < rounds; ++round) {
-    for (const std::string& name : {plane, hills}) {
-      const Run r = run(name, threads);
-      (name == plane ? on_plane : on_hills).push_back(r.ms_per_step);
-      std::printf("%5d  %-13s %8.3f  %7d  %6d  %10.4f  %12.4f  %6zu\n", round, name.c_str(),
+    for (int k = 0; k < 3; ++k) {
+      const Run r = run(names[k], threads, hills);
+      times[k].push_back(r.ms_per_step);
+      std::printf("%5d  %-18s %8.3f  %7d  %6d  %10.4f  %12.4f  %6zu\n", round, names[k].c_str(),
                   r.ms_per_step, r.through, r.dipped, r.deepest, r.fastest, r.points);
     }
   }
-  const double a = median(on_plane), b = median(on_hills);
-  std::printf("median ms/step: plane %.3f, hills %.3f, hills / plane %.2f\n", a, b, b / a);
+  const double a = median(times[0]), b = median(times[1]), c = median(times[2]);
+  std::printf(
+      "median ms/step: plane %.3f, heightfield %.3f, mesh %.3f; heightfield / plane %.2f, "
+      "mesh / plane %.2f\n",
+      a, b, c, b / a, c / a);
   return 0;
 }

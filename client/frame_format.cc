@@ -33,6 +33,13 @@ Json shape_json(const v1::Shape& shape) {
                 {"spacing", {f.spacing_x(), f.spacing_y()}},
                 {"heights", slice(f.heights(), 0, f.heights_size())}}}};
     }
+    case v1::Shape::kMesh: {
+      const v1::Mesh& m = shape.mesh();
+      return {{"mesh",
+               {{"vertices", slice(m.vertices(), 0, m.vertices_size())},
+                {"triangles",
+                 Json(std::vector<std::uint32_t>(m.triangles().begin(), m.triangles().end()))}}}};
+    }
     default:
       return {{"plane", true}};
   }

@@ -19,6 +19,7 @@
 #include "client.h"
 #include "frame_format.h"
 #include "recording.h"
+#include "scenes/mesh_file_reader.h"
 #include "tumble/command_line.h"
 
 using namespace tumble;
@@ -61,6 +62,9 @@ struct SpawnOptions {
   std::string heights_file;  // heightfield: rows of heights (read by read_heights)
   std::vector<double> spacing{1, 1};
   v1::HeightField height_field;
+  std::string mesh_file;  // mesh: an OBJ, STL, PLY, ... file (read by read_mesh_file)
+  double mesh_scale = 1;
+  v1::Mesh mesh;
   std::optional<double> gravity_scale, linear_damping, angular_damping;
   std::vector<double> force, torque;
   std::optional<std::uint32_t> layers, mask;
@@ -75,6 +79,9 @@ struct SpawnOptions {
       *spec.mutable_shape()->mutable_heightfield() = height_field;
       spec.mutable_shape()->mutable_heightfield()->set_spacing_x(spacing[0]);
       spec.mutable_shape()->mutable_heightfield()->set_spacing_y(spacing[1]);
+      spec.set_type(v1::BODY_TYPE_STATIC);
+    } else if (shape == "mesh") {
+      *spec.mutable_shape()->mutable_mesh() = mesh;
       spec.set_type(v1::BODY_TYPE_STATIC);
     } else {
       spec.mutable_shape()->mutable_capsule()->set_radius(radius);
@@ -101,6 +108,10 @@ struct SpawnOptions {
 // The most samples a heightfield may have (the engine's kMaxHeightFieldSamples: the server refuses
 // more); reading stops there, so a huge file is not read whole.
 constexpr int kMaxHeightSamples = 1 << 22;
+// The most vertices and triangles a mesh may have (the engine's kMaxMeshVertices and
+// kMaxMeshTriangles: the server refuses more).
+constexpr std::size_t kMaxMeshVertices = std::size_t{1} << 21;
+constexpr std::size_t kMaxMeshTriangles = std::size_t{1} << 21;
 
 // A heightfield's heights from a text file: one row of samples along x per line, the rows along
 // y from the lowest y up, numbers parted by spaces or commas; blank lines and lines starting with
@@ -141,11 +152,11 @@ Status read_heights(const std::string& path, v1::HeightField* out) {
 // The shape's options spawn and overlap share; spawn also takes terrain.
 void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = false) {
   const std::vector<std::string> shapes =
-      terrain ? std::vector<std::string>{"box", "sphere", "capsule", "heightfield"}
+      terrain ? std::vector<std::string>{"box", "sphere", "capsule", "heightfield", "mesh"}
               : std::vector<std::string>{"box", "sphere", "capsule"};
   command
       ->add_option("shape", options->shape,
-                   terrain ? "box, sphere, capsule or heightfield" : "box, sphere or capsule")
+                   terrain ? "box, sphere, capsule, heightfield or mesh" : "box, sphere or capsule")
       ->required()
       ->check(CLI::IsMember(shapes));
   if (terrain) {
@@ -157,6 +168,13 @@ void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = 
     command->add_option("--spacing", options->spacing, "heightfield: x,y between samples (m)")
         ->delimiter(',')
         ->expected(2);
+    command
+        ->add_option("--file", options->mesh_file,
+                     "mesh: a mesh file (OBJ, STL, PLY and the others Assimp reads); its "
+                     "triangles face the side their corners run counter-clockwise from")
+        ->check(cli::existing_file);
+    command->add_option("--scale", options->mesh_scale,
+                        "mesh: multiplies every coordinate of the file (0.01 for cm)");
   }
   command->add_option("--size", options->size, "box: full extents x,y,z (m)")
       ->delimiter(',')
@@ -573,6 +591,19 @@ int main(int argc, char** argv) {
         return fail("spawn", Status::error("--heights: required for a heightfield"));
       if (Status s = read_heights(body.heights_file, &body.height_field); !s)
         return fail("spawn", s);
+    }
+    if (body.shape == "mesh") {
+      if (body.mesh_file.empty())
+        return fail("spawn", Status::error("--file: required for a mesh"));
+      // The server checks the mesh against its limits and names what is wrong; these bounds
+      // only stop a huge file from being copied into a request that would be refused.
+      mesh_files::Arrays mesh;
+      if (std::string error = mesh_files::read(body.mesh_file, body.mesh_scale, kMaxMeshVertices,
+                                               kMaxMeshTriangles, &mesh);
+          !error.empty())
+        return fail("spawn", Status::error(error));
+      body.mesh.mutable_vertices()->Assign(mesh.xyz.begin(), mesh.xyz.end());
+      body.mesh.mutable_triangles()->Assign(mesh.triangles.begin(), mesh.triangles.end());
     }
     Result<std::vector<std::uint64_t>> made = client.spawn({body.spec()});
     if (!made) return fail("spawn", made.status());

@@ -75,10 +75,27 @@ Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
         return built.status().within("shape.heightfield.");
       return ShapeDef{std::move(def)};
     }
+    case v1::Shape::kMesh: {
+      const v1::Mesh& mesh = shape.mesh();
+      if (mesh.vertices().size() % 3 != 0)
+        return Status::error("shape.mesh.vertices: must hold x, y, z triples");
+      if (mesh.triangles().size() % 3 != 0)
+        return Status::error("shape.mesh.triangles: must hold triples of vertex indices");
+      TriangleMeshDef def;
+      def.vertices.reserve(mesh.vertices().size() / 3);
+      for (int i = 0; i < mesh.vertices().size(); i += 3)
+        def.vertices.emplace_back(mesh.vertices(i), mesh.vertices(i + 1), mesh.vertices(i + 2));
+      def.triangles.reserve(mesh.triangles().size() / 3);
+      for (int i = 0; i < mesh.triangles().size(); i += 3)
+        def.triangles.push_back({mesh.triangles(i), mesh.triangles(i + 1), mesh.triangles(i + 2)});
+      if (Result<TriangleMesh> built = TriangleMesh::create(def); !built)
+        return built.status().within("shape.mesh.");
+      return ShapeDef{std::move(def)};
+    }
     case v1::Shape::KIND_NOT_SET:
       break;
   }
-  return Status::error("shape: required (box, sphere, capsule, hull, plane or heightfield)");
+  return Status::error("shape: required (box, sphere, capsule, hull, plane, heightfield or mesh)");
 }
 
 }  // namespace
@@ -109,6 +126,8 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
     return Status::error("type: a plane must be static");
   if (std::holds_alternative<HeightFieldDef>(def.shape) && def.type != BodyType::kStatic)
     return Status::error("type: a heightfield must be static");
+  if (std::holds_alternative<TriangleMeshDef>(def.shape) && def.type != BodyType::kStatic)
+    return Status::error("type: a mesh must be static");
   if (Status s = finite(spec.position(), "position"); !s) return s;
   if (Status s = finite(spec.linear_velocity(), "linear_velocity"); !s) return s;
   if (Status s = finite(spec.angular_velocity(), "angular_velocity"); !s) return s;
@@ -201,6 +220,19 @@ void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) 
       field->set_spacing_x(def.spacing_x);
       field->set_spacing_y(def.spacing_y);
       field->mutable_heights()->Assign(def.heights.begin(), def.heights.end());
+      break;
+    }
+    case ShapeType::kMesh: {
+      const TriangleMeshDef& def = s.mesh()->def();
+      v1::Mesh* mesh = shape->mutable_mesh();
+      mesh->mutable_vertices()->Reserve(static_cast<int>(3 * def.vertices.size()));
+      for (const Vec3& v : def.vertices)
+        for (int k = 0; k < 3; ++k)
+          mesh->add_vertices(v[k]);
+      mesh->mutable_triangles()->Reserve(static_cast<int>(3 * def.triangles.size()));
+      for (const auto& t : def.triangles)
+        for (std::uint32_t index : t)
+          mesh->add_triangles(index);
       break;
     }
   }

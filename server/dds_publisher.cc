@@ -405,6 +405,18 @@ void DdsPublisher::describe_for_ros2(const Catalogue& now) {
           }
         break;
       }
+      case ShapeType::kMesh: {
+        // Its triangles, the first kMaxMarkerTriangles of a larger mesh.
+        marker.type = kTriangleList;
+        marker.scale = {1, 1, 1};
+        const TriangleMesh& mesh = *shape.mesh();
+        const auto count =
+            std::min(mesh.triangle_count(), static_cast<std::size_t>(kMaxMarkerTriangles));
+        for (std::size_t t = 0; t < count; ++t)
+          for (const Vec3& p : mesh.triangle(t))
+            ros.triangles.push_back({p.x(), p.y(), p.z()});
+        break;
+      }
     }
   }
   // The points' buffers are final now (the map does not move its values).

@@ -172,7 +172,7 @@ class FuzzService {
   v1::BodySpec body(Hostile& h) {
     v1::BodySpec spec;
     v1::Shape* shape = spec.mutable_shape();
-    switch (h.integer(0, 7)) {
+    switch (h.integer(0, 8)) {
       case 0:
         set(h.vector(0.05, 2), shape->mutable_box()->mutable_size());
         break;
@@ -213,6 +213,24 @@ class FuzzService {
                       (h.chance(0.2) ? 1 : 0);
         for (int k = 0; k < n; ++k)
           field->add_heights(h.number(-0.5, 0.5));
+        break;
+      }
+      case 6: {
+        // A mesh: few or no vertices, indices in range or past it, repeated (degenerate), or
+        // not a whole triple.
+        v1::Mesh* mesh = shape->mutable_mesh();
+        const int counts[] = {0, 3, 4, 8, 20};
+        const int n = counts[h.integer(0, 4)];
+        for (int p = 0; p < n; ++p) {
+          const Vec3 v = h.chance(0.9) ? h.rng().vector(-2, 2) : h.vector(-2, 2);
+          for (int k = 0; k < 3; ++k)
+            mesh->add_vertices(v[k]);
+        }
+        const int triangles = h.integer(0, 12);
+        for (int t = 0; t < 3 * triangles; ++t)
+          mesh->add_triangles(
+              static_cast<std::uint32_t>(h.integer(0, n + (h.chance(0.05) ? 3 : 0))));
+        if (h.chance(0.1)) mesh->add_triangles(0);
         break;
       }
       default:

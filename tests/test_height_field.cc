@@ -11,46 +11,12 @@
 #include <vector>
 
 #include "physics/world.h"
+#include "terrain_support.h"
 
 namespace tumble {
 namespace {
 
-constexpr double kDt = 1.0 / 60;
-
-HeightFieldDef field_of(std::uint32_t nx, std::uint32_t ny, double spacing,
-                        const std::function<double(double, double)>& height) {
-  HeightFieldDef def;
-  def.samples_x = nx;
-  def.samples_y = ny;
-  def.spacing_x = def.spacing_y = spacing;
-  for (std::uint32_t j = 0; j < ny; ++j)
-    for (std::uint32_t i = 0; i < nx; ++i)
-      def.heights.push_back(height((i - 0.5 * (nx - 1)) * spacing, (j - 0.5 * (ny - 1)) * spacing));
-  return def;
-}
-
-BodyId add_static(World* world, const ShapeDef& shape, const Vec3& position = Vec3::Zero()) {
-  BodyDef def;
-  def.shape = shape;
-  def.type = BodyType::kStatic;
-  def.position = position;
-  return world->create_body(def).value();
-}
-
-BodyId add_dynamic(World* world, const ShapeDef& shape, const Vec3& position,
-                   const Vec3& velocity = Vec3::Zero()) {
-  BodyDef def;
-  def.shape = shape;
-  def.mass = 1;
-  def.position = position;
-  def.linear_velocity = velocity;
-  return world->create_body(def).value();
-}
-
-void run(World* world, int steps) {
-  for (int i = 0; i < steps; ++i)
-    ASSERT_TRUE(world->step(kDt).is_ok());
-}
+using namespace terrain_testing;
 
 std::string refusal(const HeightFieldDef& def) {
   const Result<Shape> shape = Shape::create(def);
@@ -112,14 +78,6 @@ TEST(HeightField, OnlyConvexAndBoundaryEdgesAreActive) {
 }
 
 // A unit box's lowest height at rest on `ground`, after two seconds.
-double rest_height(const ShapeDef& ground, const ShapeDef& body, const Vec3& at) {
-  World world;
-  add_static(&world, ground);
-  const BodyId id = add_dynamic(&world, body, at);
-  run(&world, 120);
-  return world.body(id)->position().z();
-}
-
 TEST(HeightField, BodiesRestOnFlatTerrainAsOnThePlane) {
   const HeightFieldDef floor = field_of(21, 21, 0.5, [](double, double) { return 0.0; });
   for (const ShapeDef& body : {ShapeDef{BoxDef{Vec3(0.3, 0.2, 0.1)}}, ShapeDef{SphereDef{0.2}},
@@ -168,25 +126,6 @@ TEST(HeightField, SphereRestsInAValleyAndOnARidge) {
   EXPECT_NEAR(rest_height(ridge, BoxDef{Vec3(0.2, 0.2, 0.1)}, Vec3(0.1, 0, 1)), 0.1, 1e-4);
 }
 
-// Brute force: every triangle, the nearest upper-side hit.
-double brute_force_ray(const HeightField& field, const Vec3& o, const Vec3& d, double max_t) {
-  double best = max_t + 1;
-  for (std::size_t t = 0; t < field.triangle_count(); ++t) {
-    const std::array<Vec3, 3> v = field.triangle(t);
-    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
-    const double along = n.dot(d);
-    if (along >= 0) continue;
-    const double s = n.dot(v[0] - o) / along;
-    if (s < 0 || s > max_t) continue;
-    const Vec3 p = o + s * d;
-    bool inside = true;
-    for (int e = 0; e < 3; ++e)
-      inside = inside && (v[(e + 1) % 3] - v[e]).cross(p - v[e]).dot(n) >= -1e-12 * n.squaredNorm();
-    if (inside) best = std::min(best, s);
-  }
-  return best;
-}
-
 TEST(HeightField, RaysMeetTheNearestTriangleAsBruteForceDoes) {
   std::mt19937 random(7);
   std::uniform_real_distribution<double> unit(-1, 1);
@@ -207,7 +146,9 @@ TEST(HeightField, RaysMeetTheNearestTriangleAsBruteForceDoes) {
     ray.direction = direction;
     ray.max_distance = 10;
     const RayHit hit = world.cast_ray(ray).value();
-    const double expected = brute_force_ray(field, origin, direction, 10);
+    const double expected = brute_force_ray(
+        field.triangle_count(), [&](std::size_t t) { return field.triangle(t); }, origin,
+        direction, 10);
     if (expected > 10) {
       // Misses the surface: it may still enter the solid through a side wall.
       if (hit.hit()) {

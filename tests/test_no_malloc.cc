@@ -107,12 +107,16 @@ TEST(NoMalloc, TwoThreadStepsOfALandedPileCallNoAllocator) {
   EXPECT_EQ(allocations_in_steps(pile, 20, 2, 150), 0);
 }
 
-// Terrain: the pairs with a heightfield keep each thread's contact room (its manifolds' points)
-// and their extra manifolds' slots from step to step.
+// Terrain, as a heightfield and as a mesh: the pairs keep each thread's contact room (its
+// manifolds' points, a mesh's triangles and faces found) and their extra manifolds' slots from
+// step to step.
 TEST(NoMalloc, StepsOnTerrainCallNoAllocator) {
   SceneDef pile = terrain_pile_scene(64);
   pile.world.solver.sleeping = false;
   EXPECT_EQ(allocations_in_steps(pile, 20, 1, 200), 0);
+  SceneDef on_mesh = terrain_mesh_pile_scene(64);
+  on_mesh.world.solver.sleeping = false;
+  EXPECT_EQ(allocations_in_steps(on_mesh, 20, 1, 200), 0);
 }
 
 // Jointed islands: the direct solve of a double pendulum and of an arm on its motors (auto),

@@ -2,10 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 
 #include "scene_runner.h"
+#include "scenes/mesh_file.h"
 
 namespace tumble::testing {
 namespace {
@@ -127,6 +129,94 @@ TEST(SceneJson, HeightFieldsAreReadCheckedAndWrittenBack) {
   EXPECT_EQ(error_of(R"({"bodies": [{"shape": "heightfield", "samples": [2, 2],
       "spacing": [1, 1], "heights": [0, 0, 0, 0], "static": false}]})"),
             "bodies[0].type: a heightfield must be static");
+}
+
+TEST(SceneJson, MeshesAreReadCheckedAndWrittenBack) {
+  const Result<SceneDef> scene = parse_scene(R"({"bodies": [
+      {"shape": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]],
+       "triangles": [[0, 1, 2], [0, 2, 3]], "position": [0, 0, -1]}]})");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  const auto& mesh = std::get<TriangleMeshDef>(scene.value().bodies[0].shape);
+  ASSERT_EQ(mesh.vertices.size(), 4u);
+  EXPECT_EQ(mesh.vertices[2], Vec3(1, 1, 0));
+  ASSERT_EQ(mesh.triangles.size(), 2u);
+  EXPECT_EQ(mesh.triangles[1][2], 3u);
+  EXPECT_EQ(scene.value().bodies[0].type, BodyType::kStatic);  // static unasked
+  EXPECT_EQ(scene_to_json(parse_scene(scene_to_json(scene.value())).value()),
+            scene_to_json(scene.value()));
+  EXPECT_TRUE(make_world(scene.value()).ok());
+
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "triangles": [[0, 1, 2]]}]})"),
+            "bodies[0].vertices: must be an array of points [x, y, z] in m (or give a \"file\")");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "vertices": [[0, 0, 0], [1, 0], [0, 1, 0]],
+      "triangles": [[0, 1, 2]]}]})"),
+            "bodies[0].vertices[1]: must be an array of 3 numbers");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]],
+      "triangles": [[0, 1, 3]]}]})"),
+            "bodies[0].triangles[0][2]: must be an index into vertices, 0 to 2");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]],
+      "triangles": [[0, 1]]}]})"),
+            "bodies[0].triangles[0]: must be [a, b, c], indices into vertices");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [2, 0, 0]],
+      "triangles": [[0, 1, 2]]}]})"),
+            "bodies[0].shape.triangles[0]: degenerate (its corners are repeated or in a line)");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]],
+      "triangles": [[0, 1, 2]], "static": false}]})"),
+            "bodies[0].type: a mesh must be static");
+  // Text from elsewhere (the network) may not name files on this machine.
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "file": "/etc/passwd"}]})"),
+            "bodies[0].file: mesh files are read only from scene files on disk; send vertices and "
+            "triangles");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "mesh", "file": "a.obj", "vertices": []}]})"),
+            "bodies[0].file: a mesh comes from a file or from vertices and triangles, not both");
+}
+
+// A scene file names mesh files relative to itself; OBJ and ASCII STL through Assimp, scaled.
+TEST(SceneJson, MeshesComeFromFilesBesideTheScene) {
+  const std::string folder = ::testing::TempDir() + "tumble_mesh_files/";
+  std::filesystem::create_directories(folder + "meshes");
+  // A 2 x 2 m floor of two triangles, in cm, with a quad the reader splits.
+  std::ofstream(folder + "meshes/floor.obj") << "v -100 -100 0\nv 100 -100 0\nv 100 100 0\n"
+                                                "v -100 100 0\nf 1 2 3 4\n";
+  std::ofstream(folder + "meshes/ramp.stl")
+      << "solid ramp\n facet normal 0 -0.7071 0.7071\n  outer loop\n   vertex 0 0 0\n"
+         "   vertex 1 0 0\n   vertex 1 1 1\n  endloop\n endfacet\nendsolid ramp\n";
+  std::ofstream(folder + "scene.json") << R"({"bodies": [
+      {"shape": "mesh", "file": "meshes/floor.obj", "scale": 0.01},
+      {"shape": "mesh", "file": "meshes/ramp.stl", "position": [5, 0, 0]},
+      {"shape": "box", "size": [0.2, 0.2, 0.2], "mass": 1, "position": [0.3, 0.2, 0.5]}]})";
+  const Result<SceneDef> scene = load_scene_file(folder + "scene.json");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  const auto& floor = std::get<TriangleMeshDef>(scene.value().bodies[0].shape);
+  EXPECT_EQ(floor.triangles.size(), 2u);
+  ASSERT_EQ(floor.vertices.size(), 4u);
+  for (const Vec3& v : floor.vertices)
+    EXPECT_EQ(v.cwiseAbs(), Vec3(1, 1, 0));
+  // Its triangles face up, as the file's quad runs counter-clockwise seen from above.
+  const TriangleMesh built = TriangleMesh::create(floor).value();
+  EXPECT_GT(built.normal(0).z(), 0.99);
+  EXPECT_EQ(std::get<TriangleMeshDef>(scene.value().bodies[1].shape).triangles.size(), 1u);
+  // The box lands on the floor.
+  World world = make_world(scene.value()).value();
+  for (int i = 0; i < 120; ++i)
+    ASSERT_TRUE(world.step(scene.value().dt).is_ok());
+  EXPECT_NEAR(world.body(world.id_at(2)).position().z(), 0.1, 1e-3);
+
+  std::ofstream(folder + "broken.json")
+      << R"({"bodies": [{"shape": "mesh", "file": "meshes/missing.obj"}]})";
+  const std::string missing = load_scene_file(folder + "broken.json").error();
+  EXPECT_NE(missing.find("bodies[0].file: mesh file '" + folder + "meshes/missing.obj'"),
+            std::string::npos)
+      << missing;
+  std::ofstream(folder + "meshes/nothing.obj") << "# no faces\nv 0 0 0\n";
+  EXPECT_NE(read_mesh_file(folder + "meshes/nothing.obj").status().message().find("nothing.obj"),
+            std::string::npos);
+  EXPECT_NE(read_mesh_file(folder + "meshes/floor.obj", -1)
+                .status()
+                .message()
+                .find("scale must be a finite number > 0"),
+            std::string::npos);
+  std::filesystem::remove_all(folder);
 }
 
 TEST(StandardScenes, TerrainPileLandsOnTheHills) {

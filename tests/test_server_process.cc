@@ -287,6 +287,34 @@ TEST(ServerProcess, CliSpawnsAHeightfieldFromAFile) {
       << refused.text;
 }
 
+TEST(ServerProcess, CliSpawnsAMeshFromAFile) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  TempDir dir;
+  // A 2 x 2 m floor in cm, one quad the reader splits into two triangles.
+  std::ofstream(dir / "floor.obj") << "v -100 -100 0\nv 100 -100 0\nv 100 100 0\nv -100 100 0\n"
+                                      "f 1 2 3 4\n";
+  const Output spawned =
+      run(tumble + "spawn mesh --file " + (dir / "floor.obj") + " --scale 0.01 --pos 100,0,1");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  const std::string mesh = spawned.text.substr(0, spawned.text.find('\n'));
+  const Output bodies = run(tumble + "bodies " + mesh);
+  ASSERT_EQ(bodies.code, 0) << bodies.text;
+  EXPECT_NE(bodies.text.find("\"static\":true"), std::string::npos) << bodies.text;
+  const Output hit = run(tumble + "ray --from 100.2,0.5,5 --dir 0,0,-1");
+  ASSERT_EQ(hit.code, 0) << hit.text;
+  EXPECT_NE(hit.text.find(mesh), std::string::npos) << hit.text;
+  // A file of no triangles, and triangles in a line, are refused naming what is wrong.
+  std::ofstream(dir / "points.obj") << "v 0 0 0\nv 1 0 0\n";
+  const Output empty = run(tumble + "spawn mesh --file " + (dir / "points.obj"));
+  EXPECT_NE(empty.code, 0);
+  EXPECT_NE(empty.text.find("points.obj"), std::string::npos) << empty.text;
+  const Output missing = run(tumble + "spawn mesh");
+  EXPECT_NE(missing.code, 0);
+  EXPECT_NE(missing.text.find("--file: required for a mesh"), std::string::npos) << missing.text;
+}
+
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--max-message-mb", "1"}));

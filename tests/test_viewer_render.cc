@@ -184,6 +184,25 @@ TEST(HeightFieldMesh, TrianglesFaceUpWithTheSlopesNormals) {
   EXPECT_TRUE(height_field_mesh(1, 3, 1.0, 2.0, std::vector<double>(3, 0.0)).indices.empty());
 }
 
+TEST(SurfaceMesh, EachTriangleFlatWithItsOwnNormal) {
+  // A floor triangle facing up and a wall triangle facing +y, sharing an edge; one of no area.
+  const std::vector<double> xyz = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 1, 2, 0, 0};
+  const std::vector<std::uint32_t> indices = {0, 1, 2, 0, 3, 1, 0, 1, 4};
+  const Mesh mesh = surface_mesh(xyz, indices);
+  ASSERT_EQ(mesh.indices.size(), 6u);  // the one of no area left out
+  ASSERT_EQ(mesh.vertices.size(), 6u * 6);
+  const Eigen::Vector3f expected[2] = {{0, 0, 1}, {0, 1, 0}};
+  for (std::size_t t = 0; t < 2; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3f normal =
+          Eigen::Map<const Eigen::Vector3f>(&mesh.vertices[6 * mesh.indices[3 * t + k] + 3]);
+      EXPECT_LT((normal - expected[t]).norm(), 1e-6f) << t;
+    }
+  EXPECT_TRUE(surface_mesh(xyz, std::vector<std::uint32_t>{0, 1, 5}).indices.empty());
+  EXPECT_TRUE(surface_mesh(std::vector<double>(4, 0.0), indices).indices.empty());
+  EXPECT_TRUE(surface_mesh(xyz, std::vector<std::uint32_t>{0, 1}).indices.empty());
+}
+
 #ifdef TUMBLE_HAVE_WORLD_VIEW
 // A frame's bodies become instances of their meshes; contacts add a ball and a rod each, only
 // when asked.

@@ -34,7 +34,7 @@ std::optional<std::pair<Eigen::Vector3f, float>> WorldView::bounds() const {
   for (const auto& [id, pose] : poses_) {
     const auto look = looks_.find(id);
     if (look == looks_.end() || look->second.shape().has_plane() ||
-        look->second.shape().has_heightfield())
+        look->second.shape().has_heightfield() || look->second.shape().has_mesh())
       continue;  // the ground frames the bodies on it, not itself
     const v1::Shape& shape = look->second.shape();
     float reach = 0.5f;
@@ -168,6 +168,25 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
                               f.samples_x(), f.samples_y(), f.spacing_x(), f.spacing_y(),
                               std::span<const double>(f.heights().data(),
                                                       static_cast<std::size_t>(f.heights_size())))))
+                  .first;
+        }
+        instance.model = model.matrix();
+        add(mesh->second, instance);
+        break;
+      }
+      case v1::Shape::kMesh: {
+        auto mesh = surface_meshes_.find(id);
+        if (mesh == surface_meshes_.end()) {
+          const v1::Mesh& m = shape.mesh();
+          mesh =
+              surface_meshes_
+                  .emplace(
+                      id,
+                      renderer.add_mesh(surface_mesh(
+                          std::span<const double>(m.vertices().data(),
+                                                  static_cast<std::size_t>(m.vertices_size())),
+                          std::span<const std::uint32_t>(
+                              m.triangles().data(), static_cast<std::size_t>(m.triangles_size())))))
                   .first;
         }
         instance.model = model.matrix();

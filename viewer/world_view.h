@@ -12,6 +12,7 @@
 #include "height_field_mesh.h"
 #include "hull_mesh.h"
 #include "renderer.h"
+#include "surface_mesh.h"
 #include "tumble/v1/world.pb.h"
 
 namespace tumble::viewer {
@@ -53,6 +54,7 @@ class WorldView {
   std::map<std::pair<float, float>, int> capsule_meshes_;
   std::unordered_map<std::uint64_t, int> hull_meshes_;  // by body id: each hull its own mesh
   std::unordered_map<std::uint64_t, int> height_field_meshes_;  // the same for heightfields
+  std::unordered_map<std::uint64_t, int> surface_meshes_;       // and for triangle meshes
   v1::Contacts contacts_;
   v1::JointStates joints_;
   // Each body's place in the order bodies were described, counted from the last time the view

@@ -20,6 +20,8 @@ Status validate(const BodyDef& def) {
     return Status::error("type: a half_space must be static");
   if (std::holds_alternative<HeightFieldDef>(def.shape) && def.type != BodyType::kStatic)
     return Status::error("type: a heightfield must be static");
+  if (std::holds_alternative<TriangleMeshDef>(def.shape) && def.type != BodyType::kStatic)
+    return Status::error("type: a mesh must be static");
   if (Status s = check_vector(def.position, "position"); !s) return s;
   if (!is_finite(def.orientation)) return Status::error("orientation: must be finite");
   const double norm = def.orientation.norm();

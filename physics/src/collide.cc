@@ -26,6 +26,7 @@ std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b
 
   switch (b.type()) {
     case ShapeType::kHeightField:  // collide_terrain's
+    case ShapeType::kMesh:
       break;
     case ShapeType::kHalfSpace:
       flags = collide_half_space(a, a_in_b, a_at, margin, out);

@@ -49,6 +49,7 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
     }
     case ShapeType::kHalfSpace:
     case ShapeType::kHeightField:
+    case ShapeType::kMesh:
       return kCollisionOk;
   }
   out->depth = -std::numeric_limits<double>::infinity();

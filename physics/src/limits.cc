@@ -48,6 +48,8 @@ ShapeSpan span_of(const Shape& shape) {
       const HeightFieldDef& def = shape.height_field()->def();
       return {"shape.spacing", std::min(def.spacing_x, def.spacing_y), "shape.heights"};
     }
+    case ShapeType::kMesh:
+      return {"shape.triangles", shape.mesh()->feature_size(), "shape.vertices"};
     case ShapeType::kHalfSpace:
       break;
   }

@@ -54,24 +54,29 @@ std::uint32_t collide_round_polyhedron(const Vec3& p, const Vec3& q, double radi
 std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec3& translation,
                                  double margin, ContactManifold* out);
 
-// A heightfield's contacts with one convex body: one manifold for each normal it pushes the body
-// along (a box on a ridge touches two slopes), at most kMaxTerrainManifolds; a body on a flat
-// stretch has one, the one it has on a plane. Cells visited per pair are bounded by
-// kMaxTerrainCells (kTerrainCellLimit when cut).
+// Terrain's (a heightfield's or a mesh's) contacts with one convex body: one manifold for each
+// normal it pushes the body along (a box on a ridge touches two slopes), at most
+// kMaxTerrainManifolds; a body on a flat stretch has one, the one it has on a plane. Cells
+// visited per pair are bounded by kMaxTerrainCells, mesh triangles by kMaxTerrainTriangles
+// (kTerrainCellLimit when cut).
 constexpr int kMaxTerrainManifolds = 4;
 constexpr std::size_t kMaxTerrainCells = 1 << 16;
+constexpr std::size_t kMaxTerrainTriangles = 1 << 17;
 struct TerrainContacts {
   std::array<ContactManifold, kMaxTerrainManifolds> manifolds;
   int count = 0;
 };
-// A, any convex shape, placed in the heightfield's frame by (rotation, translation). Manifolds in
-// the heightfield's frame, normals from A into the terrain.
+// A, any convex shape, placed in the terrain's frame by (rotation, translation). Manifolds in
+// the terrain's frame, normals from A into the terrain.
 std::uint32_t collide_height_field(const Shape& a, const Mat3& rotation, const Vec3& translation,
                                    const HeightField& field, const CollisionSettings& settings,
                                    TerrainContacts* out);
+std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& translation,
+                           const TriangleMesh& mesh, const CollisionSettings& settings,
+                           TerrainContacts* out);
 // Whether a pair must go through collide_terrain (one of them is terrain).
 inline bool is_terrain_pair(const Shape& a, const Shape& b) {
-  return a.type() == ShapeType::kHeightField || b.type() == ShapeType::kHeightField;
+  return is_terrain(a.type()) || is_terrain(b.type());
 }
 // Every manifold of a terrain pair, in the world, normals from a to b.
 std::uint32_t collide_terrain(const Shape& a, const Pose& pose_a, const Shape& b,

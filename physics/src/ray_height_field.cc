@@ -14,14 +14,15 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-// Where the ray meets the triangle's upper side, if it does within [0, max_t].
-bool ray_triangle(const std::array<Vec3, 3>& v, const Vec3& origin, const Vec3& direction,
-                  double* t) {
+}  // namespace
+
+bool ray_triangle_front(const std::array<Vec3, 3>& v, const Vec3& origin, const Vec3& direction,
+                        double* t) {
   const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0];
   const Vec3 p = direction.cross(e2);
   const double det = e1.dot(p);
-  // det = -direction . (e1 x e2): positive for a ray coming down onto the upper side; from below
-  // (the solid's inside) or along the plane it does not enter here.
+  // det = -direction . (e1 x e2): positive for a ray coming onto the front (a heightfield's upper
+  // side); from behind (a heightfield's solid) or along the plane it does not enter here.
   if (det <= 0) return false;
   const double inverse = 1 / det;
   const Vec3 s = origin - v[0];
@@ -34,8 +35,6 @@ bool ray_triangle(const std::array<Vec3, 3>& v, const Vec3& origin, const Vec3& 
   *t = e2.dot(q) * inverse;
   return *t >= 0;
 }
-
-}  // namespace
 
 bool ray_height_field(const HeightField& field, const Vec3& origin, const Vec3& direction,
                       double max_t, ShapeRayHit* hit) {
@@ -93,7 +92,7 @@ bool ray_height_field(const HeightField& field, const Vec3& origin, const Vec3& 
     for (std::uint32_t k = 0; k < 2; ++k) {
       const std::array<Vec3, 3> v = field.triangle(2 * (std::size_t{j} * field.cells_x() + i) + k);
       double t;
-      if (ray_triangle(v, origin, direction, &t) && t < best) {
+      if (ray_triangle_front(v, origin, direction, &t) && t < best) {
         best = t;
         best_normal = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
       }

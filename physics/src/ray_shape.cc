@@ -151,6 +151,8 @@ bool ray_shape(const Shape& shape, const Vec3& origin, const Vec3& direction, do
       return ray_hull(*shape.polyhedron(), origin, direction, max_t, hit);
     case ShapeType::kHeightField:
       return ray_height_field(*shape.height_field(), origin, direction, max_t, hit);
+    case ShapeType::kMesh:
+      return ray_mesh(*shape.mesh(), origin, direction, max_t, hit);
     case ShapeType::kHalfSpace: {
       // The solid below z = 0.
       if (origin.z() <= 0) {

@@ -33,6 +33,8 @@ const char* shape_type_name(ShapeType type) {
       return "half_space";
     case ShapeType::kHeightField:
       return "heightfield";
+    case ShapeType::kMesh:
+      return "mesh";
   }
   return "unknown";
 }
@@ -73,6 +75,11 @@ Result<Shape> Shape::create(const ShapeDef& def) {
     if (!built) return built.status();
     shape.type_ = ShapeType::kHeightField;
     shape.height_field_ = std::make_shared<HeightField>(std::move(built).value());
+  } else if (const auto* mesh = std::get_if<TriangleMeshDef>(&def)) {
+    Result<TriangleMesh> built = TriangleMesh::create(*mesh);
+    if (!built) return built.status();
+    shape.type_ = ShapeType::kMesh;
+    shape.mesh_ = std::make_shared<TriangleMesh>(std::move(built).value());
   } else {
     shape.type_ = ShapeType::kHalfSpace;
   }
@@ -100,6 +107,8 @@ Aabb Shape::local_bounds() const {
       return Aabb::infinite();
     case ShapeType::kHeightField:
       return height_field_->bounds();
+    case ShapeType::kMesh:
+      return mesh_->bounds();
   }
   return Aabb::infinite();
 }
@@ -117,6 +126,7 @@ double Shape::volume() const {
       return polyhedron_->volume;
     case ShapeType::kHalfSpace:
     case ShapeType::kHeightField:
+    case ShapeType::kMesh:
       return std::numeric_limits<double>::infinity();
   }
   return 0;
@@ -158,6 +168,7 @@ MassProperties Shape::mass_properties(double density) const {
     }
     case ShapeType::kHalfSpace:
     case ShapeType::kHeightField:
+    case ShapeType::kMesh:
       props.mass = std::numeric_limits<double>::infinity();
       break;
   }
@@ -177,6 +188,8 @@ double Shape::size() const {
       return 1.0;
     case ShapeType::kHeightField:
       return std::max(height_field_->def().spacing_x, height_field_->def().spacing_y);
+    case ShapeType::kMesh:
+      return mesh_->feature_size();
   }
   return 1.0;
 }
@@ -187,6 +200,7 @@ double compute_inner_radius(ShapeType type, double radius, const Vec3& half_exte
                             const ConvexPolyhedron* polyhedron) {
   switch (type) {
     case ShapeType::kHeightField:
+    case ShapeType::kMesh:
       return 0;
     case ShapeType::kSphere:
     case ShapeType::kCapsule:
@@ -207,12 +221,11 @@ double compute_inner_radius(ShapeType type, double radius, const Vec3& half_exte
 
 double compute_outer_radius(ShapeType type, double radius, double half_height,
                             const Vec3& half_extents, const ConvexPolyhedron* polyhedron,
-                            const HeightField* height_field) {
+                            const Aabb& terrain_bounds) {
   switch (type) {
-    case ShapeType::kHeightField: {
-      const Aabb box = height_field->bounds();
-      return box.min.cwiseAbs().cwiseMax(box.max.cwiseAbs()).norm();
-    }
+    case ShapeType::kHeightField:
+    case ShapeType::kMesh:
+      return terrain_bounds.min.cwiseAbs().cwiseMax(terrain_bounds.max.cwiseAbs()).norm();
     case ShapeType::kSphere:
       return radius;
     case ShapeType::kCapsule:
@@ -235,8 +248,9 @@ double compute_outer_radius(ShapeType type, double radius, double half_height,
 
 void Shape::update_radii() {
   inner_radius_ = compute_inner_radius(type_, radius_, half_extents_, polyhedron_.get());
-  outer_radius_ = compute_outer_radius(type_, radius_, half_height_, half_extents_,
-                                       polyhedron_.get(), height_field_.get());
+  outer_radius_ =
+      compute_outer_radius(type_, radius_, half_height_, half_extents_, polyhedron_.get(),
+                           is_terrain(type_) ? local_bounds() : Aabb{});
 }
 
 Vec3 Shape::support(const Vec3& d) const {
@@ -258,9 +272,10 @@ Vec3 Shape::support(const Vec3& d) const {
       return polyhedron_->support(d);
     case ShapeType::kHalfSpace:
     case ShapeType::kHeightField:
+    case ShapeType::kMesh:
       break;
   }
-  TUMBLE_ASSERT(false && "a half-space or heightfield has no support point");
+  TUMBLE_ASSERT(false && "a half-space or terrain has no support point");
   return Vec3::Zero();
 }
 
@@ -279,11 +294,13 @@ Shape Shape::recentred(const Vec3& offset) const {
 }
 
 ShapeState Shape::state() const {
-  ShapeState state{type_, radius_, half_height_, half_extents_, nullptr, nullptr};
+  ShapeState state{type_, radius_, half_height_, half_extents_, nullptr, nullptr, nullptr};
   if (type_ == ShapeType::kHull) state.polyhedron = polyhedron_;
   if (type_ == ShapeType::kHeightField)  // the definition, owned with the field
     state.height_field =
         std::shared_ptr<const HeightFieldDef>(height_field_, &height_field_->def());
+  if (type_ == ShapeType::kMesh)
+    state.mesh = std::shared_ptr<const TriangleMeshDef>(mesh_, &mesh_->def());
   return state;
 }
 
@@ -388,6 +405,10 @@ Result<Shape> Shape::from_state(const ShapeState& state) {
         return Status::error("height_field: required for a heightfield");
       // Built again from its definition: the checks and the derived edges are create()'s.
       return create(*state.height_field);
+    }
+    case ShapeType::kMesh: {
+      if (state.mesh == nullptr) return Status::error("mesh: required for a mesh");
+      return create(*state.mesh);
     }
     case ShapeType::kHull: {
       if (state.polyhedron == nullptr) return Status::error("polyhedron: required for a hull");

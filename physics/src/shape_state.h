@@ -18,6 +18,7 @@ struct ShapeState {
   Vec3 half_extents = Vec3::Zero();
   std::shared_ptr<const ConvexPolyhedron> polyhedron;  // hulls only (a box rebuilds its own)
   std::shared_ptr<const HeightFieldDef> height_field;  // heightfields only
+  std::shared_ptr<const TriangleMeshDef> mesh;         // meshes only
 };
 
 }  // namespace tumble

@@ -121,6 +121,17 @@ void put_shape(Writer& w, const Shape& shape) {
       w.put(h);
     return;
   }
+  if (s.type == ShapeType::kMesh) {
+    const TriangleMeshDef& def = *s.mesh;
+    w.put(static_cast<std::uint32_t>(def.vertices.size()));
+    for (const Vec3& v : def.vertices)
+      w.put(v);
+    w.put(static_cast<std::uint32_t>(def.triangles.size()));
+    for (const auto& triangle : def.triangles)
+      for (std::uint32_t index : triangle)
+        w.put(index);
+    return;
+  }
   if (s.type != ShapeType::kHull) return;
   const ConvexPolyhedron& p = *s.polyhedron;
   w.put(static_cast<std::uint32_t>(p.vertices.size()));
@@ -151,7 +162,7 @@ Result<Shape> take_shape(Reader& r) {
   s.half_height = r.take<double>("half_height");
   s.half_extents = r.vec3("half_extents");
   if (!r.ok()) return r.status();
-  if (type > static_cast<std::uint8_t>(ShapeType::kHeightField))
+  if (type > static_cast<std::uint8_t>(ShapeType::kMesh))
     return Status::error("type: unknown shape type " + std::to_string(type));
   s.type = static_cast<ShapeType>(type);
   if (s.type == ShapeType::kHull) {
@@ -189,6 +200,18 @@ Result<Shape> take_shape(Reader& r) {
       h = r.take<double>("height_field.heights");
     if (!r.ok()) return r.status();
     s.height_field = std::make_shared<const HeightFieldDef>(std::move(def));
+  }
+  if (s.type == ShapeType::kMesh) {
+    TriangleMeshDef def;
+    def.vertices.resize(r.count("mesh.vertices", 24));
+    for (Vec3& v : def.vertices)
+      v = r.vec3("mesh.vertices");
+    def.triangles.resize(r.count("mesh.triangles", 12));
+    for (auto& triangle : def.triangles)
+      for (std::uint32_t& index : triangle)
+        index = r.take<std::uint32_t>("mesh.triangles");
+    if (!r.ok()) return r.status();
+    s.mesh = std::make_shared<const TriangleMeshDef>(std::move(def));
   }
   return Shape::from_state(s);  // checks every number and index
 }

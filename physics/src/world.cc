@@ -211,7 +211,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     // A moving body joins the moving set, which every step visits anyway; only a resting one
     // changes what the broad phase keeps.
     if (slot.body.is_kinematic()) kinematic_.push_back(index);
-    if (slot.body.shape.type() == ShapeType::kHeightField) ++terrain_count_;
+    if (is_terrain(slot.body.shape.type())) ++terrain_count_;
     if (slot.body.is_moving())
       join_awake(index);
     else if (!slot.body.carries())  // a carrier's bounds are made every step, as a moving body's
@@ -235,7 +235,7 @@ Status World::remove_body(BodyId id) {
   else
     resting_changed(id.index);
   if (slot.body.is_kinematic()) std::erase(kinematic_, id.index);
-  if (slot.body.shape.type() == ShapeType::kHeightField) --terrain_count_;
+  if (is_terrain(slot.body.shape.type())) --terrain_count_;
   // The step's per-slot data forget it (bounds kept for moving bodies are not visited again).
   if (id.index < bounds_.size()) {
     bounds_[id.index] = Aabb();

@@ -172,6 +172,8 @@ Result<bool> World::overlap(const OverlapQuery& query, std::size_t max_bodies,
     return Status::error("shape: a half-space holds half the world; ask a large box");
   if (std::holds_alternative<HeightFieldDef>(query.shape))
     return Status::error("shape: a heightfield is terrain, not a query's shape; ask a box");
+  if (std::holds_alternative<TriangleMeshDef>(query.shape))
+    return Status::error("shape: a mesh is terrain, not a query's shape; ask a box");
   Result<Shape> shape = Shape::create(query.shape);
   if (!shape) return shape.status().within("shape.");
   if (Status s = validate_placement(query.pose); !s) return s;

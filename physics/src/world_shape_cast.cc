@@ -24,6 +24,8 @@ Status validate(const ShapeCast& cast) {
     return Status::error("shape: a half-space holds half the world and cannot be swept");
   if (std::holds_alternative<HeightFieldDef>(cast.shape))
     return Status::error("shape: a heightfield is terrain and cannot be swept");
+  if (std::holds_alternative<TriangleMeshDef>(cast.shape))
+    return Status::error("shape: a mesh is terrain and cannot be swept");
   if (Status s = validate_placement(cast.pose); !s) return s;
   if (!is_finite(cast.translation)) return Status::error("translation: must be finite");
   if (!(cast.translation.norm() <= kMaxRayLength))

@@ -262,7 +262,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     if (world.bodies_[i].body.asleep) world.link_sleeper(i, world.bodies_[i].body.sleep_island);
     if (world.bodies_[i].body.is_moving()) world.awake_.push_back(i);
     if (world.bodies_[i].body.is_kinematic()) world.kinematic_.push_back(i);
-    if (world.bodies_[i].body.shape.type() == ShapeType::kHeightField) ++world.terrain_count_;
+    if (is_terrain(world.bodies_[i].body.shape.type())) ++world.terrain_count_;
     world.filters_used_ = world.filters_used_ || world.bodies_[i].body.filter != CollisionFilter{};
   }
   world.live_count_ = live;

@@ -1,6 +1,7 @@
 // The JSON scene format. Every field is checked with its path; unknown fields are errors, so a
 // misspelt key never silently falls back to a default.
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -8,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "scenes/mesh_file.h"
 #include "scenes/scene.h"
 
 namespace tumble {
@@ -146,10 +148,67 @@ HeightFieldDef read_height_field(ObjectReader& r) {
   return def;
 }
 
+// The folder of the scene file being loaded, against which a mesh's "file" is found; empty while
+// parsing text that came from elsewhere (the network), which may not name files on this machine.
+thread_local const std::filesystem::path* mesh_folder = nullptr;
+
+// Inline: "vertices": [[x, y, z], ...] (m), "triangles": [[a, b, c], ...] (indices, counter-
+// clockwise seen from the front). Or, in a scene file on disk, "file": an OBJ, STL, PLY, ... path
+// relative to the scene file, with an optional "scale".
+TriangleMeshDef read_mesh(ObjectReader& r) {
+  const Json* file = r.find("file");
+  const Json* vertices = r.find("vertices");
+  const Json* triangles = r.find("triangles");
+  if (file != nullptr) {
+    if (vertices != nullptr || triangles != nullptr)
+      fail(r.child("file"), "a mesh comes from a file or from vertices and triangles, not both");
+    if (!file->is_string() || file->get<std::string>().empty())
+      fail(r.child("file"), "must be the path of a mesh file (OBJ, STL, PLY, ...)");
+    if (mesh_folder == nullptr)
+      fail(r.child("file"),
+           "mesh files are read only from scene files on disk; send vertices and triangles");
+    const double scale = positive(r, "scale", 1);
+    Result<TriangleMeshDef> mesh =
+        read_mesh_file((*mesh_folder / file->get<std::string>()).string(), scale);
+    if (!mesh) fail(r.child("file"), mesh.status().message());
+    return std::move(mesh).value();
+  }
+  TriangleMeshDef def;
+  if (vertices == nullptr || !vertices->is_array() || vertices->empty())
+    fail(r.child("vertices"), "must be an array of points [x, y, z] in m (or give a \"file\")");
+  if (vertices->size() > kMaxMeshVertices)
+    fail(r.child("vertices"), std::to_string(vertices->size()) + ", more than the " +
+                                  std::to_string(kMaxMeshVertices) + " a mesh may have");
+  def.vertices.reserve(vertices->size());
+  for (std::size_t i = 0; i < vertices->size(); ++i)
+    def.vertices.push_back(ObjectReader::read_vector(
+        (*vertices)[i], r.child("vertices") + "[" + std::to_string(i) + "]"));
+  if (triangles == nullptr || !triangles->is_array() || triangles->empty())
+    fail(r.child("triangles"), "must be an array of [a, b, c], indices into vertices");
+  if (triangles->size() > kMaxMeshTriangles)
+    fail(r.child("triangles"), std::to_string(triangles->size()) + ", more than the " +
+                                   std::to_string(kMaxMeshTriangles) + " a mesh may have");
+  def.triangles.reserve(triangles->size());
+  for (std::size_t i = 0; i < triangles->size(); ++i) {
+    const Json& t = (*triangles)[i];
+    const std::string path = r.child("triangles") + "[" + std::to_string(i) + "]";
+    if (!t.is_array() || t.size() != 3) fail(path, "must be [a, b, c], indices into vertices");
+    std::array<std::uint32_t, 3> triangle;
+    for (int k = 0; k < 3; ++k) {
+      if (!t[k].is_number_unsigned() || t[k].get<std::uint64_t>() >= vertices->size())
+        fail(path + "[" + std::to_string(k) + "]",
+             "must be an index into vertices, 0 to " + std::to_string(vertices->size() - 1));
+      triangle[k] = static_cast<std::uint32_t>(t[k].get<std::uint64_t>());
+    }
+    def.triangles.push_back(triangle);
+  }
+  return def;
+}
+
 ShapeDef read_shape(ObjectReader& r) {
   const std::string type = r.string("shape", "");
   if (type.empty())
-    fail(r.child("shape"), "missing (box, sphere, capsule, hull, plane or heightfield)");
+    fail(r.child("shape"), "missing (box, sphere, capsule, hull, plane, heightfield or mesh)");
   if (type == "box") {
     const Json* size = r.find("size");
     if (size == nullptr) fail(r.child("size"), "missing (full extents x, y, z in m)");
@@ -180,8 +239,9 @@ ShapeDef read_shape(ObjectReader& r) {
   }
   if (type == "plane") return HalfSpaceDef{};
   if (type == "heightfield") return read_height_field(r);
+  if (type == "mesh") return read_mesh(r);
   fail(r.child("shape"),
-       "unknown shape '" + type + "' (box, sphere, capsule, hull, plane or heightfield)");
+       "unknown shape '" + type + "' (box, sphere, capsule, hull, plane, heightfield or mesh)");
 }
 
 void read_limits(const Json& json, WorldLimits* limits) {
@@ -204,7 +264,8 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   BodyDef def;
   def.shape = read_shape(r);
   const bool ground = std::holds_alternative<HalfSpaceDef>(def.shape) ||
-                      std::holds_alternative<HeightFieldDef>(def.shape);
+                      std::holds_alternative<HeightFieldDef>(def.shape) ||
+                      std::holds_alternative<TriangleMeshDef>(def.shape);
   const bool is_static = r.boolean("static", ground);
   const bool kinematic = r.boolean("kinematic", false);
   if (is_static && kinematic) fail(r.child("kinematic"), "a body is static or kinematic, not both");
@@ -430,6 +491,14 @@ Json body_json(const BodyDef& def) {
           out["samples"] = Json::array({shape.samples_x, shape.samples_y});
           out["spacing"] = Json::array({shape.spacing_x, shape.spacing_y});
           out["heights"] = shape.heights;
+        } else if constexpr (std::is_same_v<T, TriangleMeshDef>) {
+          out["shape"] = "mesh";
+          out["vertices"] = Json::array();
+          for (const Vec3& v : shape.vertices)
+            out["vertices"].push_back(vector_json(v));
+          out["triangles"] = Json::array();
+          for (const auto& t : shape.triangles)
+            out["triangles"].push_back(Json::array({t[0], t[1], t[2]}));
         } else {
           out["shape"] = "plane";
         }
@@ -558,7 +627,10 @@ Result<SceneDef> load_scene_file(const std::string& path) {
   if (!file) return Status::error(path + ": cannot open");
   std::stringstream text;
   text << file.rdbuf();
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  mesh_folder = &folder;
   Result<SceneDef> scene = parse_scene(text.str());
+  mesh_folder = nullptr;
   if (!scene) return scene.status().within(path + ": ");
   return scene;
 }

@@ -75,6 +75,15 @@ SceneDef terrain_pile_scene(int count) {
   return scene;
 }
 
+SceneDef terrain_mesh_pile_scene(int count) {
+  SceneDef scene = terrain_pile_scene(count);
+  scene.name = "terrain-mesh-" + std::to_string(count);
+  BodyDef& ground = scene.bodies.front();
+  ground.shape =
+      mesh_of_height_field(HeightField::create(std::get<HeightFieldDef>(ground.shape)).value());
+  return scene;
+}
+
 SceneDef pyramid_scene(int base) {
   SceneDef scene = base_scene("pyramid-" + std::to_string(base), 20);
   scene.bodies.push_back(ground());
@@ -483,9 +492,9 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   // Counted, ground included, before anything is built, so a request for a huge scene costs
   // nothing.
-  if (name == "pile" || name == "terrain" || name == "pyramid" || name == "tower" ||
-      name == "chain" || name == "rope-bridge" || name == "ragdolls") {
-    const bool piled = name == "pile" || name == "terrain";
+  if (name == "pile" || name == "terrain" || name == "terrain-mesh" || name == "pyramid" ||
+      name == "tower" || name == "chain" || name == "rope-bridge" || name == "ragdolls") {
+    const bool piled = name == "pile" || name == "terrain" || name == "terrain-mesh";
     const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(piled ? 1000 : 20));
     const std::uint64_t bodies = (name == "pyramid"    ? n * (n + 1) / 2
                                   : name == "ragdolls" ? 11 * n
@@ -502,6 +511,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   };
   if (name == "pile") return pile_scene(size.value_or(1000));
   if (name == "terrain") return terrain_pile_scene(size.value_or(1000));
+  if (name == "terrain-mesh") return terrain_mesh_pile_scene(size.value_or(1000));
   if (name == "pyramid") return pyramid_scene(size.value_or(20));
   if (name == "tower") return tower_scene(size.value_or(20));
   if (name == "mass-ratio" || name == "mass-ratio-inv") {
@@ -557,8 +567,8 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   return Status::error(
       "scene '" + shown(spec) +
-      "': unknown; the standard scenes are pile, terrain, pyramid, tower, mass-ratio, "
-      "mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
+      "': unknown; the standard scenes are pile, terrain, terrain-mesh, pyramid, tower, "
+      "mass-ratio, mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
       "chain, cradle, door, rope-bridge, arm, ragdolls, carousel, default");
 }
 

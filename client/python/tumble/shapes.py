@@ -95,7 +95,33 @@ class HeightField:
         return shape
 
 
-SHAPES = (Box, Sphere, Capsule, Hull, Plane, HeightField)
+@dataclass(frozen=True)
+class Mesh:
+    """Static geometry of triangles (static bodies only): `vertices` (N, 3) in m in the body's
+    frame, `triangles` (M, 3) of indices into them. Triangles are one-sided: each holds bodies on
+    its front, the side from which its corners run counter-clockwise (a floor's triangles run
+    counter-clockwise seen from above; a room's walls face in)."""
+
+    vertices: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    triangles: np.ndarray = field(default_factory=lambda: np.zeros((1, 3), dtype=np.uint32))
+
+    def to_proto(self):
+        vertices = convert.points(self.vertices, "vertices")
+        triangles = np.asarray(self.triangles)
+        if triangles.ndim != 2 or triangles.shape[1] != 3 or triangles.shape[0] < 1:
+            raise ArgumentError(f"triangles: expected an (M, 3) array of vertex indices, got "
+                                f"shape {triangles.shape}")
+        if not np.issubdtype(triangles.dtype, np.integer):
+            raise ArgumentError("triangles: must be integers (indices into vertices)")
+        if triangles.min() < 0 or triangles.max() >= len(vertices):
+            raise ArgumentError(f"triangles: indices must be 0 to {len(vertices) - 1}")
+        shape = pb.Shape()
+        shape.mesh.vertices.extend(np.asarray(vertices, dtype=float).ravel().tolist())
+        shape.mesh.triangles.extend(triangles.astype(np.uint32).ravel().tolist())
+        return shape
+
+
+SHAPES = (Box, Sphere, Capsule, Hull, Plane, HeightField, Mesh)
 
 
 def from_proto(shape):
@@ -115,4 +141,7 @@ def from_proto(shape):
         field_ = shape.heightfield
         heights = np.array(field_.heights, dtype=float).reshape(field_.samples_y, field_.samples_x)
         return HeightField(heights, (field_.spacing_x, field_.spacing_y))
+    if kind == "mesh":
+        return Mesh(np.array(shape.mesh.vertices, dtype=float).reshape(-1, 3),
+                    np.array(shape.mesh.triangles, dtype=np.uint32).reshape(-1, 3))
     raise ArgumentError(f"shape: unknown kind {kind!r}")

@@ -15,7 +15,7 @@ from tumble import convert, shapes
 from tumble.bodies import Body, BodySpec, aliased, bits
 from tumble.errors import ArgumentError, Error, from_rpc
 from tumble.frames import FrameStream, plain
-from tumble.shapes import Box, Capsule, HeightField, Hull, Plane, Sphere
+from tumble.shapes import Box, Capsule, HeightField, Hull, Mesh, Plane, Sphere
 from tumble.v1 import world_pb2 as pb
 from tumble.v1 import world_pb2_grpc as pb_grpc
 
@@ -157,7 +157,7 @@ class WorldCalls:
     # --- bodies -------------------------------------------------------------------------------
 
     def spawn(self, shape, position=None, linear_velocity=None, **options):
-        """Spawns one body of `shape` (Box, Sphere, Capsule, Hull, Plane or HeightField); returns
+        """Spawns one body of `shape` (Box, Sphere, Capsule, Hull, Plane, HeightField or Mesh); returns
         its id.
         Options are BodySpec's: orientation, angular_velocity, mass, density, friction,
         restitution, color, static, kinematic (moved only by its velocity: linear_velocity,
@@ -204,6 +204,12 @@ class WorldCalls:
         (x, y, m), centred on `position`; see HeightField."""
         return self.spawn(HeightField(np.asarray(heights, dtype=float), tuple(spacing)), position,
                           static=True, **options)
+
+    def spawn_mesh(self, vertices, triangles, position=None, **options):
+        """Static geometry of triangles: `vertices` ((N, 3), body frame, m) and `triangles`
+        ((M, 3) indices, counter-clockwise seen from the front); see Mesh."""
+        return self.spawn(Mesh(convert.points(vertices, "vertices"), np.asarray(triangles)),
+                          position, static=True, **options)
 
     def remove(self, ids):
         """Removes a body or a list of them, all or nothing (one unknown id: NOT_FOUND)."""

@@ -10,6 +10,7 @@
 #include "physics/math.h"
 #include "physics/polyhedron.h"
 #include "physics/status.h"
+#include "physics/triangle_mesh.h"
 
 namespace tumble {
 
@@ -41,15 +42,29 @@ struct HullDef {
 // Only static bodies may use it.
 struct HalfSpaceDef {};
 // HeightFieldDef (physics/height_field.h): terrain; only static bodies may use it.
+// TriangleMeshDef (physics/triangle_mesh.h): static geometry of triangles; only static bodies.
 
-using ShapeDef = std::variant<SphereDef, CapsuleDef, BoxDef, HullDef, HalfSpaceDef, HeightFieldDef>;
+using ShapeDef = std::variant<SphereDef, CapsuleDef, BoxDef, HullDef, HalfSpaceDef, HeightFieldDef,
+                              TriangleMeshDef>;
 
 // Ordered so that collision dispatch can always put the lower type first (the values are the
 // state format's: a new type goes last).
-enum class ShapeType : std::uint8_t { kSphere, kCapsule, kBox, kHull, kHalfSpace, kHeightField };
+enum class ShapeType : std::uint8_t {
+  kSphere,
+  kCapsule,
+  kBox,
+  kHull,
+  kHalfSpace,
+  kHeightField,
+  kMesh
+};
+// Terrain: shapes of many triangles, which may touch a body along several normals at once.
+inline bool is_terrain(ShapeType type) {
+  return type == ShapeType::kHeightField || type == ShapeType::kMesh;
+}
 // Shapes only static bodies may have: the ground and terrain.
 inline bool is_static_only(ShapeType type) {
-  return type == ShapeType::kHalfSpace || type == ShapeType::kHeightField;
+  return type == ShapeType::kHalfSpace || is_terrain(type);
 }
 const char* shape_type_name(ShapeType type);
 
@@ -74,14 +89,17 @@ class Shape {
   const ConvexPolyhedron* polyhedron() const { return polyhedron_.get(); }
   // The heightfield of a heightfield shape; null for the other shapes.
   const HeightField* height_field() const { return height_field_.get(); }
+  // The mesh of a mesh shape; null for the other shapes.
+  const TriangleMesh* mesh() const { return mesh_.get(); }
 
   // Bounds in the shape frame; infinite for a half-space. A heightfield's reach down to its base.
   Aabb local_bounds() const;
-  double volume() const;  // m^3; infinite for a half-space and a heightfield
+  double volume() const;  // m^3; infinite for a half-space, a heightfield and a mesh
   // Mass properties for a uniform density (kg/m^3).
   MassProperties mass_properties(double density) const;
   // A length that sets the scale of numerical tolerances: the largest half extent (a
-  // heightfield's: its larger spacing, the size of its features).
+  // heightfield's: its larger spacing, the size of its features; a mesh's: its longest triangle
+  // edge).
   double size() const;
   // m: the radius of the largest sphere about the shape's origin that fits inside it (the
   // smallest half extent of a box); a body moving less than this per step cannot jump over a
@@ -107,6 +125,7 @@ class Shape {
   Vec3 half_extents_ = Vec3::Zero();
   std::shared_ptr<const ConvexPolyhedron> polyhedron_;
   std::shared_ptr<const HeightField> height_field_;
+  std::shared_ptr<const TriangleMesh> mesh_;
   double inner_radius_ = 0, outer_radius_ = 0;
   void update_radii();
 };

@@ -1,0 +1,86 @@
+// A triangle mesh: static geometry (a room, a floor, a terrain from a modelling tool) given as
+// vertices and triangles. Static only.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "physics/height_field.h"  // kSmoothEdgeAngle
+#include "physics/math.h"
+#include "physics/status.h"
+
+namespace tumble {
+
+// vertices: m, finite, each coordinate within kMaxMeshCoordinate; triangles: indices into
+// vertices, counter-clockwise seen from the side bodies are pushed out to (the triangle's
+// front). A triangle whose corners are repeated or in a line (its area below 1e-12 of its longest
+// edge squared) is refused: it has no normal. Open meshes (a floor, a ramp) are fine; an edge that
+// is not shared by exactly two triangles winding it in opposite directions is a boundary edge.
+// At most kMaxMeshVertices and kMaxMeshTriangles (each step's contact search and every query walk
+// the mesh's tree, and a snapshot carries every vertex).
+inline constexpr std::size_t kMaxMeshVertices = std::size_t{1} << 21;   // 2,097,152
+inline constexpr std::size_t kMaxMeshTriangles = std::size_t{1} << 21;  // 2,097,152
+inline constexpr double kMaxMeshCoordinate = 1e6;
+struct TriangleMeshDef {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+// The built mesh, immutable and shared by the shapes made of it: the triangles' adjacency, which
+// edges are convex, and a bounding-volume tree over the triangles.
+class TriangleMesh {
+ public:
+  // The message names the bad field ("triangles[17]: degenerate ...").
+  static Result<TriangleMesh> create(const TriangleMeshDef& def);
+
+  const TriangleMeshDef& def() const { return def_; }
+  std::size_t triangle_count() const { return def_.triangles.size(); }
+  std::array<Vec3, 3> triangle(std::size_t t) const {
+    const auto& [a, b, c] = def_.triangles[t];
+    return {def_.vertices[a], def_.vertices[b], def_.vertices[c]};
+  }
+  // Unit, out of the front.
+  Vec3 normal(std::size_t t) const;
+  // Bit e set: the edge from vertex e to vertex e+1 is convex (the neighbour across it turns
+  // away behind the triangle's plane by more than kSmoothEdgeAngle) or a boundary edge. Only such
+  // edges may give a contact a normal other than a face's (docs/COLLISION.md, "Triangle meshes").
+  std::uint8_t active_edges(std::size_t t) const { return active_edges_[t]; }
+  // The triangle across edge e of t, or -1 on a boundary edge.
+  std::int64_t neighbour(std::size_t t, int e) const { return neighbours_[3 * t + e]; }
+  Aabb bounds() const { return bounds_; }
+  // The longest edge of any triangle, m: the size of the mesh's features.
+  double feature_size() const { return feature_size_; }
+  // The triangles whose bounds meet `box`, appended to `out` (cleared first), at most `limit` of
+  // them; false when more were there.
+  bool triangles_meeting(const Aabb& box, std::vector<std::uint32_t>* out, std::size_t limit) const;
+
+  // The tree: each node's bounds (single precision, rounded outwards) and either two children
+  // (count == 0: children at first and first + 1) or `count` triangles of order_ from first.
+  struct Node {
+    std::array<float, 3> min, max;
+    std::uint32_t first = 0, count = 0;
+  };
+  const std::vector<Node>& nodes() const { return nodes_; }
+  std::uint32_t ordered_triangle(std::size_t k) const { return order_[k]; }
+  // Deep enough for any tree create() builds (it splits at the median: depth <= log2 of the
+  // triangle count + 1).
+  static constexpr int kMaxDepth = 48;
+
+ private:
+  TriangleMeshDef def_;
+  std::vector<std::int32_t> neighbours_;
+  std::vector<std::uint8_t> active_edges_;
+  std::vector<Node> nodes_;
+  std::vector<std::uint32_t> order_;
+  Aabb bounds_;
+  double feature_size_ = 0;
+  void build_adjacency();
+  void build_tree();
+};
+
+// The heightfield's surface as a mesh of the same triangles (the same vertex order and split), for
+// terrain authored as a grid but wanted as a mesh, and for comparing the two.
+TriangleMeshDef mesh_of_height_field(const HeightField& field);
+
+}  // namespace tumble

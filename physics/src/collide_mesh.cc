@@ -1,0 +1,146 @@
+// Convex bodies against a triangle mesh: the triangles the mesh's tree finds under the body's
+// bounds, met by the rules of triangle_contacts.cc. Unlike a heightfield's, a mesh's triangles
+// are surfaces with a front, not the top of a solid, so a triangle holds only a body whose centre
+// is in front of it (one-sided, as Jolt's and Bullet's meshes are by default), and a body vertex
+// counts for a triangle only where the line from the centre to it crosses the triangle: a box
+// hanging over a mesh cube's top edge then meets the top, not the side its lower corners lie
+// behind.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "manifold.h"
+#include "narrow_phase.h"
+#include "physics/triangle_mesh.h"
+#include "triangle_contacts.h"
+
+namespace tumble {
+namespace {
+
+// A triangle whose face may hold the body's vertices.
+struct FrontFace {
+  std::array<Vec3, 3> v;
+  Vec3 n;
+  double centre_height;  // of the body's centre over the plane, > 0
+};
+
+struct MeshScratch {
+  std::vector<std::uint32_t> triangles;
+  std::vector<Vec3> vertices;  // the body's, in the mesh's frame
+  std::vector<FrontFace> faces;
+};
+
+MeshScratch& mesh_scratch() {
+  thread_local MeshScratch scratch;
+  return scratch;
+}
+
+}  // namespace
+
+std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& translation,
+                           const TriangleMesh& mesh, const CollisionSettings& settings,
+                           TerrainContacts* out) {
+  out->count = 0;
+  const double margin = settings.margin;
+  const TriangleBody body(a, rotation, translation, margin);
+  MeshScratch& s = mesh_scratch();
+  std::uint32_t flags = kCollisionOk;
+  if (!mesh.triangles_meeting(body.bounds, &s.triangles, kMaxTerrainTriangles))
+    flags |= kTerrainCellLimit;
+  if (s.triangles.empty()) return flags;
+  TriangleContacts& contacts =
+      TriangleContacts::begin(margin, std::max(a.size(), mesh.feature_size()));
+  if (!body.round) {
+    const auto& vertices = a.polyhedron()->vertices;
+    s.vertices.resize(vertices.size());
+    for (std::size_t k = 0; k < vertices.size(); ++k)
+      s.vertices[k] = rotation * vertices[k] + translation;
+  }
+  s.faces.clear();
+  const Vec3 centre = 0.5 * (body.bounds.min + body.bounds.max);
+  const Vec3 half = 0.5 * body.bounds.extent();
+  const auto in_front = [&](const std::array<Vec3, 3>& v, const Vec3& n) {
+    return (translation - v[0]).dot(n) > 0;
+  };
+
+  for (const std::uint32_t t : s.triangles) {
+    const std::array<Vec3, 3> v = mesh.triangle(t);
+    const Vec3 n = mesh.normal(t);
+    // Wholly more than the margin in front of the plane (its bounds, grown by the margin, are),
+    // the body touches neither the face nor its edges; wholly behind, neither either.
+    const double middle = (centre - v[0]).dot(n), reach = half.dot(n.cwiseAbs());
+    if (middle - reach > 0 || middle + reach < 0) continue;
+    const bool front = in_front(v, n);
+    if (front && body.round) {
+      contacts.round_face_points(body, v, n);
+    } else if (front) {
+      s.faces.push_back({v, n, (translation - v[0]).dot(n)});
+    }
+    const std::uint8_t active = mesh.active_edges(t);
+    for (int e = 0; e < 3; ++e) {
+      const std::int64_t other = mesh.neighbour(t, e);
+      if ((active & (1u << e)) == 0 || (other >= 0 && static_cast<std::uint32_t>(other) < t))
+        continue;
+      Vec3 other_normal;
+      if (other >= 0) {
+        const auto o = static_cast<std::size_t>(other);
+        other_normal = mesh.normal(o);
+        // A body behind both sides is inside the solid the two make: the edge does not hold it.
+        if (!front && !in_front(mesh.triangle(o), other_normal)) continue;
+      }
+      flags |= contacts.edge(body, v, n, e, other >= 0 ? &other_normal : nullptr,
+                             3 * std::uint64_t{t} + e, settings);
+    }
+  }
+  // Vertex by vertex, as on a plane and a heightfield, so that a body on a flat floor gets its
+  // points in the order the plane gives them.
+  for (std::uint32_t index = 0; index < s.vertices.size(); ++index) {
+    const Vec3& x = s.vertices[index];
+    for (const FrontFace& face : s.faces) {
+      const double height = (x - face.v[0]).dot(face.n);
+      if (height > margin) continue;
+      // Below the plane: where the line from the centre crosses it; within the margin above it,
+      // the foot.
+      const Vec3 at =
+          height < 0 ? Vec3(translation + (x - translation) *
+                                              (face.centre_height / (face.centre_height - height)))
+                     : Vec3(x - height * face.n);
+      if (inside_triangle(face.v, face.n, at))
+        contacts.vertex_face_point(face.v, face.n, x, index, true);
+    }
+  }
+  contacts.finish(out);
+  return flags;
+}
+
+std::uint32_t collide_terrain(const Shape& a, const Pose& pose_a, const Shape& b,
+                              const Pose& pose_b, const CollisionSettings& settings,
+                              TerrainContacts* out) {
+  out->count = 0;
+  if (is_static_only(a.type()) && is_static_only(b.type())) return kCollisionOk;
+  const bool b_is_terrain = is_terrain(b.type());
+  const Shape& body = b_is_terrain ? a : b;
+  const Shape& terrain = b_is_terrain ? b : a;
+  const Pose& body_pose = b_is_terrain ? pose_a : pose_b;
+  const Pose& terrain_pose = b_is_terrain ? pose_b : pose_a;
+  const Mat3 terrain_rotation = terrain_pose.orientation.toRotationMatrix();
+  const Mat3 rotation = terrain_rotation.transpose() * body_pose.orientation.toRotationMatrix();
+  const Vec3 translation =
+      terrain_rotation.transpose() * (body_pose.position - terrain_pose.position);
+  const std::uint32_t flags =
+      terrain.type() == ShapeType::kMesh
+          ? collide_mesh(body, rotation, translation, *terrain.mesh(), settings, out)
+          : collide_height_field(body, rotation, translation, *terrain.height_field(), settings,
+                                 out);
+  for (int c = 0; c < out->count; ++c) {
+    ContactManifold& m = out->manifolds[c];
+    manifold_to_world(terrain_rotation, terrain_pose.position, &m);
+    if (b_is_terrain) continue;
+    m.normal = -m.normal;
+    for (int i = 0; i < m.count; ++i)
+      std::swap(m.points[i].point_a, m.points[i].point_b);
+  }
+  return flags;
+}
+
+}  // namespace tumble

@@ -1,0 +1,232 @@
+#include "physics/triangle_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace tumble {
+namespace {
+
+float round_down(double x) {
+  const float f = static_cast<float>(x);
+  return f > x ? std::nextafter(f, -HUGE_VALF) : f;
+}
+float round_up(double x) {
+  const float f = static_cast<float>(x);
+  return f < x ? std::nextafter(f, HUGE_VALF) : f;
+}
+
+constexpr std::uint32_t kLeafTriangles = 4;
+
+}  // namespace
+
+Result<TriangleMesh> TriangleMesh::create(const TriangleMeshDef& def) {
+  if (def.vertices.size() > kMaxMeshVertices)
+    return Status::error("vertices: " + std::to_string(def.vertices.size()) + ", more than the " +
+                         std::to_string(kMaxMeshVertices) + " a mesh may have");
+  if (def.triangles.empty()) return Status::error("triangles: a mesh needs at least one");
+  if (def.triangles.size() > kMaxMeshTriangles)
+    return Status::error("triangles: " + std::to_string(def.triangles.size()) + ", more than the " +
+                         std::to_string(kMaxMeshTriangles) + " a mesh may have");
+  for (std::size_t k = 0; k < def.vertices.size(); ++k)
+    if (!def.vertices[k].allFinite() ||
+        !(def.vertices[k].cwiseAbs().maxCoeff() <= kMaxMeshCoordinate))
+      return Status::error("vertices[" + std::to_string(k) + "]: must be finite, within 1e6 m");
+  TriangleMesh mesh;
+  double longest_edge = 0;
+  for (std::size_t t = 0; t < def.triangles.size(); ++t) {
+    for (std::uint32_t index : def.triangles[t])
+      if (index >= def.vertices.size())
+        return Status::error("triangles[" + std::to_string(t) + "]: vertex " +
+                             std::to_string(index) + " of " + std::to_string(def.vertices.size()));
+    const auto& [a, b, c] = def.triangles[t];
+    const Vec3 &p = def.vertices[a], &q = def.vertices[b], &r = def.vertices[c];
+    const double longest =
+        std::max({(q - p).squaredNorm(), (r - q).squaredNorm(), (p - r).squaredNorm()});
+    if (!((q - p).cross(r - p).norm() > 1e-12 * longest))
+      return Status::error("triangles[" + std::to_string(t) +
+                           "]: degenerate (its corners are repeated or in a line)");
+    longest_edge = std::max(longest_edge, std::sqrt(longest));
+  }
+  mesh.def_ = def;
+  mesh.feature_size_ = longest_edge;
+  for (const auto& triangle : def.triangles)
+    for (std::uint32_t index : triangle)
+      mesh.bounds_.grow(def.vertices[index]);
+  mesh.build_adjacency();
+  mesh.build_tree();
+  return mesh;
+}
+
+Vec3 TriangleMesh::normal(std::size_t t) const {
+  const std::array<Vec3, 3> v = triangle(t);
+  return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+}
+
+void TriangleMesh::build_adjacency() {
+  // Every edge keyed by its lower and higher vertex; equal keys sort together.
+  struct EdgeUse {
+    std::uint64_t key;
+    std::uint32_t triangle;
+    std::uint8_t edge;
+  };
+  const std::size_t count = triangle_count();
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * count);
+  for (std::size_t t = 0; t < count; ++t) {
+    for (int e = 0; e < 3; ++e) {
+      const std::uint64_t a = def_.triangles[t][e], b = def_.triangles[t][(e + 1) % 3];
+      uses.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<std::uint32_t>(t),
+                      static_cast<std::uint8_t>(e)});
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.key != y.key ? x.key < y.key : x.triangle < y.triangle;
+  });
+  neighbours_.assign(3 * count, -1);
+  for (std::size_t k = 0; k < uses.size();) {
+    std::size_t end = k + 1;
+    while (end < uses.size() && uses[end].key == uses[k].key)
+      ++end;
+    // Two triangles winding the edge in opposite directions: their fronts agree, and the edge
+    // joins them. Anything else (three sheets on one edge, a flipped neighbour) is a boundary.
+    if (end - k == 2) {
+      const EdgeUse& x = uses[k];
+      const EdgeUse& y = uses[k + 1];
+      if (def_.triangles[x.triangle][x.edge] == def_.triangles[y.triangle][(y.edge + 1) % 3]) {
+        neighbours_[3 * x.triangle + x.edge] = static_cast<std::int32_t>(y.triangle);
+        neighbours_[3 * y.triangle + y.edge] = static_cast<std::int32_t>(x.triangle);
+      }
+    }
+    k = end;
+  }
+  // Convex edges are active, as on a heightfield (height_field.cc): the neighbour's far corner
+  // clearly behind this triangle's plane and the two turning by more than kSmoothEdgeAngle.
+  const double smooth = std::cos(kSmoothEdgeAngle);
+  active_edges_.assign(count, 0);
+  for (std::size_t t = 0; t < count; ++t) {
+    const std::array<Vec3, 3> v = triangle(t);
+    const Vec3 n = normal(t);
+    const double flat =
+        1e-9 * std::sqrt(std::max({(v[1] - v[0]).squaredNorm(), (v[2] - v[1]).squaredNorm(),
+                                   (v[0] - v[2]).squaredNorm()}));
+    std::uint8_t bits = 0;
+    for (int e = 0; e < 3; ++e) {
+      const std::int64_t other = neighbour(t, e);
+      if (other < 0) {
+        bits |= 1u << e;
+        continue;
+      }
+      const std::array<Vec3, 3> w = triangle(static_cast<std::size_t>(other));
+      double behind = 0;
+      for (const Vec3& q : w)
+        behind = std::min(behind, (q - v[0]).dot(n));
+      if (behind < -flat && normal(static_cast<std::size_t>(other)).dot(n) < smooth)
+        bits |= 1u << e;
+    }
+    active_edges_[t] = bits;
+  }
+}
+
+void TriangleMesh::build_tree() {
+  const std::size_t count = triangle_count();
+  order_.resize(count);
+  std::vector<Vec3> centres(count);
+  for (std::size_t t = 0; t < count; ++t) {
+    order_[t] = static_cast<std::uint32_t>(t);
+    const std::array<Vec3, 3> v = triangle(t);
+    centres[t] = (v[0] + v[1] + v[2]) / 3;
+  }
+  nodes_.clear();
+  nodes_.reserve(2 * (count / kLeafTriangles + 1));
+  nodes_.push_back({});
+  // Each entry: a node to fill from order_[first, first + count). Splitting at the median keeps
+  // the tree balanced, so its depth is bounded by the logarithm of the triangle count.
+  struct Task {
+    std::uint32_t node, first, count;
+  };
+  std::vector<Task> tasks{{0, 0, static_cast<std::uint32_t>(count)}};
+  while (!tasks.empty()) {
+    const Task task = tasks.back();
+    tasks.pop_back();
+    Aabb box, centre_box;
+    for (std::uint32_t k = task.first; k < task.first + task.count; ++k) {
+      const auto& triangle = def_.triangles[order_[k]];
+      for (std::uint32_t index : triangle)
+        box.grow(def_.vertices[index]);
+      centre_box.grow(centres[order_[k]]);
+    }
+    Node& node = nodes_[task.node];
+    for (int k = 0; k < 3; ++k) {
+      node.min[k] = round_down(box.min[k]);
+      node.max[k] = round_up(box.max[k]);
+    }
+    if (task.count <= kLeafTriangles) {
+      node.first = task.first;
+      node.count = task.count;
+      continue;
+    }
+    int axis = 0;
+    centre_box.extent().maxCoeff(&axis);
+    const std::uint32_t half = task.count / 2;
+    std::nth_element(
+        order_.begin() + task.first, order_.begin() + task.first + half,
+        order_.begin() + task.first + task.count, [&](std::uint32_t x, std::uint32_t y) {
+          return centres[x][axis] != centres[y][axis] ? centres[x][axis] < centres[y][axis] : x < y;
+        });
+    const auto left = static_cast<std::uint32_t>(nodes_.size());
+    node.first = left;
+    node.count = 0;
+    nodes_.push_back({});
+    nodes_.push_back({});
+    tasks.push_back({left, task.first, half});
+    tasks.push_back({left + 1, task.first + half, task.count - half});
+  }
+}
+
+TriangleMeshDef mesh_of_height_field(const HeightField& field) {
+  TriangleMeshDef mesh;
+  const HeightFieldDef& def = field.def();
+  mesh.vertices.reserve(std::size_t{def.samples_x} * def.samples_y);
+  for (std::uint32_t j = 0; j < def.samples_y; ++j)
+    for (std::uint32_t i = 0; i < def.samples_x; ++i)
+      mesh.vertices.push_back(field.sample(i, j));
+  mesh.triangles.reserve(field.triangle_count());
+  const auto at = [&](std::uint32_t i, std::uint32_t j) { return j * def.samples_x + i; };
+  for (std::uint32_t j = 0; j < field.cells_y(); ++j) {
+    for (std::uint32_t i = 0; i < field.cells_x(); ++i) {
+      mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  return mesh;
+}
+
+bool TriangleMesh::triangles_meeting(const Aabb& box, std::vector<std::uint32_t>* out,
+                                     std::size_t limit) const {
+  out->clear();
+  const auto meets = [&box](const Node& node) {
+    for (int k = 0; k < 3; ++k)
+      if (!(node.min[k] <= box.max[k] && box.min[k] <= node.max[k])) return false;
+    return true;
+  };
+  std::array<std::uint32_t, 2 * kMaxDepth> stack;
+  int size = 0;
+  stack[size++] = 0;
+  while (size > 0) {
+    const Node& node = nodes_[stack[--size]];
+    if (!meets(node)) continue;
+    if (node.count == 0) {
+      stack[size++] = node.first;
+      stack[size++] = node.first + 1;
+      continue;
+    }
+    for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+      if (out->size() == limit) return false;
+      out->push_back(order_[k]);
+    }
+  }
+  return true;
+}
+
+}  // namespace tumble

@@ -1,0 +1,283 @@
+// Triangle meshes: refusals that name the field; adjacency and which edges may push; bodies at
+// rest on a triangulated floor where they rest on the plane, and a sliding box stopping where it
+// stops on the plane; terrain as a mesh giving what the heightfield gives; one-sided triangles
+// (a room's inside, a cube's outside, a box hanging over an edge); rays against brute force;
+// bounded work for a huge body; snapshots bit for bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "physics/world.h"
+#include "terrain_support.h"
+
+namespace tumble {
+namespace {
+
+using namespace terrain_testing;
+
+TriangleMeshDef mesh_of(const HeightFieldDef& def) {
+  return mesh_of_height_field(HeightField::create(def).value());
+}
+
+// The box [-h, h]^3 as 12 triangles facing out (or in, for a room).
+TriangleMeshDef cube_mesh(const Vec3& h, bool facing_in) {
+  TriangleMeshDef mesh;
+  for (int k = 0; k < 8; ++k)
+    mesh.vertices.push_back(
+        Vec3(k & 1 ? h.x() : -h.x(), k & 2 ? h.y() : -h.y(), k & 4 ? h.z() : -h.z()));
+  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    mesh.triangles.push_back({q[0], q[1], q[2]});
+    mesh.triangles.push_back({q[0], q[2], q[3]});
+  }
+  if (facing_in)
+    for (auto& t : mesh.triangles)
+      std::swap(t[1], t[2]);
+  return mesh;
+}
+
+std::string refusal(const TriangleMeshDef& def) {
+  const Result<Shape> shape = Shape::create(def);
+  return shape ? "" : shape.status().message();
+}
+
+TEST(TriangleMesh, RefusesBadDefinitionsNamingTheField) {
+  const TriangleMeshDef good = cube_mesh(Vec3(1, 1, 1), false);
+  EXPECT_EQ(refusal(good), "");
+  EXPECT_NE(refusal(TriangleMeshDef{good.vertices, {}}).find("triangles: a mesh needs"),
+            std::string::npos);
+  TriangleMeshDef bad = good;
+  bad.triangles[5][2] = 8;
+  EXPECT_NE(refusal(bad).find("triangles[5]: vertex 8 of 8"), std::string::npos) << refusal(bad);
+  bad = good;
+  bad.triangles[3] = {1, 1, 2};
+  EXPECT_NE(refusal(bad).find("triangles[3]: degenerate"), std::string::npos);
+  bad = good;
+  bad.vertices.push_back(Vec3(0.5, 0.5, 0.5));
+  bad.triangles.push_back({0, 7, 8});  // the three in a line
+  EXPECT_NE(refusal(bad).find("triangles[12]: degenerate"), std::string::npos);
+  bad = good;
+  bad.vertices[4].y() = std::nan("");
+  EXPECT_NE(refusal(bad).find("vertices[4]: must be finite"), std::string::npos);
+  bad = good;
+  bad.vertices[2].x() = 2e6;
+  EXPECT_NE(refusal(bad).find("vertices[2]"), std::string::npos);
+  bad = good;
+  bad.vertices.resize(kMaxMeshVertices + 1, Vec3::Zero());
+  EXPECT_NE(refusal(bad).find("vertices: 2097153, more than the 2097152"), std::string::npos);
+  // A mesh is static only.
+  World world;
+  BodyDef def;
+  def.shape = good;
+  def.mass = 1;
+  const Result<BodyId> dynamic = world.create_body(def);
+  ASSERT_FALSE(dynamic);
+  EXPECT_EQ(dynamic.status().message(), "type: a mesh must be static");
+  EXPECT_EQ(world.body_count(), 0u);
+}
+
+TEST(TriangleMesh, KnowsItsNeighboursAndWhichEdgesAreConvex) {
+  const TriangleMesh cube = TriangleMesh::create(cube_mesh(Vec3(1, 2, 3), false)).value();
+  for (std::size_t t = 0; t < cube.triangle_count(); ++t) {
+    for (int e = 0; e < 3; ++e) {
+      const std::int64_t other = cube.neighbour(t, e);
+      ASSERT_GE(other, 0) << t << " " << e;  // closed
+      const bool diagonal = cube.normal(t).dot(cube.normal(static_cast<std::size_t>(other))) > 0.5;
+      // A face's diagonal is flat: inactive; the cube's edges are convex: active.
+      EXPECT_EQ((cube.active_edges(t) >> e) & 1, diagonal ? 0 : 1) << t << " " << e;
+    }
+  }
+  // Inside out, every edge is concave: none is active.
+  const TriangleMesh room = TriangleMesh::create(cube_mesh(Vec3(1, 2, 3), true)).value();
+  for (std::size_t t = 0; t < room.triangle_count(); ++t)
+    EXPECT_EQ(room.active_edges(t), 0) << t;
+  // A triangle wound against its neighbours joins none of them: its edges are boundaries.
+  TriangleMeshDef flipped = cube_mesh(Vec3(1, 1, 1), false);
+  std::swap(flipped.triangles[0][1], flipped.triangles[0][2]);
+  const TriangleMesh open = TriangleMesh::create(flipped).value();
+  for (int e = 0; e < 3; ++e) {
+    EXPECT_EQ(open.neighbour(0, e), -1);
+    EXPECT_EQ((open.active_edges(0) >> e) & 1, 1);
+  }
+}
+
+TEST(TriangleMesh, BodiesRestOnATriangulatedFloorAsOnThePlane) {
+  const TriangleMeshDef floor = mesh_of(field_of(21, 21, 0.5, [](double, double) { return 0.0; }));
+  for (const ShapeDef& body : {ShapeDef{BoxDef{Vec3(0.3, 0.2, 0.1)}}, ShapeDef{SphereDef{0.2}},
+                               ShapeDef{CapsuleDef{0.1, 0.3}}}) {
+    const Vec3 at(0.13, -0.41, 0.5);
+    EXPECT_NEAR(rest_height(floor, body, at), rest_height(HalfSpaceDef{}, body, at), 1e-9);
+  }
+}
+
+TEST(TriangleMesh, SlidingBoxStopsWhereItStopsOnThePlane) {
+  // 5 m/s across a floor of 0.5 m cells, over many inner edges and both diagonals' directions.
+  const TriangleMeshDef floor = mesh_of(field_of(81, 81, 0.5, [](double, double) { return 0.0; }));
+  auto stop = [](const ShapeDef& ground) {
+    World world;
+    add_static(&world, ground);
+    BodyDef box;
+    box.shape = BoxDef{Vec3(0.25, 0.25, 0.25)};
+    box.mass = 1;
+    box.friction = 0.5;
+    box.position = Vec3(-12, -3.1, 0.25);
+    box.linear_velocity = Vec3(4.5, 2.18, 0);  // 5 m/s
+    const BodyId id = world.create_body(box).value();
+    run(&world, 180);
+    return world.body(id)->position();
+  };
+  const Vec3 on_plane = stop(HalfSpaceDef{});
+  const Vec3 on_mesh = stop(floor);
+  EXPECT_GT((on_plane - Vec3(-12, -3.1, 0.25)).norm(), 2.0);  // it did slide
+  EXPECT_LT((on_mesh - on_plane).norm(), 1e-6);
+}
+
+TEST(TriangleMesh, SphereAndBoxRestInAValleyAndOnARidgeAsOnTheHeightfield) {
+  const double r = 0.3, slope = 0.5;
+  const double a = std::atan(slope);
+  const TriangleMeshDef valley =
+      mesh_of(field_of(9, 9, 0.5, [&](double, double y) { return slope * std::abs(y); }));
+  const TriangleMeshDef ridge =
+      mesh_of(field_of(9, 9, 0.5, [&](double, double y) { return -slope * std::abs(y); }));
+  EXPECT_NEAR(rest_height(valley, SphereDef{r}, Vec3(0.1, 0, 1)), r / std::cos(a), 1e-4);
+  EXPECT_NEAR(rest_height(ridge, SphereDef{r}, Vec3(0.1, 0, 1)), r, 1e-4);
+  EXPECT_NEAR(rest_height(ridge, BoxDef{Vec3(0.2, 0.2, 0.1)}, Vec3(0.1, 0, 1)), 0.1, 1e-4);
+}
+
+TEST(TriangleMesh, TrianglesHoldBodiesOnTheirFrontOnly) {
+  // On a closed cube (facing out): a box rests on its top.
+  EXPECT_NEAR(rest_height(cube_mesh(Vec3(1, 1, 0.5), false), BoxDef{Vec3(0.2, 0.2, 0.2)},
+                          Vec3(0.3, -0.2, 1.2)),
+              0.7, 1e-4);
+  // Inside a room (facing in): a box rests on its floor, the ceiling above it no hindrance.
+  EXPECT_NEAR(
+      rest_height(cube_mesh(Vec3(2, 2, 1), true), BoxDef{Vec3(0.2, 0.2, 0.2)}, Vec3(0.3, -0.2, 0)),
+      -0.8, 1e-4);
+  // A box hanging two thirds of its length over the cube's top edge tips off it; the side its
+  // lower corners come to lie behind never throws it sideways.
+  World world;
+  add_static(&world, cube_mesh(Vec3(1, 1, 0.5), false));
+  const BodyId box = add_dynamic(&world, BoxDef{Vec3(0.3, 0.2, 0.1)}, Vec3(1.1, 0, 0.601));
+  double fastest_sideways = 0;
+  for (int k = 0; k < 60; ++k) {
+    run(&world, 1);
+    fastest_sideways = std::max(fastest_sideways, std::abs(world.body(box)->linear_velocity().y()));
+    fastest_sideways = std::max(fastest_sideways, world.body(box)->linear_velocity().x());
+  }
+  EXPECT_LT(fastest_sideways, 1.0);
+  EXPECT_LT(world.body(box)->position().z(), 0.4);  // it fell past the top
+  EXPECT_GT(world.body(box)->position().x(), 1.0);  // beside the cube, not through it
+}
+
+TEST(TriangleMesh, RaysMeetTheNearestFrontAsBruteForceDoes) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  // Bumpy terrain and a closed cube floating over it: rays from everywhere, in every direction.
+  TriangleMeshDef def = mesh_of(field_of(33, 25, 0.37, [&](double x, double y) {
+    return 0.4 * std::sin(1.3 * x) * std::cos(0.9 * y) + 0.05 * unit(random);
+  }));
+  const TriangleMeshDef cube = cube_mesh(Vec3(1, 0.7, 0.4), false);
+  const auto first = static_cast<std::uint32_t>(def.vertices.size());
+  for (const Vec3& v : cube.vertices)
+    def.vertices.push_back(v + Vec3(0.5, 0.2, 1.5));
+  for (auto t : cube.triangles)
+    def.triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
+  World world;
+  const Vec3 at(2, -1, 0.5);
+  add_static(&world, def, at);
+  const TriangleMesh mesh = TriangleMesh::create(def).value();
+  int hits = 0;
+  for (int k = 0; k < 4000; ++k) {
+    const Vec3 origin(5 * unit(random), 4 * unit(random), 1.5 + 2 * unit(random));
+    const Vec3 direction = Vec3(unit(random), unit(random), unit(random)).normalized();
+    RayCast ray;
+    ray.origin = origin + at;
+    ray.direction = direction;
+    ray.max_distance = 10;
+    const RayHit hit = world.cast_ray(ray).value();
+    const double expected = brute_force_ray(
+        mesh.triangle_count(), [&](std::size_t t) { return mesh.triangle(t); }, origin,
+        direction, 10);
+    ASSERT_EQ(hit.hit(), expected <= 10) << k;
+    if (!hit.hit()) continue;
+    EXPECT_NEAR(hit.distance, expected, 1e-9) << k;
+    EXPECT_LT(hit.normal.dot(direction), 0) << k;
+    ++hits;
+  }
+  EXPECT_GT(hits, 1000);
+}
+
+// 64 boxes dropped on bumpy terrain made a mesh: no centre ever comes nearer the surface under
+// it than half a box's thickness allows, and they come to rest.
+TEST(TriangleMesh, PileOfBoxesComesToRestOnTerrainMadeAMesh) {
+  const TriangleMeshDef def = mesh_of(field_of(41, 41, 0.5, [](double x, double y) {
+    return 0.3 * std::sin(0.8 * x) * std::sin(0.7 * y) + 0.1 * std::cos(2.1 * x + 0.3 * y);
+  }));
+  World world;
+  add_static(&world, def);
+  std::vector<BodyId> bodies;
+  for (int k = 0; k < 64; ++k) {
+    const Vec3 at(-3.5 + (k % 8), -3.5 + (k / 8) % 8, 1.5 + 0.2 * (k % 3));
+    bodies.push_back(add_dynamic(&world, BoxDef{Vec3(0.2, 0.15, 0.1)}, at));
+  }
+  World terrain;
+  add_static(&terrain, def);
+  for (int chunk = 0; chunk < 15; ++chunk) {
+    run(&world, 20);
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      const BodyView body = world.body(bodies[k]);
+      RayCast down;
+      down.origin = body.position() + Vec3(0, 0, 5);
+      down.direction = -Vec3::UnitZ();
+      down.max_distance = 20;
+      const RayHit surface = terrain.cast_ray(down).value();
+      ASSERT_TRUE(surface.hit());
+      EXPECT_GT(body.position().z() - surface.point.z(), 0.05) << k << " at " << chunk;
+      if (chunk == 14) {
+        EXPECT_LT(body.linear_velocity().norm(), 1e-3) << k;
+      }
+    }
+  }
+}
+
+// A body over more triangles than a pair may visit is met on the first kMaxTerrainTriangles of
+// them, and the narrow phase says so; a body over fewer is met whole and raises nothing.
+TEST(TriangleMesh, AHugeBodyVisitsABoundedNumberOfTrianglesAndSaysSo) {
+  const Shape mesh =
+      Shape::create(mesh_of(field_of(401, 401, 0.5, [](double, double) { return 0.0; }))).value();
+  const Shape huge = Shape::create(BoxDef{Vec3(90, 90, 1)}).value();
+  const Shape small = Shape::create(BoxDef{Vec3(1, 1, 1)}).value();
+  ContactManifold manifold;
+  const Pose ground;
+  const Pose resting{Vec3(0, 0, 0.999), Quat::Identity()};
+  EXPECT_NE(
+      collide(huge, resting, mesh, ground, CollisionSettings{}, &manifold) & kTerrainCellLimit, 0u);
+  EXPECT_EQ(collide(small, resting, mesh, ground, CollisionSettings{}, &manifold), 0u);
+  EXPECT_EQ(manifold.count, 4);
+  EXPECT_NEAR(manifold.depth, 0.001, 1e-12);
+}
+
+TEST(TriangleMesh, SnapshotsStepBitForBit) {
+  const TriangleMeshDef def = mesh_of(
+      field_of(17, 13, 0.6, [](double x, double y) { return 0.2 * std::sin(x) * std::cos(y); }));
+  World world;
+  add_static(&world, def, Vec3(0.5, 0, -0.2));
+  for (int k = 0; k < 12; ++k)
+    add_dynamic(&world, BoxDef{Vec3(0.2, 0.2, 0.2)}, Vec3(-2 + 0.8 * (k % 6), (k / 6) - 0.5, 1));
+  run(&world, 40);
+  const std::string saved = world.save_state();
+  World copy;
+  ASSERT_TRUE(copy.restore_state(saved).is_ok());
+  EXPECT_EQ(copy.save_state(), saved);
+  run(&world, 30);
+  run(&copy, 30);
+  EXPECT_EQ(copy.save_state(), world.save_state());
+}
+
+}  // namespace
+}  // namespace tumble
