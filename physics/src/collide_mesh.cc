@@ -4,7 +4,10 @@
 // is in front of it (one-sided, as Jolt's and Bullet's meshes are by default), and a body vertex
 // counts for a triangle only where the line from the centre to it crosses the triangle: a box
 // hanging over a mesh cube's top edge then meets the top, not the side its lower corners lie
-// behind.
+// behind. And where that line crosses several triangles that do not make a concave corner (both
+// slopes of a ridge, two faces of gently curved terrain), the vertex counts for the one it
+// crosses first only: as on a heightfield, where a vertex is over one triangle, a body resting
+// across an edge gets one manifold and not two of almost the same normal.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -24,11 +27,27 @@ struct FrontFace {
   double centre_height;  // of the body's centre over the plane, > 0
 };
 
+// A face a vertex counts for, and where the line from the body's centre to the vertex crosses
+// the face's plane: a fraction of the way (past 1 for a vertex in front of the plane).
+struct Crossing {
+  const FrontFace* face;
+  double at;
+};
+
 struct MeshScratch {
   std::vector<std::uint32_t> triangles;
   std::vector<Vec3> vertices;  // the body's, in the mesh's frame
   std::vector<FrontFace> faces;
+  std::vector<Crossing> crossings;
 };
+
+// Whether triangles a and b make a concave corner: some corner of b clearly in front of a's plane.
+bool concave(const FrontFace& a, const FrontFace& b) {
+  const double flat = 1e-9 * (a.v[1] - a.v[0]).norm();
+  for (const Vec3& q : b.v)
+    if ((q - a.v[0]).dot(a.n) > flat) return true;
+  return false;
+}
 
 MeshScratch& mesh_scratch() {
   thread_local MeshScratch scratch;
@@ -96,17 +115,23 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
   // points in the order the plane gives them.
   for (std::uint32_t index = 0; index < s.vertices.size(); ++index) {
     const Vec3& x = s.vertices[index];
+    s.crossings.clear();
     for (const FrontFace& face : s.faces) {
       const double height = (x - face.v[0]).dot(face.n);
       if (height > margin) continue;
       // Below the plane: where the line from the centre crosses it; within the margin above it,
       // the foot.
-      const Vec3 at =
-          height < 0 ? Vec3(translation + (x - translation) *
-                                              (face.centre_height / (face.centre_height - height)))
-                     : Vec3(x - height * face.n);
-      if (inside_triangle(face.v, face.n, at))
-        contacts.vertex_face_point(face.v, face.n, x, index, true);
+      const double at = face.centre_height / (face.centre_height - height);
+      const Vec3 point = height < 0 ? Vec3(translation + (x - translation) * at)
+                                    : Vec3(x - height * face.n);
+      if (inside_triangle(face.v, face.n, point)) s.crossings.push_back({&face, at});
+    }
+    for (const Crossing& c : s.crossings) {
+      const bool entered_elsewhere = std::any_of(
+          s.crossings.begin(), s.crossings.end(), [&](const Crossing& d) {
+            return (d.at < c.at || (d.at == c.at && d.face < c.face)) && !concave(*c.face, *d.face);
+          });
+      if (!entered_elsewhere) contacts.vertex_face_point(c.face->v, c.face->n, x, index, true);
     }
   }
   contacts.finish(out);
