@@ -37,20 +37,11 @@ bool ray_mesh(const TriangleMesh& mesh, const Vec3& origin, const Vec3& directio
   const auto& nodes = mesh.nodes();
   double best = max_t;
   std::int64_t best_triangle = -1;
-  // Each node waiting with where the ray enters it: one entered beyond the nearest hit found
-  // since it was pushed is dropped unopened.
-  struct Waiting {
-    std::uint32_t node;
-    double enter;
-  };
-  std::array<Waiting, 2 * TriangleMesh::kMaxDepth> stack;
+  std::array<std::uint32_t, 2 * TriangleMesh::kMaxDepth> stack;
   int size = 0;
-  if (const double enter = enter_node(nodes[0], origin, inverse, best); enter <= best)
-    stack[size++] = {0, enter};
+  if (enter_node(nodes[0], origin, inverse, best) <= best) stack[size++] = 0;
   while (size > 0) {
-    const Waiting waiting = stack[--size];
-    if (waiting.enter > best) continue;
-    const TriangleMesh::Node& node = nodes[waiting.node];
+    const TriangleMesh::Node& node = nodes[stack[--size]];
     if (node.count == 0) {
       const double near = enter_node(nodes[node.first], origin, inverse, best);
       const double far = enter_node(nodes[node.first + 1], origin, inverse, best);
@@ -59,7 +50,7 @@ bool ray_mesh(const TriangleMesh& mesh, const Vec3& origin, const Vec3& directio
       const std::uint32_t children[2] = {node.first, node.first + 1};
       const double enters[2] = {near, far};
       for (int k : {left_first ? 1 : 0, left_first ? 0 : 1})
-        if (enters[k] <= best) stack[size++] = {children[k], enters[k]};
+        if (enters[k] <= best) stack[size++] = children[k];
       continue;
     }
     for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
