@@ -64,7 +64,7 @@ class BulletSimulation final : public Simulation {
     } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
       shape = std::make_unique<btCapsuleShapeZ>(capsule->radius, 2 * capsule->half_height);
     } else {
-      *why_not = "hulls are not mapped to Bullet";
+      *why_not = "hulls, heightfields and meshes are not mapped to Bullet";
       return false;
     }
     // A kinematic body is Bullet's: no mass, CF_KINEMATIC_OBJECT, moved through its motion state
