@@ -63,8 +63,17 @@ class BulletSimulation final : public Simulation {
       shape = std::make_unique<btSphereShape>(sphere->radius);
     } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
       shape = std::make_unique<btCapsuleShapeZ>(capsule->radius, 2 * capsule->half_height);
+    } else if (const auto* mesh = std::get_if<TriangleMeshDef>(&def.shape)) {
+      // A btBvhTriangleMeshShape as a user makes one, without btAdjustInternalEdgeContacts (an
+      // optional contact callback): its inner edges are what the mesh scenes measure.
+      auto triangles = std::make_unique<btTriangleMesh>();
+      for (const auto& t : mesh->triangles)
+        triangles->addTriangle(to_bt(mesh->vertices[t[0]]), to_bt(mesh->vertices[t[1]]),
+                               to_bt(mesh->vertices[t[2]]));
+      shape = std::make_unique<btBvhTriangleMeshShape>(triangles.get(), true);
+      meshes_.push_back(std::move(triangles));
     } else {
-      *why_not = "hulls, heightfields and meshes are not mapped to Bullet";
+      *why_not = "hulls and heightfields are not mapped to Bullet";
       return false;
     }
     // A kinematic body is Bullet's: no mass, CF_KINEMATIC_OBJECT, moved through its motion state
@@ -204,6 +213,8 @@ class BulletSimulation final : public Simulation {
   btSequentialImpulseConstraintSolver solver_;
   btDiscreteDynamicsWorld world_;
   double dt_;
+  // The triangles of shapes_' meshes, declared first so that the shapes go before them.
+  std::vector<std::unique_ptr<btTriangleMesh>> meshes_;
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btDefaultMotionState>> states_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
