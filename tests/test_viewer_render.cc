@@ -249,6 +249,49 @@ TEST_F(RenderTest, FramesBecomeInstancesWithAnOptionalContactOverlay) {
   EXPECT_FLOAT_EQ(overlay[renderer_->sphere_mesh()][0].model(0, 0), 0.015f * around->second);
 }
 
+// A mesh body is drawn as its own triangles, once however many frames name it; like the ground it
+// does not enlarge the sphere the camera frames.
+TEST_F(RenderTest, MeshBodiesAreDrawnAsTheirTriangles) {
+  v1::Frame frame;
+  v1::BodyDescription* box = frame.add_added();
+  box->set_id(7);
+  v1::Vec3* size = box->mutable_shape()->mutable_box()->mutable_size();
+  size->set_x(1);
+  size->set_y(1);
+  size->set_z(1);
+  v1::BodyDescription* floor = frame.add_added();
+  floor->set_id(9);
+  floor->set_type(v1::BODY_TYPE_STATIC);
+  v1::Mesh* mesh = floor->mutable_shape()->mutable_mesh();
+  for (double v : {-50.0, -50.0, 0.0, 50.0, -50.0, 0.0, 50.0, 50.0, 0.0, -50.0, 50.0, 0.0})
+    mesh->add_vertices(v);
+  for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u})
+    mesh->add_triangles(i);
+  for (std::uint64_t id : {7u, 9u})
+    frame.add_ids(id);
+  for (double v : {0.0, 0.0, 3.0, 0.0, 0.0, 0.0})
+    frame.add_positions(v);
+  for (int body = 0; body < 2; ++body)
+    for (double v : {1.0, 0.0, 0.0, 0.0})
+      frame.add_orientations(v);
+  WorldView view;
+  view.apply(frame);
+  view.apply(frame);
+  const auto drawn = view.instances(*renderer_);
+  std::size_t instances = 0, other_meshes = 0;
+  for (std::size_t m = 0; m < drawn.size(); ++m) {
+    instances += drawn[m].size();
+    if (!drawn[m].empty() && static_cast<int>(m) != renderer_->box_mesh()) ++other_meshes;
+  }
+  EXPECT_EQ(instances, 2u);  // the box and the mesh
+  EXPECT_EQ(drawn[renderer_->box_mesh()].size(), 1u);
+  EXPECT_EQ(other_meshes, 1u);
+  const auto around = view.bounds();
+  ASSERT_TRUE(around.has_value());
+  EXPECT_NEAR(around->first.z(), 3.0f, 1e-5f);  // the box's centre: the 100 m floor left out
+  EXPECT_LT(around->second, 2.0f);
+}
+
 // A frame's joints (asked for) become a ball at each anchor and a rod along each axis; a frame
 // without them draws none.
 TEST_F(RenderTest, JointsBecomeAnOverlayOfAnchorsAndAxes) {
