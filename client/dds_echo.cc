@@ -83,9 +83,10 @@ Json stats_json(const tumble_msgs_msg_dds__StepStats_& m) {
 }
 
 Json body_json(const tumble_msgs_msg_dds__Body_& m) {
-  const char* shapes[] = {"sphere", "capsule", "box", "hull", "plane", "heightfield", "mesh"};
+  const char* shapes[] = {"sphere", "capsule",     "box",  "hull",
+                          "plane",  "heightfield", "mesh", "compound"};
   Json out = {{"topic", "bodies"},      {"id", m.id},
-              {"instance", m.instance}, {"shape", m.shape < 7 ? shapes[m.shape] : "unknown"},
+              {"instance", m.instance}, {"shape", m.shape < 8 ? shapes[m.shape] : "unknown"},
               {"static", m.is_static},  {"mass", m.mass},
               {"color", m.color}};
   if (m.shape == 0 || m.shape == 1) out["radius"] = m.radius;

@@ -40,6 +40,18 @@ Json shape_json(const v1::Shape& shape) {
                 {"triangles",
                  Json(std::vector<std::uint32_t>(m.triangles().begin(), m.triangles().end()))}}}};
     }
+    case v1::Shape::kCompound: {
+      Json parts = Json::array();
+      for (const v1::CompoundPart& part : shape.compound().parts()) {
+        const v1::Quat& q = part.orientation();
+        parts.push_back(
+            {{"shape", shape_json(part.shape())},
+             {"position", {part.position().x(), part.position().y(), part.position().z()}},
+             {"orientation", part.has_orientation() ? Json{q.w(), q.x(), q.y(), q.z()}
+                                                    : Json{1.0, 0.0, 0.0, 0.0}}});
+      }
+      return {{"compound", parts}};
+    }
     default:
       return {{"plane", true}};
   }

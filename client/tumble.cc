@@ -65,6 +65,8 @@ struct SpawnOptions {
   std::string mesh_file;  // mesh: an OBJ, STL, PLY, ... file (read by read_mesh_file)
   double mesh_scale = 1;
   v1::Mesh mesh;
+  std::vector<std::string> parts;  // compound: "box:1,1,0.1@0,0,1[@w,x,y,z]" each
+  v1::Compound compound;
   std::optional<double> gravity_scale, linear_damping, angular_damping;
   std::vector<double> force, torque;
   std::optional<std::uint32_t> layers, mask;
@@ -83,6 +85,8 @@ struct SpawnOptions {
     } else if (shape == "mesh") {
       *spec.mutable_shape()->mutable_mesh() = mesh;
       spec.set_type(v1::BODY_TYPE_STATIC);
+    } else if (shape == "compound") {
+      *spec.mutable_shape()->mutable_compound() = compound;
     } else {
       spec.mutable_shape()->mutable_capsule()->set_radius(radius);
       spec.mutable_shape()->mutable_capsule()->set_half_height(half_height);
@@ -149,14 +153,83 @@ Status read_heights(const std::string& path, v1::HeightField* out) {
   return Status::ok();
 }
 
+// Numbers parted by commas ("1,0.5,2"); false on anything else.
+bool read_numbers(const std::string& text, std::vector<double>* out) {
+  out->clear();
+  std::istringstream items(text);
+  std::string item;
+  while (std::getline(items, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size()) return false;
+    out->push_back(value);
+  }
+  return !text.empty() && text.back() != ',';
+}
+
+// A compound's part from --part: "box:SX,SY,SZ", "sphere:R" or "capsule:R,HALF_HEIGHT", then
+// "@X,Y,Z" (m, in the body's frame) and optionally "@W,X,Y,Z" (its orientation). The server
+// checks the sizes; this only reads the numbers and names the part that does not parse.
+Status read_part(const std::string& text, std::size_t index, v1::CompoundPart* out) {
+  const std::string field = "--part[" + std::to_string(index) + "]";
+  const std::string usage = field + ": '" + text +
+                            "' is not KIND:SIZES@X,Y,Z[@W,X,Y,Z] (box:SX,SY,SZ, sphere:R or "
+                            "capsule:R,HALF_HEIGHT)";
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos) return Status::error(usage);
+  const std::string kind = text.substr(0, colon);
+  std::vector<std::string> pieces;
+  std::istringstream rest(text.substr(colon + 1));
+  for (std::string piece; std::getline(rest, piece, '@');)
+    pieces.push_back(piece);
+  if (pieces.size() < 2 || pieces.size() > 3) return Status::error(usage);
+  std::vector<double> sizes, at, turn;
+  if (!read_numbers(pieces[0], &sizes) || !read_numbers(pieces[1], &at) || at.size() != 3 ||
+      (pieces.size() == 3 && (!read_numbers(pieces[2], &turn) || turn.size() != 4)))
+    return Status::error(usage);
+  if (kind == "box" && sizes.size() == 3) {
+    set_vec(sizes, out->mutable_shape()->mutable_box()->mutable_size());
+  } else if (kind == "sphere" && sizes.size() == 1) {
+    out->mutable_shape()->mutable_sphere()->set_radius(sizes[0]);
+  } else if (kind == "capsule" && sizes.size() == 2) {
+    out->mutable_shape()->mutable_capsule()->set_radius(sizes[0]);
+    out->mutable_shape()->mutable_capsule()->set_half_height(sizes[1]);
+  } else {
+    return Status::error(usage);
+  }
+  set_vec(at, out->mutable_position());
+  if (!turn.empty()) {
+    out->mutable_orientation()->set_w(turn[0]);
+    out->mutable_orientation()->set_x(turn[1]);
+    out->mutable_orientation()->set_y(turn[2]);
+    out->mutable_orientation()->set_z(turn[3]);
+  }
+  return Status::ok();
+}
+
+// A compound's --part options into its parts; --part belongs to a compound only.
+Status read_parts(SpawnOptions* options) {
+  if (options->shape != "compound") {
+    if (!options->parts.empty()) return Status::error("--part: only a compound has parts");
+    return Status::ok();
+  }
+  if (options->parts.empty())
+    return Status::error("--part: a compound needs at least one (KIND:SIZES@X,Y,Z)");
+  for (std::size_t i = 0; i < options->parts.size(); ++i)
+    if (Status s = read_part(options->parts[i], i, options->compound.add_parts()); !s) return s;
+  return Status::ok();
+}
+
 // The shape's options spawn and overlap share; spawn also takes terrain.
 void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = false) {
   const std::vector<std::string> shapes =
-      terrain ? std::vector<std::string>{"box", "sphere", "capsule", "heightfield", "mesh"}
-              : std::vector<std::string>{"box", "sphere", "capsule"};
+      terrain
+          ? std::vector<std::string>{"box", "sphere", "capsule", "heightfield", "mesh", "compound"}
+          : std::vector<std::string>{"box", "sphere", "capsule", "compound"};
   command
       ->add_option("shape", options->shape,
-                   terrain ? "box, sphere, capsule, heightfield or mesh" : "box, sphere or capsule")
+                   terrain ? "box, sphere, capsule, heightfield, mesh or compound"
+                           : "box, sphere, capsule or compound")
       ->required()
       ->check(CLI::IsMember(shapes));
   if (terrain) {
@@ -176,6 +249,9 @@ void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = 
     command->add_option("--scale", options->mesh_scale,
                         "mesh: multiplies every coordinate of the file (0.01 for cm)");
   }
+  command->add_option("--part", options->parts,
+                      "compound: one part, KIND:SIZES@X,Y,Z[@W,X,Y,Z] (box:SX,SY,SZ, sphere:R or "
+                      "capsule:R,HALF_HEIGHT at X,Y,Z in the body's frame); repeat for each");
   command->add_option("--size", options->size, "box: full extents x,y,z (m)")
       ->delimiter(',')
       ->expected(3);
@@ -586,6 +662,7 @@ int main(int argc, char** argv) {
     print_line(serving.value() ? "SERVING" : "NOT_SERVING");
     return serving.value() ? 0 : 1;
   } else if (*spawn) {
+    if (Status s = read_parts(&body); !s) return fail("spawn", s);
     if (body.shape == "heightfield") {
       if (body.heights_file.empty())
         return fail("spawn", Status::error("--heights: required for a heightfield"));
@@ -757,6 +834,7 @@ int main(int argc, char** argv) {
   } else if (*overlap) {
     v1::QueryRequest request;
     v1::OverlapQuery* query = request.add_overlaps();
+    if (Status s = read_parts(&probe); !s) return fail("overlap", s);
     const v1::BodySpec spec = probe.spec();
     *query->mutable_shape() = spec.shape();
     *query->mutable_position() = spec.position();
@@ -767,6 +845,7 @@ int main(int argc, char** argv) {
   } else if (*cast) {
     v1::QueryRequest request;
     v1::ShapeCastQuery* query = request.add_shape_casts();
+    if (Status s = read_parts(&swept); !s) return fail("cast", s);
     const v1::BodySpec spec = swept.spec();
     *query->mutable_shape() = spec.shape();
     *query->mutable_position() = spec.position();

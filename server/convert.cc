@@ -5,6 +5,8 @@
 #include <numbers>
 #include <string>
 
+#include "physics/compound.h"
+
 namespace tumble::server {
 namespace {
 
@@ -31,8 +33,63 @@ void set(const Vec3& v, v1::Vec3* out) {
   out->set_z(v.z());
 }
 
+Result<Quat> unit_quat(const v1::Quat& q, const std::string& field) {
+  const double norm = std::sqrt(q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z());
+  if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
+    return Status::error(field + ": must be a unit quaternion (|q| = " + std::to_string(norm) +
+                         ")");
+  return Quat(q.w() / norm, q.x() / norm, q.y() / norm, q.z() / norm);
+}
+
+Result<ShapeDef> shape_from_proto(const v1::Shape& shape);
+
+Result<ShapeDef> compound_from_proto(const v1::Compound& compound) {
+  // Counted before anything is built: each part costs a shape.
+  if (compound.parts().empty())
+    return Status::error("shape.compound.parts: a compound needs at least one part");
+  if (static_cast<std::size_t>(compound.parts().size()) > kMaxCompoundParts)
+    return Status::error("shape.compound.parts: " + std::to_string(compound.parts().size()) +
+                         " parts, more than the " + std::to_string(kMaxCompoundParts) +
+                         " a compound may have");
+  CompoundDef def;
+  def.parts.reserve(compound.parts().size());
+  for (int i = 0; i < compound.parts().size(); ++i) {
+    const v1::CompoundPart& given = compound.parts(i);
+    const std::string field = "shape.compound.parts[" + std::to_string(i) + "]";
+    // Refused before it is read: a compound inside a compound would recurse.
+    switch (given.shape().kind_case()) {
+      case v1::Shape::kBox:
+      case v1::Shape::kSphere:
+      case v1::Shape::kCapsule:
+      case v1::Shape::kHull:
+        break;
+      default:
+        return Status::error(field +
+                             ".shape: a compound's parts must be a box, sphere, capsule "
+                             "or hull");
+    }
+    Result<ShapeDef> shape = shape_from_proto(given.shape());
+    if (!shape) return Status::error(field + "." + shape.status().message());
+    CompoundPart part{std::move(shape).value(), Pose{}};
+    if (Status s = finite(given.position(), field + ".position"); !s) return s;
+    part.pose.position = vec(given.position());
+    if (given.has_orientation()) {
+      Result<Quat> q = unit_quat(given.orientation(), field + ".orientation");
+      if (!q) return q.status();
+      part.pose.orientation = q.value();
+    }
+    def.parts.push_back(std::move(part));
+  }
+  // The engine checks the rest (offsets, sizes) and names the part.
+  if (Result<Shape> built = Shape::create(def); !built)
+    return built.status().within("shape.compound.");
+  return ShapeDef{std::move(def)};
+}
+
 Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
   switch (shape.kind_case()) {
+    case v1::Shape::kCompound:
+      return compound_from_proto(shape.compound());
     case v1::Shape::kBox: {
       const v1::Vec3& size = shape.box().size();
       for (auto [value, axis] : {std::pair{size.x(), "x"}, {size.y(), "y"}, {size.z(), "z"}})
@@ -95,7 +152,8 @@ Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
     case v1::Shape::KIND_NOT_SET:
       break;
   }
-  return Status::error("shape: required (box, sphere, capsule, hull, plane, heightfield or mesh)");
+  return Status::error(
+      "shape: required (box, sphere, capsule, hull, plane, heightfield, mesh or compound)");
 }
 
 }  // namespace
@@ -135,12 +193,9 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   def.linear_velocity = vec(spec.linear_velocity());
   def.angular_velocity = vec(spec.angular_velocity());
   if (spec.has_orientation()) {
-    const v1::Quat& q = spec.orientation();
-    const double norm = std::sqrt(q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z());
-    if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3)
-      return Status::error("orientation: must be a unit quaternion (|q| = " + std::to_string(norm) +
-                           ")");
-    def.orientation = Quat(q.w() / norm, q.x() / norm, q.y() / norm, q.z() / norm);
+    Result<Quat> q = unit_quat(spec.orientation(), "orientation");
+    if (!q) return q.status();
+    def.orientation = q.value();
   }
   if (spec.has_mass()) {
     if (Status s = positive(spec.mass(), "mass"); !s) return s;
@@ -186,13 +241,9 @@ v1::BodyType proto_body_type(BodyType type) {
   return v1::BODY_TYPE_DYNAMIC;
 }
 
-void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) {
-  out->set_id(id);
-  out->set_type(proto_body_type(look.type));
-  out->set_mass(look.mass);
-  out->set_color(look.colour);
-  v1::Shape* shape = out->mutable_shape();
-  const Shape& s = look.shape;
+namespace {
+
+void describe_shape(const Shape& s, v1::Shape* shape) {
   switch (s.type()) {
     case ShapeType::kBox:
       set(2 * s.half_extents(), shape->mutable_box()->mutable_size());
@@ -235,7 +286,29 @@ void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) 
           mesh->add_triangles(index);
       break;
     }
+    case ShapeType::kCompound:
+      for (const Compound::Part& part : s.compound()->parts()) {
+        v1::CompoundPart* out = shape->mutable_compound()->add_parts();
+        describe_shape(part.shape, out->mutable_shape());
+        set(part.pose.position, out->mutable_position());
+        const Quat& q = part.pose.orientation;
+        out->mutable_orientation()->set_w(q.w());
+        out->mutable_orientation()->set_x(q.x());
+        out->mutable_orientation()->set_y(q.y());
+        out->mutable_orientation()->set_z(q.z());
+      }
+      break;
   }
+}
+
+}  // namespace
+
+void describe(std::uint64_t id, const BodyLook& look, v1::BodyDescription* out) {
+  out->set_id(id);
+  out->set_type(proto_body_type(look.type));
+  out->set_mass(look.mass);
+  out->set_color(look.colour);
+  describe_shape(look.shape, out->mutable_shape());
 }
 
 void describe_forces(const BodyView& body, v1::BodyDescription* out) {

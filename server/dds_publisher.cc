@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "physics/compound.h"
 #include "tumble_qos.h"
 #include "tumble_states.h"
 
@@ -89,6 +90,34 @@ Marker empty_marker(const std_msgs_msg_dds__Header_& header) {
 
 std::string dds_error(const char* what, dds_return_t code) {
   return std::string(what) + ": " + dds_strretcode(code);
+}
+
+// A compound's part as triangles in the body's frame: a box's or hull's faces, a round part's
+// hull of its farthest points towards a 7 x 7 grid on each face of a cube.
+void add_part_triangles(const Compound::Part& part, std::vector<Point>* out) {
+  ConvexPolyhedron round;
+  const ConvexPolyhedron* surface = part.shape.polyhedron();
+  if (surface == nullptr) {
+    std::vector<Vec3> points;
+    for (int i = -3; i <= 3; ++i)
+      for (int j = -3; j <= 3; ++j)
+        for (int k : {-3, 3}) {  // the faces of a cube of directions: 98 of them
+          points.push_back(part.shape.support(Vec3(i, j, k)));
+          points.push_back(part.shape.support(Vec3(i, k, j)));
+          points.push_back(part.shape.support(Vec3(k, i, j)));
+        }
+    Result<ConvexPolyhedron> built = build_convex_hull(points);
+    if (!built) return;
+    round = std::move(built).value();
+    surface = &round;
+  }
+  for (const ConvexPolyhedron::Face& face : surface->faces)
+    for (std::uint32_t k = 1; k + 1 < face.count; ++k)
+      for (std::uint32_t corner : {0u, k, k + 1}) {
+        const Vec3 v =
+            part.pose.transform(surface->vertices[surface->face_vertices[face.first + corner]]);
+        out->push_back({v.x(), v.y(), v.z()});
+      }
 }
 
 }  // namespace
@@ -403,6 +432,13 @@ void DdsPublisher::describe_for_ros2(const Catalogue& now) {
             corner(i, j), corner(i1, j), corner(i1, j1);
             corner(i, j), corner(i1, j1), corner(i, j1);
           }
+        break;
+      }
+      case ShapeType::kCompound: {
+        marker.type = kTriangleList;
+        marker.scale = {1, 1, 1};
+        for (const Compound::Part& part : shape.compound()->parts())
+          add_part_triangles(part, &ros.triangles);
         break;
       }
       case ShapeType::kMesh: {

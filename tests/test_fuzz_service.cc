@@ -233,6 +233,26 @@ class FuzzService {
         if (h.chance(0.1)) mesh->add_triangles(0);
         break;
       }
+      case 7: {
+        // A compound: no parts or several, each a box or ball (now and then a plane, a compound
+        // or nothing), at offsets sometimes hostile, turned sometimes by no unit quaternion.
+        v1::Compound* compound = shape->mutable_compound();
+        for (int p = h.integer(0, 5); p > 0; --p) {
+          v1::CompoundPart* part = compound->add_parts();
+          const double kind = h.rng().uniform();
+          if (kind < 0.45)
+            set(h.vector(0.05, 1), part->mutable_shape()->mutable_box()->mutable_size());
+          else if (kind < 0.9)
+            part->mutable_shape()->mutable_sphere()->set_radius(h.number(0.05, 0.5));
+          else if (kind < 0.94)
+            part->mutable_shape()->mutable_plane();
+          else if (kind < 0.97)
+            part->mutable_shape()->mutable_compound()->add_parts();
+          set(h.chance(0.9) ? h.rng().vector(-1, 1) : h.vector(-1, 1), part->mutable_position());
+          if (h.chance(0.3)) set(h, part->mutable_orientation());
+        }
+        break;
+      }
       default:
         if (h.chance(0.5)) shape->mutable_sphere()->set_radius(0.2);
         break;  // or no shape at all

@@ -119,6 +119,14 @@ TEST(NoMalloc, StepsOnTerrainCallNoAllocator) {
   EXPECT_EQ(allocations_in_steps(on_mesh, 20, 1, 200), 0);
 }
 
+// Compounds: each pair's room for one manifold per pair of parts is laid out afresh every step in
+// arrays that keep their size, jacks and dumbbells against the ground and each other.
+TEST(NoMalloc, StepsOfCompoundsCallNoAllocator) {
+  SceneDef pile = compound_pile_scene(64);
+  pile.world.solver.sleeping = false;
+  EXPECT_EQ(allocations_in_steps(pile, 20, 1, 200), 0);
+}
+
 // Jointed islands: the direct solve of a double pendulum and of an arm on its motors (auto),
 // ragdolls in a pile on the ground (auto: the tree with soft contacts), and a ragdoll whose
 // contacts, limits and cones are one LCP (exact, exact_joints.h; Lemke's pivots allocated until

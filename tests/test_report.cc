@@ -69,7 +69,7 @@ TEST(Report, TheSlideOnAMeshStopsWhereTheSlideOnThePlaneDoes) {
 TEST(Report, ErrorsFallAsTheStepFallsWhereTheSchemeConverges) {
   const QuickReport& r = quick_report();
   const std::vector<int> rates = swept_rates(true);
-  for (const char* scene : {"projectile", "roll", "slide", "flip"}) {
+  for (const char* scene : {"projectile", "roll", "roll-dumbbell", "slide", "flip"}) {
     for (const Engine& engine : r.engines) {
       if (!engine.ours) continue;
       const double coarse = error_at(r.work, scene, engine.label, 1.0 / rates.front());

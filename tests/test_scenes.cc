@@ -171,6 +171,45 @@ TEST(SceneJson, MeshesAreReadCheckedAndWrittenBack) {
             "bodies[0].file: a mesh comes from a file or from vertices and triangles, not both");
 }
 
+TEST(SceneJson, CompoundsAreReadCheckedAndWrittenBack) {
+  const Result<SceneDef> scene = parse_scene(R"({"bodies": [
+      {"shape": "compound", "density": 600, "position": [1, 0, 0],
+       "parts": [{"shape": "box", "size": [1.2, 0.8, 0.1], "position": [0, 0, 0.75]},
+                 {"shape": "sphere", "radius": 0.1, "position": [0.5, 0, 0.35]},
+                 {"shape": "capsule", "radius": 0.05, "half_height": 0.3,
+                  "orientation": [0.7071067811865476, 0.7071067811865476, 0, 0]},
+                 {"shape": "hull", "points": [[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]]}]}]})");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  const auto& compound = std::get<CompoundDef>(scene.value().bodies[0].shape);
+  ASSERT_EQ(compound.parts.size(), 4u);
+  EXPECT_EQ(std::get<BoxDef>(compound.parts[0].shape).half_extents, Vec3(0.6, 0.4, 0.05));
+  EXPECT_EQ(compound.parts[1].pose.position, Vec3(0.5, 0, 0.35));
+  EXPECT_EQ(compound.parts[2].pose.orientation.x(), 0.7071067811865476);
+  EXPECT_EQ(scene.value().bodies[0].type, BodyType::kDynamic);
+  EXPECT_EQ(scene_to_json(parse_scene(scene_to_json(scene.value())).value()),
+            scene_to_json(scene.value()));
+  EXPECT_TRUE(make_world(scene.value()).ok());
+
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "compound"}]})"),
+            "bodies[0].parts: must be an array of parts, each a convex shape with a position and "
+            "orientation");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "compound", "parts": [{"shape": "sphere"},
+      {"shape": "plane"}]}]})"),
+            "bodies[0].parts[1].shape: a compound's parts must be a box, sphere, capsule or hull");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "compound", "parts": [
+      {"shape": "compound", "parts": []}]}]})"),
+            "bodies[0].parts[0].shape: a compound's parts must be a box, sphere, capsule or hull");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "compound", "parts": [{"shape": "sphere",
+      "radius": 0.1, "colour": 3}]}]})"),
+            "bodies[0].parts[0].colour: unknown field");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "compound", "parts": [{"shape": "box",
+      "size": [1, 1, 1], "orientation": [0, 0, 0, 0]}]}]})"),
+            "bodies[0].shape.parts[0].pose.orientation: must be a finite, non-zero quaternion");
+  EXPECT_EQ(error_of(R"({"bodies": [{"shape": "compound", "parts": [{"shape": "box",
+      "size": [1, -1, 1]}]}]})"),
+            "bodies[0].parts[0].size[1]: must be > 0");
+}
+
 // A scene file names mesh files relative to itself; OBJ and ASCII STL through Assimp, scaled.
 TEST(SceneJson, MeshesComeFromFilesBesideTheScene) {
   const std::string folder = ::testing::TempDir() + "tumble_mesh_files/";

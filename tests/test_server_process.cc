@@ -315,6 +315,43 @@ TEST(ServerProcess, CliSpawnsAMeshFromAFile) {
   EXPECT_NE(missing.text.find("--file: required for a mesh"), std::string::npos) << missing.text;
 }
 
+TEST(ServerProcess, CliSpawnsACompoundOfParts) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  // A dumbbell far from the default scene: two balls on a bar turned along y.
+  const Output spawned = run(tumble +
+                             "spawn compound --part sphere:0.2@0,-0.5,0 --part sphere:0.2@0,0.5,0 "
+                             "--part capsule:0.05,0.4@0,0,0@0.7071068,0.7071068,0,0 --pos 100,0,5");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  const std::string id = spawned.text.substr(0, spawned.text.find('\n'));
+  // The stream's first frame describes it: its parts, each with its pose.
+  const Output described = run(tumble + "stream --frames 1 --ids " + id);
+  ASSERT_EQ(described.code, 0) << described.text;
+  EXPECT_NE(described.text.find("\"compound\":[{"), std::string::npos) << described.text;
+  EXPECT_NE(described.text.find("\"capsule\":[0.05,0.4]"), std::string::npos) << described.text;
+  // A ray down through a ball hits the body; one down beside the bar, between the balls, misses.
+  const Output hit = run(tumble + "ray --from 100,0.5,8 --dir 0,0,-1");
+  ASSERT_EQ(hit.code, 0) << hit.text;
+  EXPECT_NE(hit.text.find(id), std::string::npos) << hit.text;
+  const Output miss = run(tumble + "ray --from 100.1,0.25,8 --dir 0,0,-1 --max-distance 5");
+  ASSERT_EQ(miss.code, 0) << miss.text;
+  EXPECT_EQ(miss.text.find(id), std::string::npos) << miss.text;
+  // A part that does not parse, and one the server refuses, are named.
+  const Output garbled =
+      run(tumble + "spawn compound --part sphere:0.2@0,0,0 --part box:1,1@0,0,0");
+  EXPECT_NE(garbled.code, 0);
+  EXPECT_NE(garbled.text.find("--part[1]"), std::string::npos) << garbled.text;
+  const Output refused = run(tumble + "spawn compound --part sphere:-1@0,0,0");
+  EXPECT_NE(refused.code, 0);
+  EXPECT_NE(refused.text.find("shape.compound.parts[0].shape.sphere.radius"), std::string::npos)
+      << refused.text;
+  const Output none = run(tumble + "spawn compound");
+  EXPECT_NE(none.code, 0);
+  EXPECT_NE(none.text.find("--part: a compound needs at least one"), std::string::npos)
+      << none.text;
+}
+
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--max-message-mb", "1"}));

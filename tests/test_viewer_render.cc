@@ -251,6 +251,47 @@ TEST_F(RenderTest, FramesBecomeInstancesWithAnOptionalContactOverlay) {
 
 // A mesh body is drawn as its own triangles, once however many frames name it; like the ground it
 // does not enlarge the sphere the camera frames.
+TEST_F(RenderTest, CompoundBodiesAreDrawnPartByPart) {
+  // One body: a 2 x 1 x 0.2 box 1 m above its origin and a ball of 0.5 m turned and moved 1 m
+  // along x, the body at (0, 0, 3) turned a quarter about z.
+  v1::Frame frame;
+  v1::BodyDescription* body = frame.add_added();
+  body->set_id(4);
+  v1::CompoundPart* top = body->mutable_shape()->mutable_compound()->add_parts();
+  v1::Vec3* size = top->mutable_shape()->mutable_box()->mutable_size();
+  size->set_x(2);
+  size->set_y(1);
+  size->set_z(0.2);
+  top->mutable_position()->set_z(1);
+  v1::CompoundPart* ball = body->mutable_shape()->mutable_compound()->add_parts();
+  ball->mutable_shape()->mutable_sphere()->set_radius(0.5);
+  ball->mutable_position()->set_x(1);
+  frame.add_ids(4);
+  for (double v : {0.0, 0.0, 3.0})
+    frame.add_positions(v);
+  const double half = std::sqrt(0.5);
+  for (double v : {half, 0.0, 0.0, half})
+    frame.add_orientations(v);
+  WorldView view;
+  view.apply(frame);
+  const auto drawn = view.instances(*renderer_);
+  ASSERT_EQ(drawn[renderer_->box_mesh()].size(), 1u);
+  ASSERT_EQ(drawn[renderer_->sphere_mesh()].size(), 1u);
+  // The box's centre where the body's frame puts it; the ball's at +x turned to +y.
+  const Eigen::Matrix4f box = drawn[renderer_->box_mesh()][0].model;
+  const Eigen::Matrix4f sphere = drawn[renderer_->sphere_mesh()][0].model;
+  EXPECT_LT((box.block<3, 1>(0, 3) - Eigen::Vector3f(0, 0, 4)).norm(), 1e-5f);
+  EXPECT_LT((sphere.block<3, 1>(0, 3) - Eigen::Vector3f(0, 1, 3)).norm(), 1e-5f);
+  // The box's long side (x in its part) along the world's y: the model's first column.
+  EXPECT_LT((box.block<3, 1>(0, 0) - Eigen::Vector3f(0, 1, 0)).norm(), 1e-5f);
+  EXPECT_NEAR((sphere.block<3, 1>(0, 0).norm()), 0.5f, 1e-5f);
+  // Both parts share the body's colour.
+  EXPECT_EQ(drawn[renderer_->box_mesh()][0].colour, drawn[renderer_->sphere_mesh()][0].colour);
+  const auto around = view.bounds();
+  ASSERT_TRUE(around.has_value());
+  EXPECT_GE(around->second, 1.5f);  // the ball's far side is 1.5 m from the body's origin
+}
+
 TEST_F(RenderTest, MeshBodiesAreDrawnAsTheirTriangles) {
   v1::Frame frame;
   v1::BodyDescription* box = frame.add_added();

@@ -225,7 +225,7 @@ TEST(WorldState, ShapeStateRoundTripsAndBadPolyhedraAreRefused) {
   refused(state, "edges[0]");
   state.polyhedron = nullptr;
   refused(state, "polyhedron");
-  ShapeState box{ShapeType::kBox, 0, 0, Vec3(1, -1, 1), nullptr, nullptr};
+  ShapeState box{ShapeType::kBox, 0, 0, Vec3(1, -1, 1), nullptr, nullptr, nullptr, nullptr};
   refused(box, "half_extents[1]");
 }
 

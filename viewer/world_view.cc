@@ -29,6 +29,34 @@ Camera framed(const Camera& camera, const Eigen::Vector3f& centre, float radius)
   return out;
 }
 
+namespace {
+
+// How far a shape reaches from its body's origin (a hull's is taken as half a metre).
+float reach_of(const v1::Shape& shape) {
+  if (shape.has_box())
+    return 0.5f * Eigen::Vector3f(static_cast<float>(shape.box().size().x()),
+                                  static_cast<float>(shape.box().size().y()),
+                                  static_cast<float>(shape.box().size().z()))
+                      .norm();
+  if (shape.has_sphere()) return static_cast<float>(shape.sphere().radius());
+  if (shape.has_capsule())
+    return static_cast<float>(shape.capsule().radius() + shape.capsule().half_height());
+  if (shape.has_compound()) {
+    float reach = 0;
+    for (const v1::CompoundPart& part : shape.compound().parts())
+      if (!part.shape().has_compound())
+        reach = std::max(reach,
+                         static_cast<float>(std::sqrt(part.position().x() * part.position().x() +
+                                                      part.position().y() * part.position().y() +
+                                                      part.position().z() * part.position().z())) +
+                             reach_of(part.shape()));
+    return reach;
+  }
+  return 0.5f;
+}
+
+}  // namespace
+
 std::optional<std::pair<Eigen::Vector3f, float>> WorldView::bounds() const {
   Eigen::Vector3f low = Eigen::Vector3f::Constant(INFINITY), high = -low;
   for (const auto& [id, pose] : poses_) {
@@ -36,17 +64,7 @@ std::optional<std::pair<Eigen::Vector3f, float>> WorldView::bounds() const {
     if (look == looks_.end() || look->second.shape().has_plane() ||
         look->second.shape().has_heightfield() || look->second.shape().has_mesh())
       continue;  // the ground frames the bodies on it, not itself
-    const v1::Shape& shape = look->second.shape();
-    float reach = 0.5f;
-    if (shape.has_box())
-      reach = 0.5f * Eigen::Vector3f(static_cast<float>(shape.box().size().x()),
-                                     static_cast<float>(shape.box().size().y()),
-                                     static_cast<float>(shape.box().size().z()))
-                         .norm();
-    else if (shape.has_sphere())
-      reach = static_cast<float>(shape.sphere().radius());
-    else if (shape.has_capsule())
-      reach = static_cast<float>(shape.capsule().radius() + shape.capsule().half_height());
+    const float reach = reach_of(look->second.shape());
     low = low.cwiseMin(pose.position - Eigen::Vector3f::Constant(reach));
     high = high.cwiseMax(pose.position + Eigen::Vector3f::Constant(reach));
   }
@@ -104,7 +122,6 @@ void WorldView::apply(const v1::Frame& frame) {
 
 std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
   std::vector<std::vector<Instance>> out(3);
-  const auto add = [&](int mesh, const Instance& instance) { add_instance(mesh, instance, &out); };
   for (const auto& [id, pose] : poses_) {
     const auto look = looks_.find(id);
     if (look == looks_.end()) continue;  // not described yet
@@ -113,91 +130,118 @@ std::vector<std::vector<Instance>> WorldView::instances(Renderer& renderer) {
     const auto ordinal = ordinals_.find(id);
     instance.colour = body_colour(d.color(), ordinal != ordinals_.end() ? ordinal->second : id,
                                   d.type() == v1::BODY_TYPE_STATIC);
-    Eigen::Affine3f model = Eigen::Translation3f(pose.position) * pose.orientation;
-    const v1::Shape& shape = d.shape();
-    switch (shape.kind_case()) {
-      case v1::Shape::kBox: {
-        const v1::Vec3& size = shape.box().size();
-        model.scale(Eigen::Vector3f(size.x(), size.y(), size.z()) / 2);
-        instance.model = model.matrix();
-        add(renderer.box_mesh(), instance);
-        break;
-      }
-      case v1::Shape::kSphere:
-        model.scale(static_cast<float>(shape.sphere().radius()));
-        instance.model = model.matrix();
-        add(renderer.sphere_mesh(), instance);
-        break;
-      case v1::Shape::kCapsule: {
-        const std::pair<float, float> key{static_cast<float>(shape.capsule().radius()),
-                                          static_cast<float>(shape.capsule().half_height())};
-        auto mesh = capsule_meshes_.find(key);
-        if (mesh == capsule_meshes_.end())
-          mesh =
-              capsule_meshes_.emplace(key, renderer.add_mesh(capsule(key.first, key.second))).first;
-        instance.model = model.matrix();
-        add(mesh->second, instance);
-        break;
-      }
-      case v1::Shape::kPlane:
-        model.scale(Eigen::Vector3f(200, 200, 1));  // the ground, as far as the eye goes
-        instance.model = model.matrix();
-        instance.material.x() = 1;  // a metre grid
-        add(renderer.ground_mesh(), instance);
-        break;
-      case v1::Shape::kHull: {
-        auto mesh = hull_meshes_.find(id);
-        if (mesh == hull_meshes_.end())
-          mesh = hull_meshes_
-                     .emplace(id, renderer.add_mesh(hull_mesh(std::span<const double>(
-                                      shape.hull().points().data(),
-                                      static_cast<std::size_t>(shape.hull().points_size())))))
-                     .first;
-        instance.model = model.matrix();
-        add(mesh->second, instance);
-        break;
-      }
-      case v1::Shape::kHeightfield: {
-        auto mesh = height_field_meshes_.find(id);
-        if (mesh == height_field_meshes_.end()) {
-          const v1::HeightField& f = shape.heightfield();
-          mesh =
-              height_field_meshes_
-                  .emplace(
-                      id, renderer.add_mesh(height_field_mesh(
-                              f.samples_x(), f.samples_y(), f.spacing_x(), f.spacing_y(),
-                              std::span<const double>(f.heights().data(),
-                                                      static_cast<std::size_t>(f.heights_size())))))
-                  .first;
-        }
-        instance.model = model.matrix();
-        add(mesh->second, instance);
-        break;
-      }
-      case v1::Shape::kMesh: {
-        auto mesh = surface_meshes_.find(id);
-        if (mesh == surface_meshes_.end()) {
-          const v1::Mesh& m = shape.mesh();
-          mesh =
-              surface_meshes_
-                  .emplace(
-                      id,
-                      renderer.add_mesh(surface_mesh(
-                          std::span<const double>(m.vertices().data(),
-                                                  static_cast<std::size_t>(m.vertices_size())),
-                          std::span<const std::uint32_t>(
-                              m.triangles().data(), static_cast<std::size_t>(m.triangles_size())))))
-                  .first;
-        }
-        instance.model = model.matrix();
-        add(mesh->second, instance);
-        break;
-      }
-      default:
-        break;
-    }
+    const Eigen::Affine3f placed = Eigen::Translation3f(pose.position) * pose.orientation;
+    add_shape(renderer, id, -1, d.shape(), placed, instance, &out);
   }
   return out;
+}
+
+void WorldView::add_shape(Renderer& renderer, std::uint64_t id, int part, const v1::Shape& shape,
+                          const Eigen::Affine3f& placed, const Instance& look,
+                          std::vector<std::vector<Instance>>* out) {
+  const auto add = [&](int mesh, const Instance& instance) { add_instance(mesh, instance, out); };
+  Instance instance = look;
+  Eigen::Affine3f model = placed;
+  switch (shape.kind_case()) {
+    case v1::Shape::kBox: {
+      const v1::Vec3& size = shape.box().size();
+      model.scale(Eigen::Vector3f(size.x(), size.y(), size.z()) / 2);
+      instance.model = model.matrix();
+      add(renderer.box_mesh(), instance);
+      break;
+    }
+    case v1::Shape::kSphere:
+      model.scale(static_cast<float>(shape.sphere().radius()));
+      instance.model = model.matrix();
+      add(renderer.sphere_mesh(), instance);
+      break;
+    case v1::Shape::kCapsule: {
+      const std::pair<float, float> key{static_cast<float>(shape.capsule().radius()),
+                                        static_cast<float>(shape.capsule().half_height())};
+      auto mesh = capsule_meshes_.find(key);
+      if (mesh == capsule_meshes_.end())
+        mesh =
+            capsule_meshes_.emplace(key, renderer.add_mesh(capsule(key.first, key.second))).first;
+      instance.model = model.matrix();
+      add(mesh->second, instance);
+      break;
+    }
+    case v1::Shape::kPlane:
+      model.scale(Eigen::Vector3f(200, 200, 1));  // the ground, as far as the eye goes
+      instance.model = model.matrix();
+      instance.material.x() = 1;  // a metre grid
+      add(renderer.ground_mesh(), instance);
+      break;
+    case v1::Shape::kHull: {
+      auto mesh = hull_meshes_.find({id, part});
+      if (mesh == hull_meshes_.end())
+        mesh = hull_meshes_
+                   .emplace(std::pair{id, part},
+                            renderer.add_mesh(hull_mesh(std::span<const double>(
+                                shape.hull().points().data(),
+                                static_cast<std::size_t>(shape.hull().points_size())))))
+                   .first;
+      instance.model = model.matrix();
+      add(mesh->second, instance);
+      break;
+    }
+    case v1::Shape::kHeightfield: {
+      auto mesh = height_field_meshes_.find(id);
+      if (mesh == height_field_meshes_.end()) {
+        const v1::HeightField& f = shape.heightfield();
+        mesh =
+            height_field_meshes_
+                .emplace(id,
+                         renderer.add_mesh(height_field_mesh(
+                             f.samples_x(), f.samples_y(), f.spacing_x(), f.spacing_y(),
+                             std::span<const double>(f.heights().data(),
+                                                     static_cast<std::size_t>(f.heights_size())))))
+                .first;
+      }
+      instance.model = model.matrix();
+      add(mesh->second, instance);
+      break;
+    }
+    case v1::Shape::kMesh: {
+      auto mesh = surface_meshes_.find(id);
+      if (mesh == surface_meshes_.end()) {
+        const v1::Mesh& m = shape.mesh();
+        mesh =
+            surface_meshes_
+                .emplace(
+                    id,
+                    renderer.add_mesh(surface_mesh(
+                        std::span<const double>(m.vertices().data(),
+                                                static_cast<std::size_t>(m.vertices_size())),
+                        std::span<const std::uint32_t>(
+                            m.triangles().data(), static_cast<std::size_t>(m.triangles_size())))))
+                .first;
+      }
+      instance.model = model.matrix();
+      add(mesh->second, instance);
+      break;
+    }
+    case v1::Shape::kCompound:
+      // Each part in the same colour, placed in the body's frame (a part is never a compound).
+      if (part >= 0) break;
+      for (int i = 0; i < shape.compound().parts_size(); ++i) {
+        const v1::CompoundPart& p = shape.compound().parts(i);
+        const v1::Quat& q = p.orientation();
+        const Eigen::Quaternionf turn =
+            p.has_orientation()
+                ? Eigen::Quaternionf(static_cast<float>(q.w()), static_cast<float>(q.x()),
+                                     static_cast<float>(q.y()), static_cast<float>(q.z()))
+                      .normalized()
+                : Eigen::Quaternionf::Identity();
+        const Eigen::Vector3f at(static_cast<float>(p.position().x()),
+                                 static_cast<float>(p.position().y()),
+                                 static_cast<float>(p.position().z()));
+        add_shape(renderer, id, i, p.shape(), placed * Eigen::Translation3f(at) * turn, look, out);
+      }
+      break;
+    default:
+      break;
+  }
 }
 
 // An overlay's ball: 1.5% of the radius of the sphere around the bodies, at least 5 mm.

@@ -51,8 +51,13 @@ class WorldView {
   };
   std::unordered_map<std::uint64_t, v1::BodyDescription> looks_;
   std::map<std::uint64_t, Pose> poses_;  // ordered: the same draw order every frame
+  // One shape's instances (a compound's parts, each with its own model matrix).
+  void add_shape(Renderer& renderer, std::uint64_t id, int part, const v1::Shape& shape,
+                 const Eigen::Affine3f& placed, const Instance& look,
+                 std::vector<std::vector<Instance>>* out);
   std::map<std::pair<float, float>, int> capsule_meshes_;
-  std::unordered_map<std::uint64_t, int> hull_meshes_;  // by body id: each hull its own mesh
+  // By body id and part (-1: the body itself): each hull its own mesh.
+  std::map<std::pair<std::uint64_t, int>, int> hull_meshes_;
   std::unordered_map<std::uint64_t, int> height_field_meshes_;  // the same for heightfields
   std::unordered_map<std::uint64_t, int> surface_meshes_;       // and for triangle meshes
   v1::Contacts contacts_;

@@ -63,6 +63,47 @@ class BulletSimulation final : public Simulation {
       shape = std::make_unique<btSphereShape>(sphere->radius);
     } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
       shape = std::make_unique<btCapsuleShapeZ>(capsule->radius, 2 * capsule->half_height);
+    } else if (const auto* compound = std::get_if<CompoundDef>(&def.shape)) {
+      // A btCompoundShape of the parts at their poses. Bullet takes a body's frame as its centre
+      // of mass and principal axes, so only compounds whose centre of mass is their frame's
+      // origin are mapped (the caller's inertia is about it).
+      // (This module is built apart from the engine: the volumes are worked out here.)
+      Vec3 moment = Vec3::Zero();
+      double volume = 0;
+      for (const CompoundPart& part : compound->parts) {
+        double v = 0;
+        if (const auto* box = std::get_if<BoxDef>(&part.shape)) v = 8 * box->half_extents.prod();
+        if (const auto* ball = std::get_if<SphereDef>(&part.shape))
+          v = 4.0 / 3.0 * M_PI * std::pow(ball->radius, 3);
+        if (const auto* rod = std::get_if<CapsuleDef>(&part.shape))
+          v = M_PI * rod->radius * rod->radius * (2 * rod->half_height + 4.0 / 3.0 * rod->radius);
+        moment += v * part.pose.position;
+        volume += v;
+      }
+      if ((moment / volume).norm() > 1e-9) {
+        *why_not = "compounds with their centre of mass off their frame's origin are not mapped";
+        return false;
+      }
+      auto parts = std::make_unique<btCompoundShape>();
+      for (const CompoundPart& part : compound->parts) {
+        std::unique_ptr<btCollisionShape> child;
+        if (const auto* box = std::get_if<BoxDef>(&part.shape))
+          child = std::make_unique<btBoxShape>(to_bt(box->half_extents));
+        else if (const auto* sphere = std::get_if<SphereDef>(&part.shape))
+          child = std::make_unique<btSphereShape>(sphere->radius);
+        else if (const auto* capsule = std::get_if<CapsuleDef>(&part.shape))
+          child = std::make_unique<btCapsuleShapeZ>(capsule->radius, 2 * capsule->half_height);
+        if (child == nullptr) {
+          *why_not = "hull parts of compounds are not mapped to Bullet";
+          return false;
+        }
+        const Quat& q = part.pose.orientation;
+        parts->addChildShape(
+            btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), to_bt(part.pose.position)),
+            child.get());
+        shapes_.push_back(std::move(child));
+      }
+      shape = std::move(parts);
     } else if (const auto* mesh = std::get_if<TriangleMeshDef>(&def.shape)) {
       // A btBvhTriangleMeshShape as a user makes one, without btAdjustInternalEdgeContacts (an
       // optional contact callback): its inner edges are what the mesh scenes measure.

@@ -209,7 +209,7 @@ std::unique_ptr<Simulation> make_mujoco(const PeerScene& peer, const PeerOptions
     } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
       geom << "type=\"capsule\" size=\"" << capsule->radius << ' ' << capsule->half_height << '"';
     } else {
-      failure = "hulls, heightfields and meshes are not mapped to MuJoCo";
+      failure = "hulls, heightfields, meshes and compounds are not mapped to MuJoCo";
     }
     geom << " friction=\"" << def.friction << " 0.005 0.0001\" condim=\"3\"";
     return geom.str();

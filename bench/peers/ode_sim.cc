@@ -63,7 +63,7 @@ class OdeSimulation final : public Simulation {
     } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
       geom = dCreateCapsule(space_, capsule->radius, 2 * capsule->half_height);
     } else {
-      *why_not = "hulls, heightfields and meshes are not mapped to ODE";
+      *why_not = "hulls, heightfields, meshes and compounds are not mapped to ODE";
       return false;
     }
     materials_.push_back({def.friction, def.restitution});

@@ -2,6 +2,8 @@
 // routine; a swapped pair's manifold is mirrored back. All work happens in one body's local frame
 // (the relative pose is formed once, in world coordinates), so contacts between bodies far from
 // the origin keep the precision of their size, not of their coordinates.
+#include <vector>
+
 #include "manifold.h"
 #include "narrow_phase.h"
 
@@ -27,6 +29,7 @@ std::uint32_t collide_ordered(const Shape& a, const Pose& pose_a, const Shape& b
   switch (b.type()) {
     case ShapeType::kHeightField:  // collide_terrain's
     case ShapeType::kMesh:
+    case ShapeType::kCompound:  // collide_compound's
       break;
     case ShapeType::kHalfSpace:
       flags = collide_half_space(a, a_in_b, a_at, margin, out);
@@ -68,6 +71,14 @@ std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const 
   out->count = 0;
   if (chosen != nullptr) *chosen = PolytopeFeature{};
   if (is_static_only(a.type()) && is_static_only(b.type())) return kCollisionOk;
+  if (is_compound_pair(a, b)) {
+    thread_local std::vector<ContactManifold> all(kMaxPairManifolds);
+    std::size_t count = 0;
+    const std::uint32_t flags = collide_compound(a, pose_a, b, pose_b, settings, all, &count);
+    for (std::size_t c = 0; c < count; ++c)
+      if (c == 0 || all[c].depth > out->depth) *out = all[c];
+    return flags;
+  }
   if (is_terrain_pair(a, b)) {
     TerrainContacts all;
     const std::uint32_t flags = collide_terrain(a, pose_a, b, pose_b, settings, &all);

@@ -50,6 +50,7 @@ std::uint32_t collide_half_space(const Shape& a, const Mat3& rotation, const Vec
     case ShapeType::kHalfSpace:
     case ShapeType::kHeightField:
     case ShapeType::kMesh:
+    case ShapeType::kCompound:  // collide_compound meets the ground part by part
       return kCollisionOk;
   }
   out->depth = -std::numeric_limits<double>::infinity();

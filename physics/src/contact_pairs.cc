@@ -49,6 +49,38 @@ PolytopeFeature recorded_feature(const ContactPairRecord& record) {
           record.feature_second, false};
 }
 
+void match_manifold_records(std::span<const ContactManifold> manifolds,
+                            std::span<const ContactPairRecord> run, bool by_feature,
+                            std::span<std::uint32_t> out) {
+  static_assert(kMaxPairManifolds <= 64, "one bit per record below");
+  if (!by_feature) {
+    for (std::size_t c = 0; c < manifolds.size(); ++c)
+      out[c] = c < run.size() ? static_cast<std::uint32_t>(c) : kNoRecord;
+    return;
+  }
+  std::uint64_t taken = 0;
+  const auto shares_a_point = [](const ContactManifold& m, const ContactPairRecord& r) {
+    for (int i = 0; i < m.count; ++i)
+      for (int k = 0; k < r.count; ++k)
+        if (m.points[i].feature_id == r.points[k].feature) return true;
+    return false;
+  };
+  for (std::size_t c = 0; c < manifolds.size(); ++c) {
+    out[c] = kNoRecord;
+    for (std::size_t k = 0; k < run.size() && k < kMaxPairManifolds; ++k)
+      if ((taken >> k & 1) == 0 && shares_a_point(manifolds[c], run[k])) {
+        out[c] = static_cast<std::uint32_t>(k);
+        taken |= std::uint64_t{1} << k;
+        break;
+      }
+  }
+  for (std::size_t c = 0; c < manifolds.size(); ++c)
+    if (out[c] == kNoRecord && c < run.size() && (taken >> c & 1) == 0) {
+      out[c] = static_cast<std::uint32_t>(c);
+      taken |= std::uint64_t{1} << c;
+    }
+}
+
 void record_manifold(const ContactManifold& manifold, const PolytopeFeature& feature, BodyId a,
                      const Pose& pose_a, BodyId b, const Pose& pose_b, ContactPairRecord* out) {
   out->a = a;

@@ -29,6 +29,16 @@ double relative_motion(const ContactPairRecord& record, const Pose& pose_a, cons
 
 PolytopeFeature recorded_feature(const ContactPairRecord& record);
 
+// For a pair that keeps several manifolds (terrain, compounds), which of its last step's records
+// `run` (the pair's, in order) each of this step's `manifolds` continues; out[c] is an index into
+// `run` or kNoRecord. At most kMaxPairManifolds of each. `by_feature` (compounds, whose list of
+// touching parts changes as they roll): the record sharing a point's feature id, or else the one
+// in the same place in the order that no other took. Otherwise (terrain, whose few manifolds keep
+// their order): the one in the same place.
+void match_manifold_records(std::span<const ContactManifold> manifolds,
+                            std::span<const ContactPairRecord> run, bool by_feature,
+                            std::span<std::uint32_t> out);
+
 // A record of `manifold`, from `feature`, with the bodies at these poses; impulses zero.
 void record_manifold(const ContactManifold& manifold, const PolytopeFeature& feature, BodyId a,
                      const Pose& pose_a, BodyId b, const Pose& pose_b, ContactPairRecord* out);

@@ -41,7 +41,12 @@ ImpactResult time_of_impact(const Shape& a, const SweptMotion& motion_a, const S
       result.t = t;
       return result;
     }
-    const double closing = -manifold.normal.dot(translation) + turning;
+    // The nearest parts' normal bounds how fast a compound's other parts close only along it: a
+    // compound's gap closes at most at the whole relative speed.
+    const double along = a.type() == ShapeType::kCompound || b.type() == ShapeType::kCompound
+                             ? translation.norm()
+                             : -manifold.normal.dot(translation);
+    const double closing = along + turning;
     if (closing <= 0) return result;  // moving apart along the normal, not turning: kMiss
     t += (gap - target) / closing;
     if (t >= 1) return result;

@@ -1,9 +1,11 @@
 #include "physics/limits.h"
 
 #include "body_state.h"
+#include "physics/compound.h"
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 namespace tumble {
@@ -29,9 +31,9 @@ Status below(const std::string& field, double value, const char* unit, const cha
 
 // The field that sets a shape's smallest dimension, its value, and its largest dimension.
 struct ShapeSpan {
-  const char* smallest_field;
+  std::string smallest_field;
   double smallest;
-  const char* largest_field;
+  std::string largest_field;
 };
 
 ShapeSpan span_of(const Shape& shape) {
@@ -50,6 +52,18 @@ ShapeSpan span_of(const Shape& shape) {
     }
     case ShapeType::kMesh:
       return {"shape.triangles", shape.mesh()->feature_size(), "shape.vertices"};
+    case ShapeType::kCompound: {
+      // The thinnest part sets the smallest dimension; the reach of them all, the largest.
+      ShapeSpan span{"shape.parts", std::numeric_limits<double>::infinity(), "shape.parts"};
+      const auto parts = shape.compound()->parts();
+      for (std::size_t i = 0; i < parts.size(); ++i) {
+        const ShapeSpan part = span_of(parts[i].shape);
+        if (part.smallest < span.smallest)
+          span = {"shape.parts[" + std::to_string(i) + "]." + part.smallest_field.substr(6),
+                  part.smallest, "shape.parts"};
+      }
+      return span;
+    }
     case ShapeType::kHalfSpace:
       break;
   }

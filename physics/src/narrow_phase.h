@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 
 #include "physics/collision.h"
 
@@ -78,6 +79,28 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
 inline bool is_terrain_pair(const Shape& a, const Shape& b) {
   return is_terrain(a.type()) || is_terrain(b.type());
 }
+// Whether a pair must go through collide_compound (one of them is a compound).
+inline bool is_compound_pair(const Shape& a, const Shape& b) {
+  return a.type() == ShapeType::kCompound || b.type() == ShapeType::kCompound;
+}
+// Pairs that may touch along several manifolds at once: terrain and compounds.
+inline bool is_many_manifold_pair(const Shape& a, const Shape& b) {
+  return is_terrain_pair(a, b) || is_compound_pair(a, b);
+}
+// The most manifolds a pair of these shapes can have: one per pair of parts (a convex shape is
+// one part), up to kMaxTerrainManifolds each against terrain, at most kMaxPairManifolds.
+std::size_t most_manifolds(const Shape& a, const Shape& b);
+// Every manifold of a compound pair, in the world, normals from a to b, in the order of A's
+// parts and then B's; each point's feature id mixes in the two parts' indices. `room` holds at
+// most room.size() manifolds (the deepest, kPairManifoldLimit when one is left out); *count says
+// how many it holds.
+std::uint32_t collide_compound(const Shape& a, const Pose& pose_a, const Shape& b,
+                               const Pose& pose_b, const CollisionSettings& settings,
+                               std::span<ContactManifold> room, std::size_t* count);
+// collide_compound or collide_terrain, whichever the pair needs; room for most_manifolds(a, b).
+std::uint32_t collide_many(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
+                           const CollisionSettings& settings, std::span<ContactManifold> room,
+                           std::size_t* count);
 // Every manifold of a terrain pair, in the world, normals from a to b.
 std::uint32_t collide_terrain(const Shape& a, const Pose& pose_a, const Shape& b,
                               const Pose& pose_b, const CollisionSettings& settings,

@@ -1,5 +1,7 @@
 #include "ray_shape.h"
 
+#include "physics/compound.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -136,6 +138,45 @@ bool ray_hull(const ConvexPolyhedron& hull, const Vec3& origin, const Vec3& dire
   return true;
 }
 
+// Whether the ray meets the box within [0, max_t] (the slab test, Kay and Kajiya 1986).
+bool ray_meets_box(const Aabb& box, const Vec3& origin, const Vec3& direction, double max_t) {
+  double enter = 0, leave = max_t;
+  for (int k = 0; k < 3; ++k) {
+    if (direction[k] == 0) {
+      if (origin[k] < box.min[k] || origin[k] > box.max[k]) return false;
+      continue;
+    }
+    const double inverse = 1 / direction[k];
+    double near = (box.min[k] - origin[k]) * inverse, far = (box.max[k] - origin[k]) * inverse;
+    if (near > far) std::swap(near, far);
+    enter = std::max(enter, near);
+    leave = std::min(leave, far);
+    if (enter > leave) return false;
+  }
+  return true;
+}
+
+// The nearest entry into any part, each met in its own frame.
+bool ray_compound(const Compound& compound, const Vec3& origin, const Vec3& direction, double max_t,
+                  ShapeRayHit* hit) {
+  bool found = false;
+  double reach = max_t;
+  for (const Compound::Part& part : compound.parts()) {
+    if (!ray_meets_box(part.bounds, origin, direction, reach)) continue;
+    const Quat into = part.pose.orientation.conjugate();
+    ShapeRayHit part_hit;
+    if (!ray_shape(part.shape, into * (origin - part.pose.position), into * direction, reach,
+                   &part_hit))
+      continue;
+    if (found && part_hit.t >= hit->t) continue;
+    found = true;
+    hit->t = part_hit.t;
+    hit->normal = part.pose.orientation * part_hit.normal;
+    reach = part_hit.t;
+  }
+  return found;
+}
+
 }  // namespace
 
 bool ray_shape(const Shape& shape, const Vec3& origin, const Vec3& direction, double max_t,
@@ -153,6 +194,8 @@ bool ray_shape(const Shape& shape, const Vec3& origin, const Vec3& direction, do
       return ray_height_field(*shape.height_field(), origin, direction, max_t, hit);
     case ShapeType::kMesh:
       return ray_mesh(*shape.mesh(), origin, direction, max_t, hit);
+    case ShapeType::kCompound:
+      return ray_compound(*shape.compound(), origin, direction, max_t, hit);
     case ShapeType::kHalfSpace: {
       // The solid below z = 0.
       if (origin.z() <= 0) {

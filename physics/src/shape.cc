@@ -5,6 +5,7 @@
 #include <string>
 
 #include "mass_integrals.h"
+#include "physics/compound.h"
 #include "physics/shape.h"
 #include "shape_state.h"
 
@@ -35,6 +36,8 @@ const char* shape_type_name(ShapeType type) {
       return "heightfield";
     case ShapeType::kMesh:
       return "mesh";
+    case ShapeType::kCompound:
+      return "compound";
   }
   return "unknown";
 }
@@ -80,6 +83,8 @@ Result<Shape> Shape::create(const ShapeDef& def) {
     if (!built) return built.status();
     shape.type_ = ShapeType::kMesh;
     shape.mesh_ = std::make_shared<TriangleMesh>(std::move(built).value());
+  } else if (const auto* compound = std::get_if<CompoundDef>(&def)) {
+    return Compound::create(*compound);
   } else {
     shape.type_ = ShapeType::kHalfSpace;
   }
@@ -109,6 +114,8 @@ Aabb Shape::local_bounds() const {
       return height_field_->bounds();
     case ShapeType::kMesh:
       return mesh_->bounds();
+    case ShapeType::kCompound:
+      return compound_->bounds();
   }
   return Aabb::infinite();
 }
@@ -124,6 +131,8 @@ double Shape::volume() const {
       return 8 * half_extents_.prod();
     case ShapeType::kHull:
       return polyhedron_->volume;
+    case ShapeType::kCompound:
+      return compound_->volume();
     case ShapeType::kHalfSpace:
     case ShapeType::kHeightField:
     case ShapeType::kMesh:
@@ -171,6 +180,8 @@ MassProperties Shape::mass_properties(double density) const {
     case ShapeType::kMesh:
       props.mass = std::numeric_limits<double>::infinity();
       break;
+    case ShapeType::kCompound:
+      return compound_->mass_properties(density);
   }
   return props;
 }
@@ -190,6 +201,8 @@ double Shape::size() const {
       return std::max(height_field_->def().spacing_x, height_field_->def().spacing_y);
     case ShapeType::kMesh:
       return mesh_->feature_size();
+    case ShapeType::kCompound:
+      return compound_->smallest_size();
   }
   return 1.0;
 }
@@ -201,6 +214,7 @@ double compute_inner_radius(ShapeType type, double radius, const Vec3& half_exte
   switch (type) {
     case ShapeType::kHeightField:
     case ShapeType::kMesh:
+    case ShapeType::kCompound:  // Compound::inner_radius
       return 0;
     case ShapeType::kSphere:
     case ShapeType::kCapsule:
@@ -240,6 +254,8 @@ double compute_outer_radius(ShapeType type, double radius, double half_height,
     }
     case ShapeType::kHalfSpace:
       return std::numeric_limits<double>::infinity();
+    case ShapeType::kCompound:  // Compound::outer_radius
+      return 0;
   }
   return 0;
 }
@@ -247,6 +263,11 @@ double compute_outer_radius(ShapeType type, double radius, double half_height,
 }  // namespace
 
 void Shape::update_radii() {
+  if (type_ == ShapeType::kCompound) {
+    inner_radius_ = compound_->inner_radius();
+    outer_radius_ = compound_->outer_radius();
+    return;
+  }
   inner_radius_ = compute_inner_radius(type_, radius_, half_extents_, polyhedron_.get());
   outer_radius_ =
       compute_outer_radius(type_, radius_, half_height_, half_extents_, polyhedron_.get(),
@@ -270,6 +291,8 @@ Vec3 Shape::support(const Vec3& d) const {
                   d.z() >= 0 ? half_extents_.z() : -half_extents_.z());
     case ShapeType::kHull:
       return polyhedron_->support(d);
+    case ShapeType::kCompound:
+      return compound_->support(d);
     case ShapeType::kHalfSpace:
     case ShapeType::kHeightField:
     case ShapeType::kMesh:
@@ -280,6 +303,7 @@ Vec3 Shape::support(const Vec3& d) const {
 }
 
 Shape Shape::recentred(const Vec3& offset) const {
+  if (type_ == ShapeType::kCompound && !offset.isZero(0)) return compound_->recentred(offset);
   if (type_ != ShapeType::kHull || offset.isZero(0)) return *this;
   auto moved = std::make_shared<ConvexPolyhedron>(*polyhedron_);
   for (Vec3& v : moved->vertices)
@@ -294,7 +318,8 @@ Shape Shape::recentred(const Vec3& offset) const {
 }
 
 ShapeState Shape::state() const {
-  ShapeState state{type_, radius_, half_height_, half_extents_, nullptr, nullptr, nullptr};
+  ShapeState state{type_, radius_, half_height_, half_extents_, nullptr, nullptr, nullptr, nullptr};
+  if (type_ == ShapeType::kCompound) state.compound = compound_;
   if (type_ == ShapeType::kHull) state.polyhedron = polyhedron_;
   if (type_ == ShapeType::kHeightField)  // the definition, owned with the field
     state.height_field =
@@ -409,6 +434,11 @@ Result<Shape> Shape::from_state(const ShapeState& state) {
     case ShapeType::kMesh: {
       if (state.mesh == nullptr) return Status::error("mesh: required for a mesh");
       return create(*state.mesh);
+    }
+    case ShapeType::kCompound: {
+      if (state.compound == nullptr) return Status::error("parts: required for a compound");
+      return Compound::of_parts(std::vector<Compound::Part>(state.compound->parts().begin(),
+                                                            state.compound->parts().end()));
     }
     case ShapeType::kHull: {
       if (state.polyhedron == nullptr) return Status::error("polyhedron: required for a hull");

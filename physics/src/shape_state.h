@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "physics/compound.h"
 #include "physics/math.h"
 #include "physics/polyhedron.h"
 #include "physics/shape.h"
@@ -19,6 +20,8 @@ struct ShapeState {
   std::shared_ptr<const ConvexPolyhedron> polyhedron;  // hulls only (a box rebuilds its own)
   std::shared_ptr<const HeightFieldDef> height_field;  // heightfields only
   std::shared_ptr<const TriangleMeshDef> mesh;         // meshes only
+  // Compounds only: their parts, each built from its own state (of_parts checks the poses).
+  std::shared_ptr<const Compound> compound;
 };
 
 }  // namespace tumble

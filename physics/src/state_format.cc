@@ -132,6 +132,15 @@ void put_shape(Writer& w, const Shape& shape) {
         w.put(index);
     return;
   }
+  if (s.type == ShapeType::kCompound) {
+    w.put(static_cast<std::uint32_t>(s.compound->parts().size()));
+    for (const Compound::Part& part : s.compound->parts()) {
+      w.put(part.pose.position);
+      w.put(part.pose.orientation);
+      put_shape(w, part.shape);
+    }
+    return;
+  }
   if (s.type != ShapeType::kHull) return;
   const ConvexPolyhedron& p = *s.polyhedron;
   w.put(static_cast<std::uint32_t>(p.vertices.size()));
@@ -155,16 +164,38 @@ void put_shape(Writer& w, const Shape& shape) {
   w.put(p.volume);
 }
 
-Result<Shape> take_shape(Reader& r) {
+// `in_compound`: a part's shape, which may not itself be a compound (nor recurse further).
+Result<Shape> take_shape(Reader& r, bool in_compound = false) {
   ShapeState s;
   const auto type = r.take<std::uint8_t>("type");
   s.radius = r.take<double>("radius");
   s.half_height = r.take<double>("half_height");
   s.half_extents = r.vec3("half_extents");
   if (!r.ok()) return r.status();
-  if (type > static_cast<std::uint8_t>(ShapeType::kMesh))
+  if (type > static_cast<std::uint8_t>(ShapeType::kCompound))
     return Status::error("type: unknown shape type " + std::to_string(type));
   s.type = static_cast<ShapeType>(type);
+  if (in_compound && !is_convex_part(s.type))
+    return Status::error("type: a compound's parts must be convex");
+  if (s.type == ShapeType::kCompound) {
+    // The smallest part: a pose and a sphere's fixed fields.
+    const std::uint32_t count = r.count("parts", 7 * 8 + 1 + 6 * 8);
+    if (count > kMaxCompoundParts)
+      return Status::error("parts: " + std::to_string(count) + ", more than the " +
+                           std::to_string(kMaxCompoundParts) + " a compound may have");
+    std::vector<Compound::Part> parts(count);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const std::string field = "parts[" + std::to_string(i) + "].";
+      parts[i].pose.position = r.vec3((field + "pose.position").c_str());
+      parts[i].pose.orientation = r.quat((field + "pose.orientation").c_str());
+      if (!r.ok()) return r.status();
+      Result<Shape> part = take_shape(r, true);
+      if (!part) return part.status().within(field + "shape.");
+      parts[i].shape = std::move(part).value();
+    }
+    if (!r.ok()) return r.status();
+    return Compound::of_parts(std::move(parts));
+  }
   if (s.type == ShapeType::kHull) {
     auto p = std::make_shared<ConvexPolyhedron>();
     p->vertices.resize(r.count("polyhedron.vertices", 24));

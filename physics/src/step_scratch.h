@@ -142,17 +142,20 @@ struct StepScratch {
   std::vector<double> manifold_depth;         // each manifold's depth, for the step's deepest
   std::vector<std::uint32_t> previous_pair;
   std::vector<std::uint8_t> reused;
-  // Pairs with terrain, which may touch along several normals: each such broad-phase pair's
-  // place in terrain_found (kNoTerrain for the others). Its first manifold goes where any pair's
-  // goes, the others after it; their records follow one another in `pairs`, in the same order.
-  struct TerrainFound {
-    TerrainContacts contacts;
-    std::array<ContactPairRecord, kMaxTerrainManifolds> records;
-    std::array<std::uint32_t, kMaxTerrainManifolds> previous;
+  // Pairs with terrain or a compound, which may touch along several manifolds: each such
+  // broad-phase pair's place in many_found (kNotMany for the others), which holds where its room
+  // starts in the flat arrays below, how many manifolds the pair can have (most_manifolds) and
+  // how many it has. Its first manifold goes where any pair's goes, the others after it; their
+  // records follow one another in `pairs`, in the same order. The arrays are never cut back.
+  struct ManyFound {
+    std::uint32_t first = 0, room = 0, count = 0;
   };
-  static constexpr std::uint32_t kNoTerrain = UINT32_MAX;
-  std::vector<std::uint32_t> terrain_slot;
-  std::vector<TerrainFound> terrain_found;
+  static constexpr std::uint32_t kNotMany = UINT32_MAX;
+  std::vector<std::uint32_t> many_slot;
+  std::vector<ManyFound> many_found;
+  std::vector<ContactManifold> many_manifolds;
+  std::vector<ContactPairRecord> many_records;
+  std::vector<std::uint32_t> many_previous;
 };
 
 }  // namespace tumble

@@ -211,7 +211,7 @@ Result<std::vector<BodyId>> World::create_bodies(std::span<const BodyDef> defs) 
     // A moving body joins the moving set, which every step visits anyway; only a resting one
     // changes what the broad phase keeps.
     if (slot.body.is_kinematic()) kinematic_.push_back(index);
-    if (is_terrain(slot.body.shape.type())) ++terrain_count_;
+    if (makes_many_manifolds(slot.body.shape.type())) ++many_manifold_bodies_;
     if (slot.body.is_moving())
       join_awake(index);
     else if (!slot.body.carries())  // a carrier's bounds are made every step, as a moving body's
@@ -235,7 +235,7 @@ Status World::remove_body(BodyId id) {
   else
     resting_changed(id.index);
   if (slot.body.is_kinematic()) std::erase(kinematic_, id.index);
-  if (is_terrain(slot.body.shape.type())) --terrain_count_;
+  if (makes_many_manifolds(slot.body.shape.type())) --many_manifold_bodies_;
   // The step's per-slot data forget it (bounds kept for moving bodies are not visited again).
   if (id.index < bounds_.size()) {
     bounds_[id.index] = Aabb();
@@ -782,16 +782,31 @@ void World::find_contacts(double dt) {
   const double gravity = settings_.gravity.norm();
   const int threads = thread_count(settings_.threads);
   match_pair_records(pairs_, s.pairs, s.found_previous);
-  // Pairs with terrain get room for several manifolds, numbered in pair order.
-  if (terrain_count_ > 0) {
-    resize_reusing(s.terrain_slot, pairs_.size());
-    std::uint32_t terrain_pairs = 0;
+  // Pairs with terrain or a compound get room for several manifolds, numbered in pair order.
+  if (many_manifold_bodies_ > 0) {
+    resize_reusing(s.many_slot, pairs_.size());
+    std::uint32_t many_pairs = 0, room = 0;
     for (std::size_t i = 0; i < pairs_.size(); ++i) {
-      const bool terrain =
-          is_terrain_pair(bodies_[pairs_[i].a].body.shape, bodies_[pairs_[i].b].body.shape);
-      s.terrain_slot[i] = terrain ? terrain_pairs++ : StepScratch::kNoTerrain;
+      const Shape& a = bodies_[pairs_[i].a].body.shape;
+      const Shape& b = bodies_[pairs_[i].b].body.shape;
+      s.many_slot[i] = is_many_manifold_pair(a, b) ? many_pairs++ : StepScratch::kNotMany;
     }
-    if (s.terrain_found.size() < terrain_pairs) s.terrain_found.resize(terrain_pairs);
+    // Doubled when they grow: a pile still landing on terrain adds a few such pairs most steps.
+    const auto grow = [](auto& buffer, std::size_t size) {
+      if (size > buffer.capacity()) buffer.reserve(std::max(size, 2 * buffer.capacity()));
+      buffer.resize(size);
+    };
+    grow(s.many_found, many_pairs);
+    for (std::size_t i = 0; i < pairs_.size(); ++i) {
+      if (s.many_slot[i] == StepScratch::kNotMany) continue;
+      const auto most = static_cast<std::uint32_t>(
+          most_manifolds(bodies_[pairs_[i].a].body.shape, bodies_[pairs_[i].b].body.shape));
+      s.many_found[s.many_slot[i]] = {room, most, 0};
+      room += most;
+    }
+    grow(s.many_manifolds, room);
+    grow(s.many_records, room);
+    grow(s.many_previous, room);
   }
   const std::uint32_t flags =
       or_over_indices(threads, n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
@@ -826,30 +841,40 @@ void World::find_contacts(double dt) {
           settings.feature_slack_relative = std::max(settings.feature_slack_relative, 0.05);
           settings.face_angle = std::max(settings.face_angle, 0.02);
         }
-        if (terrain_count_ > 0 && s.terrain_slot[i] != StepScratch::kNoTerrain) {
-          StepScratch::TerrainFound& found = s.terrain_found[s.terrain_slot[i]];
+        if (many_manifold_bodies_ > 0 && s.many_slot[i] != StepScratch::kNotMany) {
+          StepScratch::ManyFound& found = s.many_found[s.many_slot[i]];
+          const std::span<ContactManifold> room(s.many_manifolds.data() + found.first, found.room);
+          std::size_t count = 0;
           std::uint32_t pair_flags =
-              collide_terrain(a.shape, pose_a, b.shape, pose_b, settings, &found.contacts);
-          if (dt > 0 && found.contacts.count > 0 && fast) {  // as for any pair, below
+              collide_many(a.shape, pose_a, b.shape, pose_b, settings, room, &count);
+          if (dt > 0 && count > 0 && fast) {  // as for any pair, below
             settings.margin =
                 settings_.collision.margin + rest + motion_[pairs_[i].a] + motion_[pairs_[i].b];
-            pair_flags |=
-                collide_terrain(a.shape, pose_a, b.shape, pose_b, settings, &found.contacts);
+            pair_flags |= collide_many(a.shape, pose_a, b.shape, pose_b, settings, room, &count);
           }
-          if (found.contacts.count == 0) return pair_flags;
+          found.count = static_cast<std::uint32_t>(count);
+          if (count == 0) return pair_flags;
           s.found_flags[i] = StepScratch::kPairTouches;
+          const std::span<ContactPairRecord> records(s.many_records.data() + found.first, count);
+          const std::span<std::uint32_t> matched(s.many_previous.data() + found.first, count);
           // The pair's records of the last step follow one another, manifold by manifold.
-          for (int c = 0; c < found.contacts.count; ++c) {
-            record_manifold(found.contacts.manifolds[c], PolytopeFeature{}, contact.a, pose_a,
-                            contact.b, pose_b, &found.records[c]);
-            const std::size_t last = static_cast<std::size_t>(previous) + c;
-            found.previous[c] = previous != kNoRecord && last < s.pairs.size() &&
-                                        s.pairs[last].a == contact.a && s.pairs[last].b == contact.b
-                                    ? static_cast<std::uint32_t>(last)
-                                    : kNoRecord;
+          std::size_t run = 0;
+          if (previous != kNoRecord)
+            while (previous + run < s.pairs.size() && s.pairs[previous + run].a == contact.a &&
+                   s.pairs[previous + run].b == contact.b)
+              ++run;
+          match_manifold_records(room.first(count),
+                                 std::span<const ContactPairRecord>(s.pairs).subspan(
+                                     previous == kNoRecord ? 0 : previous, run),
+                                 is_compound_pair(a.shape, b.shape), matched);
+          for (std::size_t c = 0; c < count; ++c) {
+            record_manifold(room[c], PolytopeFeature{}, contact.a, pose_a, contact.b, pose_b,
+                            &records[c]);
+            if (matched[c] != kNoRecord) matched[c] += previous;
           }
-          contact.manifold = found.contacts.manifolds[0];
-          s.found_records[i] = found.records[0];
+          contact.manifold = room[0];
+          s.found_records[i] = records[0];
+          s.found_previous[i] = matched[0];
           return pair_flags;
         }
         // A pair of polytopes that has barely moved since its feature was searched for clips
@@ -898,8 +923,8 @@ void World::find_contacts(double dt) {
   for (std::size_t i = 0; i < pairs_.size(); ++i) {
     s.kept_index[i] = kept;
     if ((s.found_flags[i] & StepScratch::kPairTouches) == 0) continue;
-    const bool terrain = terrain_count_ > 0 && s.terrain_slot[i] != StepScratch::kNoTerrain;
-    kept += terrain ? s.terrain_found[s.terrain_slot[i]].contacts.count : 1;
+    const bool many = many_manifold_bodies_ > 0 && s.many_slot[i] != StepScratch::kNotMany;
+    kept += many ? s.many_found[s.many_slot[i]].count : 1;
   }
   resize_reusing(contacts_, kept);
   resize_reusing(s.next_pairs, kept);
@@ -912,12 +937,12 @@ void World::find_contacts(double dt) {
     s.next_pairs[k] = s.found_records[i];
     s.previous_pair[k] = s.found_previous[i];
     s.reused[k] = (s.found_flags[i] & StepScratch::kPairKeptFeature) != 0;
-    if (terrain_count_ == 0 || s.terrain_slot[i] == StepScratch::kNoTerrain) return;
-    const StepScratch::TerrainFound& found = s.terrain_found[s.terrain_slot[i]];
-    for (int c = 1; c < found.contacts.count; ++c) {
-      contacts_[k + c] = {contacts_[k].a, contacts_[k].b, found.contacts.manifolds[c]};
-      s.next_pairs[k + c] = found.records[c];
-      s.previous_pair[k + c] = found.previous[c];
+    if (many_manifold_bodies_ == 0 || s.many_slot[i] == StepScratch::kNotMany) return;
+    const StepScratch::ManyFound& found = s.many_found[s.many_slot[i]];
+    for (std::uint32_t c = 1; c < found.count; ++c) {
+      contacts_[k + c] = {contacts_[k].a, contacts_[k].b, s.many_manifolds[found.first + c]};
+      s.next_pairs[k + c] = s.many_records[found.first + c];
+      s.previous_pair[k + c] = s.many_previous[found.first + c];
       s.reused[k + c] = 0;
     }
   });

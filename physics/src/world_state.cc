@@ -222,8 +222,8 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     const BodySlotState& b = state.slots[r.b.index];
     const bool current =
         a.alive && b.alive && a.generation == r.a.generation && b.generation == r.b.generation;
-    const bool terrain = !current || is_terrain_pair(a.body.shape, b.body.shape);
-    const bool repeat_allowed = same && terrain && repeats < kMaxTerrainManifolds;
+    const bool many = !current || is_many_manifold_pair(a.body.shape, b.body.shape);
+    const bool repeat_allowed = same && many && repeats < kMaxPairManifolds;
     if (!repeat_allowed &&
         (p.a.index != r.a.index ? p.a.index > r.a.index : p.b.index >= r.b.index))
       return Status::error("contact_pairs[" + std::to_string(k) +
@@ -262,7 +262,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
     if (world.bodies_[i].body.asleep) world.link_sleeper(i, world.bodies_[i].body.sleep_island);
     if (world.bodies_[i].body.is_moving()) world.awake_.push_back(i);
     if (world.bodies_[i].body.is_kinematic()) world.kinematic_.push_back(i);
-    if (is_terrain(world.bodies_[i].body.shape.type())) ++world.terrain_count_;
+    if (makes_many_manifolds(world.bodies_[i].body.shape.type())) ++world.many_manifold_bodies_;
     world.filters_used_ = world.filters_used_ || world.bodies_[i].body.filter != CollisionFilter{};
   }
   world.live_count_ = live;

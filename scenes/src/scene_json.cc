@@ -205,10 +205,51 @@ TriangleMeshDef read_mesh(ObjectReader& r) {
   return def;
 }
 
+ShapeDef read_shape(ObjectReader& r);
+
+// A quaternion [w, x, y, z].
+Quat read_quat(const Json& q, const std::string& path) {
+  if (!q.is_array() || q.size() != 4) fail(path, "must be a quaternion [w, x, y, z]");
+  double c[4];
+  for (int k = 0; k < 4; ++k)
+    c[k] = ObjectReader::read_number(q[k], path + "[" + std::to_string(k) + "]");
+  return Quat(c[0], c[1], c[2], c[3]);
+}
+
+// "parts": [{"shape": "box", "size": [...], "position": [x, y, z], "orientation": [w, x, y, z]},
+// ...]: convex parts placed in the body's frame.
+CompoundDef read_compound(ObjectReader& r) {
+  const Json* parts = r.find("parts");
+  const std::string path = r.child("parts");
+  if (parts == nullptr || !parts->is_array() || parts->empty())
+    fail(path, "must be an array of parts, each a convex shape with a position and orientation");
+  if (parts->size() > kMaxCompoundParts)
+    fail(path, std::to_string(parts->size()) + " parts, more than the " +
+                   std::to_string(kMaxCompoundParts) + " a compound may have");
+  CompoundDef def;
+  for (std::size_t i = 0; i < parts->size(); ++i) {
+    ObjectReader part((*parts)[i], path + "[" + std::to_string(i) + "]");
+    // Refused before it is read: a compound inside a compound would recurse.
+    const Json* kind = (*parts)[i].contains("shape") ? &(*parts)[i]["shape"] : nullptr;
+    if (kind != nullptr && kind->is_string() && kind->get<std::string>() != "box" &&
+        kind->get<std::string>() != "sphere" && kind->get<std::string>() != "capsule" &&
+        kind->get<std::string>() != "hull")
+      fail(part.child("shape"), "a compound's parts must be a box, sphere, capsule or hull");
+    CompoundPart placed{read_shape(part), Pose{}};
+    placed.pose.position = part.vector("position", Vec3::Zero());
+    if (const Json* q = part.find("orientation"))
+      placed.pose.orientation = read_quat(*q, part.child("orientation"));
+    part.reject_unknown();
+    def.parts.push_back(std::move(placed));
+  }
+  return def;
+}
+
 ShapeDef read_shape(ObjectReader& r) {
   const std::string type = r.string("shape", "");
   if (type.empty())
-    fail(r.child("shape"), "missing (box, sphere, capsule, hull, plane, heightfield or mesh)");
+    fail(r.child("shape"),
+         "missing (box, sphere, capsule, hull, plane, heightfield, mesh or compound)");
   if (type == "box") {
     const Json* size = r.find("size");
     if (size == nullptr) fail(r.child("size"), "missing (full extents x, y, z in m)");
@@ -240,8 +281,10 @@ ShapeDef read_shape(ObjectReader& r) {
   if (type == "plane") return HalfSpaceDef{};
   if (type == "heightfield") return read_height_field(r);
   if (type == "mesh") return read_mesh(r);
+  if (type == "compound") return read_compound(r);
   fail(r.child("shape"),
-       "unknown shape '" + type + "' (box, sphere, capsule, hull, plane, heightfield or mesh)");
+       "unknown shape '" + type +
+           "' (box, sphere, capsule, hull, plane, heightfield, mesh or compound)");
 }
 
 void read_limits(const Json& json, WorldLimits* limits) {
@@ -275,14 +318,8 @@ BodyDef read_body(const Json& json, const std::string& path, const WorldLimits& 
   def.mass = r.number("mass", 0);
   def.density = r.number("density", def.density);
   def.position = r.vector("position", def.position);
-  if (const Json* q = r.find("orientation")) {
-    const std::string qpath = r.child("orientation");
-    if (!q->is_array() || q->size() != 4) fail(qpath, "must be a quaternion [w, x, y, z]");
-    double c[4];
-    for (int k = 0; k < 4; ++k)
-      c[k] = ObjectReader::read_number((*q)[k], qpath + "[" + std::to_string(k) + "]");
-    def.orientation = Quat(c[0], c[1], c[2], c[3]);
-  }
+  if (const Json* q = r.find("orientation"))
+    def.orientation = read_quat(*q, r.child("orientation"));
   def.linear_velocity = r.vector("linear_velocity", def.linear_velocity);
   def.angular_velocity = r.vector("angular_velocity", def.angular_velocity);
   def.friction = r.number("friction", def.friction);
@@ -466,8 +503,7 @@ Json vector_json(const Vec3& v) {
   return Json::array({v.x(), v.y(), v.z()});
 }
 
-Json body_json(const BodyDef& def) {
-  Json out = Json::object();
+void shape_json(const ShapeDef& def, Json& out) {
   std::visit(
       [&](const auto& shape) {
         using T = std::decay_t<decltype(shape)>;
@@ -499,11 +535,27 @@ Json body_json(const BodyDef& def) {
           out["triangles"] = Json::array();
           for (const auto& t : shape.triangles)
             out["triangles"].push_back(Json::array({t[0], t[1], t[2]}));
+        } else if constexpr (std::is_same_v<T, CompoundDef>) {
+          out["shape"] = "compound";
+          out["parts"] = Json::array();
+          for (const CompoundPart& part : shape.parts) {
+            Json each = Json::object();
+            shape_json(part.shape, each);
+            each["position"] = vector_json(part.pose.position);
+            const Quat& q = part.pose.orientation;
+            each["orientation"] = Json::array({q.w(), q.x(), q.y(), q.z()});
+            out["parts"].push_back(std::move(each));
+          }
         } else {
           out["shape"] = "plane";
         }
       },
-      def.shape);
+      def);
+}
+
+Json body_json(const BodyDef& def) {
+  Json out = Json::object();
+  shape_json(def.shape, out);
   out["static"] = def.type == BodyType::kStatic;
   if (def.type == BodyType::kKinematic) out["kinematic"] = true;
   if (def.mass > 0)

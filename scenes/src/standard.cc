@@ -84,6 +84,38 @@ SceneDef terrain_mesh_pile_scene(int count) {
   return scene;
 }
 
+// Bodies of parts, each within the pile's 1 m box: a jack (three 1 x 0.2 x 0.2 m bars crossing at
+// its centre) and a dumbbell (two balls of 0.25 m on a bar), in turn.
+CompoundDef jack() {
+  CompoundDef def;
+  for (int axis = 0; axis < 3; ++axis) {
+    Vec3 size = Vec3::Constant(0.2);
+    size[axis] = 1.0;
+    def.parts.push_back({BoxDef::of_size(size), Pose{}});
+  }
+  return def;
+}
+
+CompoundDef dumbbell() {
+  CompoundDef def;
+  def.parts = {{SphereDef{0.25}, Pose{Vec3(-0.25, 0, 0), Quat::Identity()}},
+               {SphereDef{0.25}, Pose{Vec3(0.25, 0, 0), Quat::Identity()}},
+               {CapsuleDef{0.08, 0.2},
+                Pose{Vec3::Zero(), Quat(0.5 * std::sqrt(2.0), 0, 0.5 * std::sqrt(2.0), 0)}}};
+  return def;
+}
+
+SceneDef compound_pile_scene(int count) {
+  SceneDef scene = pile_scene(count);
+  scene.name = "compound-pile-" + std::to_string(count);
+  for (std::size_t i = 1; i < scene.bodies.size(); ++i) {
+    BodyDef& body = scene.bodies[i];
+    body.shape = i % 2 == 1 ? ShapeDef{jack()} : ShapeDef{dumbbell()};
+    body.mass = 1;
+  }
+  return scene;
+}
+
 SceneDef pyramid_scene(int base) {
   SceneDef scene = base_scene("pyramid-" + std::to_string(base), 20);
   scene.bodies.push_back(ground());
@@ -492,9 +524,11 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   // Counted, ground included, before anything is built, so a request for a huge scene costs
   // nothing.
-  if (name == "pile" || name == "terrain" || name == "terrain-mesh" || name == "pyramid" ||
-      name == "tower" || name == "chain" || name == "rope-bridge" || name == "ragdolls") {
-    const bool piled = name == "pile" || name == "terrain" || name == "terrain-mesh";
+  if (name == "pile" || name == "terrain" || name == "terrain-mesh" || name == "compound-pile" ||
+      name == "pyramid" || name == "tower" || name == "chain" || name == "rope-bridge" ||
+      name == "ragdolls") {
+    const bool piled =
+        name == "pile" || name == "terrain" || name == "terrain-mesh" || name == "compound-pile";
     const std::uint64_t n = static_cast<std::uint64_t>(size.value_or(piled ? 1000 : 20));
     const std::uint64_t bodies = (name == "pyramid"    ? n * (n + 1) / 2
                                   : name == "ragdolls" ? 11 * n
@@ -512,6 +546,7 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   if (name == "pile") return pile_scene(size.value_or(1000));
   if (name == "terrain") return terrain_pile_scene(size.value_or(1000));
   if (name == "terrain-mesh") return terrain_mesh_pile_scene(size.value_or(1000));
+  if (name == "compound-pile") return compound_pile_scene(size.value_or(1000));
   if (name == "pyramid") return pyramid_scene(size.value_or(20));
   if (name == "tower") return tower_scene(size.value_or(20));
   if (name == "mass-ratio" || name == "mass-ratio-inv") {
@@ -567,7 +602,8 @@ Result<SceneDef> build_standard_scene(std::string_view spec, std::size_t max_bod
   }
   return Status::error(
       "scene '" + shown(spec) +
-      "': unknown; the standard scenes are pile, terrain, terrain-mesh, pyramid, tower, "
+      "': unknown; the standard scenes are pile, terrain, terrain-mesh, compound-pile, pyramid, "
+      "tower, "
       "mass-ratio, mass-ratio-inv, bullet, slide, spin, bounce, pendulum, double-pendulum, "
       "chain, cradle, door, rope-bridge, arm, ragdolls, carousel, default");
 }

@@ -13,13 +13,13 @@ Built from proto/tumble/v1/world.proto by `make python` into build/python (docs/
 from tumble.bodies import Body, BodySpec, Description
 from tumble.errors import ArgumentError, Error
 from tumble.frames import Contacts, Frame, FrameStream, JointStates
-from tumble.shapes import Box, Capsule, HeightField, Hull, Mesh, Plane, Sphere
+from tumble.shapes import Box, Capsule, Compound, HeightField, Hull, Mesh, Part, Plane, Sphere
 from tumble.local import World
 from tumble.world import Info, LoadedScene, RemoteWorld, Settings, Snapshot, States, connect
 
 __all__ = [
-    "ArgumentError", "Body", "BodySpec", "Box", "Capsule", "Contacts", "Description", "Error",
-    "Frame", "FrameStream", "HeightField", "Hull", "Info", "JointStates", "LoadedScene", "Mesh", "Plane",
+    "ArgumentError", "Body", "BodySpec", "Box", "Capsule", "Compound", "Contacts", "Description", "Error",
+    "Frame", "FrameStream", "HeightField", "Hull", "Info", "JointStates", "LoadedScene", "Mesh", "Part", "Plane",
     "Settings",
     "Snapshot",
     "RemoteWorld", "Sphere", "States", "World", "connect",

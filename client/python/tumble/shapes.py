@@ -121,7 +121,43 @@ class Mesh:
         return shape
 
 
-SHAPES = (Box, Sphere, Capsule, Hull, Plane, HeightField, Mesh)
+@dataclass(frozen=True)
+class Part:
+    """One convex part of a Compound: `shape` (Box, Sphere, Capsule or Hull) placed at
+    `position` (m) with `orientation` (w, x, y, z) in the body's frame."""
+
+    shape: object
+    position: tuple = (0.0, 0.0, 0.0)
+    orientation: tuple = (1.0, 0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Compound:
+    """One body of several convex parts (a table of boxes, a dumbbell): `parts`, 1 to 256 Part
+    entries. The body's mass properties are its parts' together at its one density; each part
+    touches other bodies with contacts of its own."""
+
+    parts: tuple = ()
+
+    def to_proto(self):
+        if not self.parts:
+            raise ArgumentError("parts: a compound needs at least one part")
+        shape = pb.Shape()
+        for i, part in enumerate(self.parts):
+            name = f"parts[{i}]"
+            if not isinstance(part, Part):
+                raise ArgumentError(f"{name}: expected a tumble.Part, got {part!r}")
+            if not isinstance(part.shape, (Box, Sphere, Capsule, Hull)):
+                raise ArgumentError(f"{name}.shape: a compound's parts must be a Box, Sphere, "
+                                    f"Capsule or Hull, got {part.shape!r}")
+            out = shape.compound.parts.add()
+            out.shape.CopyFrom(part.shape.to_proto())
+            convert.set_vec3(out.position, part.position, f"{name}.position")
+            convert.set_quat(out.orientation, part.orientation, f"{name}.orientation")
+        return shape
+
+
+SHAPES = (Box, Sphere, Capsule, Hull, Plane, HeightField, Mesh, Compound)
 
 
 def from_proto(shape):
@@ -144,4 +180,10 @@ def from_proto(shape):
     if kind == "mesh":
         return Mesh(np.array(shape.mesh.vertices, dtype=float).reshape(-1, 3),
                     np.array(shape.mesh.triangles, dtype=np.uint32).reshape(-1, 3))
+    if kind == "compound":
+        return Compound(tuple(
+            Part(from_proto(part.shape), tuple(convert.vec3(part.position)),
+                 tuple(convert.quat(part.orientation)) if part.HasField("orientation")
+                 else (1.0, 0.0, 0.0, 0.0))
+            for part in shape.compound.parts))
     raise ArgumentError(f"shape: unknown kind {kind!r}")

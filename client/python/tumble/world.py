@@ -34,7 +34,8 @@ def _placed(query, shape, position, orientation, mask, call):
     """Fills the shape a query places in the world (OverlapQuery, ShapeCastQuery): shape,
     position, orientation and mask."""
     if not isinstance(shape, shapes.SHAPES):
-        raise ArgumentError(f"shape: expected a Box, Sphere, Capsule or Hull, got {shape!r}", call)
+        raise ArgumentError(f"shape: expected a Box, Sphere, Capsule, Hull or Compound, got "
+                            f"{shape!r}", call)
     query.shape.CopyFrom(shape.to_proto())
     convert.set_vec3(query.position, position, "position")
     if orientation is not None:
@@ -157,8 +158,8 @@ class WorldCalls:
     # --- bodies -------------------------------------------------------------------------------
 
     def spawn(self, shape, position=None, linear_velocity=None, **options):
-        """Spawns one body of `shape` (Box, Sphere, Capsule, Hull, Plane, HeightField or Mesh); returns
-        its id.
+        """Spawns one body of `shape` (Box, Sphere, Capsule, Hull, Plane, HeightField, Mesh or
+        Compound); returns its id.
         Options are BodySpec's: orientation, angular_velocity, mass, density, friction,
         restitution, color, static, kinematic (moved only by its velocity: linear_velocity,
         angular_velocity, and set_state's), gravity_scale, linear_damping, angular_damping,
@@ -316,9 +317,9 @@ class WorldCalls:
         return out
 
     def overlap(self, shape, position, orientation=None, *, mask=None):
-        """The ids of the bodies that `shape` (Box, Sphere, Capsule or Hull) placed at `position`
-        (m, world) and `orientation` (w, x, y, z) overlaps or touches, in the order of their
-        slots; `mask`: the collision layers it meets (default every layer)."""
+        """The ids of the bodies that `shape` (Box, Sphere, Capsule, Hull or Compound) placed at
+        `position` (m, world) and `orientation` (w, x, y, z) overlaps or touches, in the order of
+        their slots; `mask`: the collision layers it meets (default every layer)."""
         query = _placed(pb.OverlapQuery(), shape, position, orientation, mask, "overlap")
         response = self._rpc("Query", pb.QueryRequest(overlaps=[query]))
         return [int(body) for body in response.overlap_ids]
@@ -338,7 +339,7 @@ class WorldCalls:
                 "normal": np.array(response.closest_normals[:3])}
 
     def cast_shape(self, shape, position, translation, orientation=None, *, mask=None):
-        """Sweeps `shape` (Box, Sphere, Capsule or Hull) from `position` (m, world) along
+        """Sweeps `shape` (Box, Sphere, Capsule, Hull or Compound) from `position` (m, world) along
         `translation` (m, world) without turning it (`orientation`: w, x, y, z); returns the first
         body it meets as a dict (body, fraction of the translation at first contact, 0 if it
         starts touching; point on the body and the body's outward normal there, world; converged:

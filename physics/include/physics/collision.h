@@ -52,19 +52,26 @@ struct CollisionSettings {
   double face_angle = 4.5e-7;
 };
 
+// The most manifolds one pair of bodies keeps: every touching pair of a compound's parts (and
+// each normal a part touches terrain along) has its own, the deepest kMaxPairManifolds of them
+// (kPairManifoldLimit when cut).
+inline constexpr std::size_t kMaxPairManifolds = 64;
+
 // Outcome flags a query raises; a query that hits an iteration bound still returns its best answer.
 enum CollisionFlags : std::uint32_t {
   kCollisionOk = 0,
   kGjkIterationLimit = 1u << 0,
   kEpaIterationLimit = 1u << 1,
   kEpaDegenerate = 1u << 2,
-  kTerrainCellLimit = 1u << 3,  // a body over more terrain cells than a pair may visit
+  kTerrainCellLimit = 1u << 3,   // a body over more terrain cells than a pair may visit
+  kPairManifoldLimit = 1u << 4,  // a pair of bodies touching along more manifolds than it keeps
 };
 
 // Contacts between shape `a` at `pose_a` and shape `b` at `pose_b`. Returns the flags; `out->count`
 // is 0 when the shapes are farther apart than the margin. Two static-only shapes (half-spaces,
-// heightfields) never collide. Against a heightfield, where a body can touch along several
-// normals, this is the deepest of its manifolds (World's contacts keep them all).
+// heightfields) never collide. Against terrain, where a body can touch along several normals, and
+// for a compound, whose parts touch on their own, this is the deepest of the manifolds (World's
+// contacts keep them all).
 std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
                       const CollisionSettings& settings, ContactManifold* out);
 

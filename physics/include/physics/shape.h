@@ -44,8 +44,25 @@ struct HalfSpaceDef {};
 // HeightFieldDef (physics/height_field.h): terrain; only static bodies may use it.
 // TriangleMeshDef (physics/triangle_mesh.h): static geometry of triangles; only static bodies.
 
+// One body made of several convex parts (spheres, capsules, boxes, hulls), each placed by a pose
+// in the body's frame: a table of five boxes, a dumbbell. The mass properties are the parts'
+// together at the body's one density (where parts overlap, the overlap counts once per part, as
+// in Bullet and Jolt); each part touches other bodies with contacts of its own. 1 to
+// kMaxCompoundParts parts (every pair of bodies walks the parts, so their number bounds the time
+// a step can take).
+inline constexpr std::size_t kMaxCompoundParts = 256;
+struct CompoundPart;
+struct CompoundDef {
+  std::vector<CompoundPart> parts;
+};
+
 using ShapeDef = std::variant<SphereDef, CapsuleDef, BoxDef, HullDef, HalfSpaceDef, HeightFieldDef,
-                              TriangleMeshDef>;
+                              TriangleMeshDef, CompoundDef>;
+
+struct CompoundPart {
+  ShapeDef shape;  // convex: a sphere, capsule, box or hull
+  Pose pose;       // the part's frame in the body's (orientation normalized on creation)
+};
 
 // Ordered so that collision dispatch can always put the lower type first (the values are the
 // state format's: a new type goes last).
@@ -56,7 +73,8 @@ enum class ShapeType : std::uint8_t {
   kHull,
   kHalfSpace,
   kHeightField,
-  kMesh
+  kMesh,
+  kCompound
 };
 // Terrain: shapes of many triangles, which may touch a body along several normals at once.
 inline bool is_terrain(ShapeType type) {
@@ -65,6 +83,10 @@ inline bool is_terrain(ShapeType type) {
 // Shapes only static bodies may have: the ground and terrain.
 inline bool is_static_only(ShapeType type) {
   return type == ShapeType::kHalfSpace || is_terrain(type);
+}
+// Shapes whose pairs may touch along several manifolds at once: terrain and compounds.
+inline bool makes_many_manifolds(ShapeType type) {
+  return is_terrain(type) || type == ShapeType::kCompound;
 }
 const char* shape_type_name(ShapeType type);
 
@@ -75,6 +97,7 @@ struct MassProperties {
 };
 
 struct ShapeState;  // everything a shape is made of, for the state format (physics/src)
+class Compound;     // physics/compound.h
 
 class Shape {
  public:
@@ -91,6 +114,8 @@ class Shape {
   const HeightField* height_field() const { return height_field_.get(); }
   // The mesh of a mesh shape; null for the other shapes.
   const TriangleMesh* mesh() const { return mesh_.get(); }
+  // The parts of a compound shape (physics/compound.h); null for the other shapes.
+  const Compound* compound() const { return compound_.get(); }
 
   // Bounds in the shape frame; infinite for a half-space. A heightfield's reach down to its base.
   Aabb local_bounds() const;
@@ -99,15 +124,17 @@ class Shape {
   MassProperties mass_properties(double density) const;
   // A length that sets the scale of numerical tolerances: the largest half extent (a
   // heightfield's: its larger spacing, the size of its features; a mesh's: its longest triangle
-  // edge).
+  // edge; a compound's: its smallest part's).
   double size() const;
   // m: the radius of the largest sphere about the shape's origin that fits inside it (the
   // smallest half extent of a box); a body moving less than this per step cannot jump over a
-  // wall of its own thickness. 0 when the origin is outside; infinite for a half-space.
+  // wall of its own thickness. 0 when the origin is outside; infinite for a half-space; a
+  // compound's is its thinnest part's (each part moving less than its own cannot jump a wall).
   double inner_radius() const { return inner_radius_; }
   // m: the largest distance of a point of the shape from its origin; infinite for a half-space.
   double outer_radius() const { return outer_radius_; }
-  // The point of the shape farthest along `direction` (shape frame); convex shapes only.
+  // The point of the shape farthest along `direction` (shape frame): of a compound, its parts'
+  // convex hull's. Not for a half-space or terrain.
   Vec3 support(const Vec3& direction) const;
   // The same shape moved so that `offset` (shape frame) becomes the origin.
   Shape recentred(const Vec3& offset) const;
@@ -126,8 +153,10 @@ class Shape {
   std::shared_ptr<const ConvexPolyhedron> polyhedron_;
   std::shared_ptr<const HeightField> height_field_;
   std::shared_ptr<const TriangleMesh> mesh_;
+  std::shared_ptr<const Compound> compound_;
   double inner_radius_ = 0, outer_radius_ = 0;
   void update_radii();
+  friend class Compound;
 };
 
 }  // namespace tumble

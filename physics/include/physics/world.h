@@ -334,7 +334,7 @@ class World {
   std::vector<std::uint32_t> kinematic_;
   // How many live bodies are terrain (heightfields): their pairs may give several manifolds
   // (find_contacts); a world without pays one test of zero.
-  std::size_t terrain_count_ = 0;
+  std::size_t many_manifold_bodies_ = 0;  // terrain and compounds (makes_many_manifolds)
   // The broad phase's moving bodies: awake_ and the kinematic bodies with a velocity, ascending
   // (awake_ itself where there are none).
   std::vector<std::uint32_t> moving_scratch_;

@@ -30,6 +30,8 @@ class SceneRandom {
 SceneDef pile_scene(int count = 1000);             // S1: a lattice of tilted boxes falling, 10 s
 SceneDef terrain_pile_scene(int count = 1000);  // the same pile onto rolling hills (a heightfield)
 SceneDef terrain_mesh_pile_scene(int count = 1000);  // the same hills as a triangle mesh
+// The pile with each box a body of parts: jacks (three crossing bars) and dumbbells in turn.
+SceneDef compound_pile_scene(int count = 1000);
 SceneDef pyramid_scene(int base = 20);             // S2: base boxes at the bottom, 20 s
 SceneDef tower_scene(int height = 20);             // S3: 20 s
 SceneDef mass_ratio_scene(bool inverted = false);  // S4: 1, 1, 1000 kg bottom to top (inverted:
