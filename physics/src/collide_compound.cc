@@ -4,6 +4,7 @@
 // CompoundShape do. Parts are culled by their bounds first, so a pair pays for the parts that
 // can touch.
 #include <algorithm>
+#include <cmath>
 
 #include "narrow_phase.h"
 #include "physics/compound.h"
@@ -13,24 +14,32 @@ namespace {
 
 struct PlacedPart {
   const Shape* shape;
-  Pose pose;    // world
-  Aabb bounds;  // world
+  Pose pose;     // world
+  double reach;  // m: the part's outer radius about its origin
   std::uint32_t index;
 };
 
-// A compound's parts placed in the world, or the shape itself as its only part.
-void place_parts(const Shape& shape, const Pose& pose, std::vector<PlacedPart>* out) {
+// The parts of `shape` (a compound's, or the shape itself as its only part) that can reach
+// `other` placed in the world: each part's bounds, in the shape's frame, against the other's
+// bounds brought into that frame, so that a part left out costs one box test and no placing.
+void place_parts(const Shape& shape, const Pose& pose, const Shape& other, const Pose& other_pose,
+                 double margin, std::vector<PlacedPart>* out) {
   out->clear();
   if (shape.type() != ShapeType::kCompound) {
-    out->push_back({&shape, pose, transform_aabb(shape.local_bounds(), pose), 0});
+    out->push_back({&shape, pose, shape.outer_radius(), 0});
     return;
   }
+  const Quat into = pose.orientation.conjugate();
+  const Pose other_here{into * (other_pose.position - pose.position),
+                        into * other_pose.orientation};
+  const Aabb reach = transform_aabb(other.local_bounds(), other_here).expanded(margin);
   const auto parts = shape.compound()->parts();
+  out->reserve(parts.size());  // room for every part at once, however many touch this time
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const Compound::Part& part = parts[i];
+    if (!part.bounds.overlaps(reach)) continue;
     const Pose placed{pose.transform(part.pose.position), pose.orientation * part.pose.orientation};
-    out->push_back(
-        {&part.shape, placed, transform_aabb(part.bounds, pose), static_cast<std::uint32_t>(i)});
+    out->push_back({&part.shape, placed, part.shape.outer_radius(), static_cast<std::uint32_t>(i)});
   }
 }
 
@@ -69,17 +78,19 @@ std::uint32_t collide_compound(const Shape& a, const Pose& pose_a, const Shape& 
   *count = 0;
   if (room.empty()) return kCollisionOk;
   thread_local std::vector<PlacedPart> parts_a, parts_b;
-  place_parts(a, pose_a, &parts_a);
-  place_parts(b, pose_b, &parts_b);
-  const Aabb reach_b = transform_aabb(b.local_bounds(), pose_b).expanded(settings.margin);
+  place_parts(a, pose_a, b, pose_b, settings.margin, &parts_a);
+  if (parts_a.empty()) return kCollisionOk;
+  place_parts(b, pose_b, a, pose_a, settings.margin, &parts_b);
   std::uint32_t flags = kCollisionOk;
   TerrainContacts terrain;
   ContactManifold manifold;
   for (const PlacedPart& part_a : parts_a) {
-    if (!part_a.bounds.overlaps(reach_b)) continue;
-    const Aabb reach_a = part_a.bounds.expanded(settings.margin);
     for (const PlacedPart& part_b : parts_b) {
-      if (!part_b.bounds.overlaps(reach_a)) continue;
+      // Parts farther apart than their outer spheres (and the margin) cannot touch.
+      const double reach = part_a.reach + part_b.reach + settings.margin;
+      if (std::isfinite(reach) &&
+          (part_b.pose.position - part_a.pose.position).squaredNorm() > reach * reach)
+        continue;
       if (is_terrain_pair(*part_a.shape, *part_b.shape)) {
         flags |= collide_terrain(*part_a.shape, part_a.pose, *part_b.shape, part_b.pose, settings,
                                  &terrain);
