@@ -138,8 +138,8 @@ TEST(FuzzFiles, SceneJson) {
   EXPECT_GT(tally.refused, 300u);
 }
 
-std::string landed_pile_snapshot() {
-  World world = make_world(pile_scene(20)).value();
+std::string landed_pile_snapshot(const SceneDef& scene = pile_scene(20)) {
+  World world = make_world(scene).value();
   for (int k = 0; k < 40; ++k)
     EXPECT_TRUE(world.step(1.0 / 60).is_ok());
   server::SavedWorld saved;
@@ -154,14 +154,13 @@ std::string landed_pile_snapshot() {
   return server::encode_snapshot(saved);
 }
 
-TEST(FuzzFiles, Snapshots) {
-  Hostile h(18);
-  const std::string good = landed_pile_snapshot();
+// Damaged snapshots of `good`, counted; every accepted one must step soundly.
+FuzzTally fuzz_snapshots(Hostile& h, const std::string& good, int count) {
   v1::snapshot::WorldSnapshot parsed;
-  ASSERT_TRUE(parsed.ParseFromString(good));
-  ASSERT_GT(World::state_sizes(parsed.engine_state()).value().contact_pairs, 0u);
+  EXPECT_TRUE(parsed.ParseFromString(good));
+  EXPECT_GT(World::state_sizes(parsed.engine_state()).value().contact_pairs, 0u);
   FuzzTally tally;
-  for (int i = 0; i < 3000; ++i) {
+  for (int i = 0; i < count; ++i) {
     const std::string bytes = testing::damaged_snapshot(h, good);
     ++tally.tried;
     Result<server::SavedWorld> saved = server::decode_snapshot(bytes);
@@ -179,10 +178,27 @@ TEST(FuzzFiles, Snapshots) {
                     << " was accepted but stepped into an unsound world: " << wrong;
     }
   }
+  return tally;
+}
+
+TEST(FuzzFiles, Snapshots) {
+  Hostile h(18);
+  const FuzzTally tally = fuzz_snapshots(h, landed_pile_snapshot(), 3000);
   print("snapshots", tally);
   EXPECT_EQ(tally.poisoned, 0u);
   EXPECT_GT(tally.accepted, 100u);
   EXPECT_GT(tally.refused, 1000u);
+}
+
+// A pile of bodies of parts: hostile numbers over their parts' poses and shapes, their counts and
+// types (a part that says it is a compound, a plane or a mesh).
+TEST(FuzzFiles, SnapshotsOfCompounds) {
+  Hostile h(19);
+  const FuzzTally tally = fuzz_snapshots(h, landed_pile_snapshot(compound_pile_scene(12)), 1500);
+  print("snapshots of compounds", tally);
+  EXPECT_EQ(tally.poisoned, 0u);
+  EXPECT_GT(tally.accepted, 50u);
+  EXPECT_GT(tally.refused, 500u);
 }
 
 // A recording splits each frame into its channels (recording_writer.h); reading puts it back
