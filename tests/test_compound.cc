@@ -282,6 +282,12 @@ TEST(Compound, APairKeepsItsDeepestManifoldsAndSaysSo) {
   const std::uint32_t flags = collide(shape, tilted, ground, Pose{}, settings, &deepest);
   EXPECT_NE(flags & kPairManifoldLimit, 0u);
   EXPECT_NEAR(deepest.depth, 0.01 + std::sin(0.01) * 1.8, 1e-6);
+  // Two rafts heaped into one another: 10,000 pairs of parts within reach, of which a pair of
+  // bodies meets at most kMaxPartPairs; still an answer, and the flag.
+  const std::uint32_t heaped = collide(
+      shape, Pose{}, shape, Pose{Vec3(0.01, 0.01, 0), Quat::Identity()}, settings, &deepest);
+  EXPECT_NE(heaped & kPairManifoldLimit, 0u);
+  EXPECT_GT(deepest.count, 0);
 
   World world;
   add_static(&world, HalfSpaceDef{});

@@ -135,6 +135,41 @@ TEST(WorldState, TouchingPairsKeepTheirColoursFromStepToStep) {
     EXPECT_LT(record.colour, kContactColours);
 }
 
+// A compound pair's records keep their part pairs' features with the parts' indices in the top
+// bits: a resumed world clips the same features, and a record naming a part the body lacks, or a
+// face its part lacks, is refused.
+TEST(WorldState, CompoundRecordsNameTheirParts) {
+  SceneDef scene = compound_pile_scene(8);
+  scene.world.solver.sleeping = false;
+  World world = build(scene);
+  for (int k = 0; k < 240; ++k)
+    ASSERT_TRUE(world.step(kDt));
+  const WorldStateData good = data_of(world);
+  std::size_t with_parts = 0, at = 0;
+  for (std::size_t k = 0; k < good.contact_pairs.size(); ++k)
+    if (good.contact_pairs[k].feature_kind != 0 && good.contact_pairs[k].feature_first >> 16 != 0) {
+      ++with_parts;
+      at = k;
+    }
+  ASSERT_GT(with_parts, 0u);  // some part other than the first keeps a feature
+  WorldStateData s = good;
+  s.contact_pairs[at].feature_first = (200u << 16) | (s.contact_pairs[at].feature_first & 0xffff);
+  expect_refused(world.settings(), s, "contact_pairs[" + std::to_string(at) + "].feature");
+  s = good;
+  s.contact_pairs[at].feature_kind = 1;
+  s.contact_pairs[at].feature_first = (s.contact_pairs[at].feature_first & 0xffff0000u) | 1000;
+  expect_refused(world.settings(), s, "contact_pairs[" + std::to_string(at) + "].feature");
+  World resumed = world_of(world.settings(), good).value();
+  std::uint64_t reused = 0;
+  for (int k = 0; k < 30; ++k) {
+    ASSERT_TRUE(world.step(kDt));
+    ASSERT_TRUE(resumed.step(kDt));
+    reused += world.last_step().reused_manifolds;
+  }
+  EXPECT_EQ(resumed.save_state(), world.save_state());
+  EXPECT_GT(reused, 0u);  // the part pairs' features were kept, not searched every step
+}
+
 TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   const World original = busy_world();
   const WorldStateData good = data_of(original);

@@ -6,6 +6,7 @@
 
 #include "manifold.h"
 #include "narrow_phase.h"
+#include "physics/compound.h"
 
 namespace tumble {
 namespace {
@@ -102,6 +103,20 @@ std::uint32_t collide(const Shape& a, const Pose& pose_a, const Shape& b, const 
 
 bool feature_fits(const Shape& a, const Shape& b, const PolytopeFeature& feature) {
   if (feature.kind == PolytopeFeature::kNone) return true;
+  if (is_compound_pair(a, b)) {
+    // The parts' indices in the top bits (kPartShift); a shape that is not a compound is part 0.
+    const auto part = [](const Shape& shape, std::uint32_t index) -> const Shape* {
+      if (shape.type() != ShapeType::kCompound) return index == 0 ? &shape : nullptr;
+      const auto parts = shape.compound()->parts();
+      return index < parts.size() ? &parts[index].shape : nullptr;
+    };
+    const Shape* part_a = part(a, feature.first >> kPartShift);
+    const Shape* part_b = part(b, feature.second >> kPartShift);
+    if (part_a == nullptr || part_b == nullptr) return false;
+    return feature_fits(*part_a, *part_b,
+                        {feature.kind, feature.first & kPartFeatureMask,
+                         feature.second & kPartFeatureMask, feature.searched});
+  }
   const ConvexPolyhedron* first = a.type() <= b.type() ? a.polyhedron() : b.polyhedron();
   const ConvexPolyhedron* second = a.type() <= b.type() ? b.polyhedron() : a.polyhedron();
   if (first == nullptr || second == nullptr) return false;

@@ -5,6 +5,7 @@
 #include <array>
 #include <span>
 
+#include "contact_record.h"
 #include "physics/collision.h"
 
 namespace tumble {
@@ -90,17 +91,45 @@ inline bool is_many_manifold_pair(const Shape& a, const Shape& b) {
 // The most manifolds a pair of these shapes can have: one per pair of parts (a convex shape is
 // one part), up to kMaxTerrainManifolds each against terrain, at most kMaxPairManifolds.
 std::size_t most_manifolds(const Shape& a, const Shape& b);
+// A compound pair's part pairs keep their separating-axis features from step to step as a single
+// pair of polytopes does (ContactPairRecord): the record of a part pair's manifold carries the
+// two parts' indices in the top 16 bits of feature_first and feature_second (the faces and edges
+// of a part number fewer than 2^16: a hull has at most 1024 points).
+constexpr std::uint32_t kPartShift = 16;
+constexpr std::uint32_t kPartFeatureMask = (1u << kPartShift) - 1;
+// What the last step left of a compound pair, for kept features: its records, in order, and how
+// far a part pair may have moved since its feature was searched (manifold_reuse times the
+// smaller part's size; the bodies' outer radii bound the motion, relative_motion).
+struct PartHistory {
+  std::span<const ContactPairRecord> run;
+  double reuse = 0;
+  double outer_a = 0, outer_b = 0;
+};
+// Beside each manifold collide_compound keeps: the feature it came from (the parts in the top
+// bits; kNone for round parts and terrain) and the record of `run` whose feature it kept
+// (UINT32_MAX: searched afresh).
+struct PartFeature {
+  PolytopeFeature feature;
+  std::uint32_t kept_from = UINT32_MAX;
+};
+
 // Every manifold of a compound pair, in the world, normals from a to b, in the order of A's
 // parts and then B's; each point's feature id mixes in the two parts' indices. `room` holds at
 // most room.size() manifolds (the deepest, kPairManifoldLimit when one is left out); *count says
-// how many it holds.
+// how many it holds. With `history`, a part pair of polytopes that has barely moved clips its
+// kept feature without searching; `features` (empty, or as large as room) receives each kept
+// manifold's feature.
 std::uint32_t collide_compound(const Shape& a, const Pose& pose_a, const Shape& b,
                                const Pose& pose_b, const CollisionSettings& settings,
-                               std::span<ContactManifold> room, std::size_t* count);
+                               std::span<ContactManifold> room, std::size_t* count,
+                               const PartHistory* history = nullptr,
+                               std::span<PartFeature> features = {});
 // collide_compound or collide_terrain, whichever the pair needs; room for most_manifolds(a, b).
+// `history` and `features` as collide_compound's (terrain manifolds have no feature).
 std::uint32_t collide_many(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
                            const CollisionSettings& settings, std::span<ContactManifold> room,
-                           std::size_t* count);
+                           std::size_t* count, const PartHistory* history = nullptr,
+                           std::span<PartFeature> features = {});
 // Every manifold of a terrain pair, in the world, normals from a to b.
 std::uint32_t collide_terrain(const Shape& a, const Pose& pose_a, const Shape& b,
                               const Pose& pose_b, const CollisionSettings& settings,

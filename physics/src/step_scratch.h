@@ -156,6 +156,7 @@ struct StepScratch {
   std::vector<ContactManifold> many_manifolds;
   std::vector<ContactPairRecord> many_records;
   std::vector<std::uint32_t> many_previous;
+  std::vector<PartFeature> many_features;  // a compound's part pairs' features (narrow_phase.h)
 };
 
 }  // namespace tumble

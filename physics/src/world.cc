@@ -807,6 +807,7 @@ void World::find_contacts(double dt) {
     grow(s.many_manifolds, room);
     grow(s.many_records, room);
     grow(s.many_previous, room);
+    grow(s.many_features, room);
   }
   const std::uint32_t flags =
       or_over_indices(threads, n > 64, n, 32, [&](std::int64_t i) -> std::uint32_t {
@@ -844,34 +845,50 @@ void World::find_contacts(double dt) {
         if (many_manifold_bodies_ > 0 && s.many_slot[i] != StepScratch::kNotMany) {
           StepScratch::ManyFound& found = s.many_found[s.many_slot[i]];
           const std::span<ContactManifold> room(s.many_manifolds.data() + found.first, found.room);
-          std::size_t count = 0;
-          std::uint32_t pair_flags =
-              collide_many(a.shape, pose_a, b.shape, pose_b, settings, room, &count);
-          if (dt > 0 && count > 0 && fast) {  // as for any pair, below
-            settings.margin =
-                settings_.collision.margin + rest + motion_[pairs_[i].a] + motion_[pairs_[i].b];
-            pair_flags |= collide_many(a.shape, pose_a, b.shape, pose_b, settings, room, &count);
-          }
-          found.count = static_cast<std::uint32_t>(count);
-          if (count == 0) return pair_flags;
-          s.found_flags[i] = StepScratch::kPairTouches;
-          const std::span<ContactPairRecord> records(s.many_records.data() + found.first, count);
-          const std::span<std::uint32_t> matched(s.many_previous.data() + found.first, count);
+          const std::span<PartFeature> features(s.many_features.data() + found.first, found.room);
           // The pair's records of the last step follow one another, manifold by manifold.
           std::size_t run = 0;
           if (previous != kNoRecord)
             while (previous + run < s.pairs.size() && s.pairs[previous + run].a == contact.a &&
                    s.pairs[previous + run].b == contact.b)
               ++run;
-          match_manifold_records(room.first(count),
-                                 std::span<const ContactPairRecord>(s.pairs).subspan(
-                                     previous == kNoRecord ? 0 : previous, run),
-                                 is_compound_pair(a.shape, b.shape), matched);
+          const std::span<const ContactPairRecord> last_step =
+              std::span<const ContactPairRecord>(s.pairs).subspan(
+                  previous == kNoRecord ? 0 : previous, run);
+          // A compound's part pairs keep their features as a single pair does (below).
+          const PartHistory history{last_step, reuse, a.shape.outer_radius(),
+                                    b.shape.outer_radius()};
+          const bool keep_features = reuse > 0 && !fast && run > 0;
+          std::size_t count = 0;
+          std::uint32_t pair_flags =
+              collide_many(a.shape, pose_a, b.shape, pose_b, settings, room, &count,
+                           keep_features ? &history : nullptr, features);
+          if (dt > 0 && count > 0 && fast) {  // as for any pair, below
+            settings.margin =
+                settings_.collision.margin + rest + motion_[pairs_[i].a] + motion_[pairs_[i].b];
+            pair_flags |= collide_many(a.shape, pose_a, b.shape, pose_b, settings, room, &count,
+                                       nullptr, features);
+          }
+          found.count = static_cast<std::uint32_t>(count);
+          if (count == 0) return pair_flags;
+          s.found_flags[i] = StepScratch::kPairTouches;
+          const std::span<ContactPairRecord> records(s.many_records.data() + found.first, count);
+          const std::span<std::uint32_t> matched(s.many_previous.data() + found.first, count);
+          match_manifold_records(room.first(count), last_step, is_compound_pair(a.shape, b.shape),
+                                 matched);
           for (std::size_t c = 0; c < count; ++c) {
-            record_manifold(room[c], PolytopeFeature{}, contact.a, pose_a, contact.b, pose_b,
+            record_manifold(room[c], features[c].feature, contact.a, pose_a, contact.b, pose_b,
                             &records[c]);
+            // The motion allowed is counted from where the feature was searched for.
+            if (features[c].kept_from != UINT32_MAX) {
+              const ContactPairRecord& kept = last_step[features[c].kept_from];
+              records[c].relative_position = kept.relative_position;
+              records[c].relative_orientation = kept.relative_orientation;
+            }
             if (matched[c] != kNoRecord) matched[c] += previous;
           }
+          if (features[0].kept_from != UINT32_MAX)
+            s.found_flags[i] |= StepScratch::kPairKeptFeature;
           contact.manifold = room[0];
           s.found_records[i] = records[0];
           s.found_previous[i] = matched[0];
@@ -943,7 +960,7 @@ void World::find_contacts(double dt) {
       contacts_[k + c] = {contacts_[k].a, contacts_[k].b, s.many_manifolds[found.first + c]};
       s.next_pairs[k + c] = s.many_records[found.first + c];
       s.previous_pair[k + c] = s.many_previous[found.first + c];
-      s.reused[k + c] = 0;
+      s.reused[k + c] = s.many_features[found.first + c].kept_from != UINT32_MAX;
     }
   });
   collision_flags_ = flags;

@@ -56,6 +56,10 @@ struct CollisionSettings {
 // each normal a part touches terrain along) has its own, the deepest kMaxPairManifolds of them
 // (kPairManifoldLimit when cut).
 inline constexpr std::size_t kMaxPairManifolds = 64;
+// The most pairs of parts whose bounds meet that one pair of bodies collides in a step (each a
+// convex pair: a compound's parts are at most 256, hulls of at most 1024 points); past it the
+// rest are left out and kPairManifoldLimit is raised.
+inline constexpr std::size_t kMaxPartPairs = 4096;
 
 // Outcome flags a query raises; a query that hits an iteration bound still returns its best answer.
 enum CollisionFlags : std::uint32_t {
@@ -63,8 +67,10 @@ enum CollisionFlags : std::uint32_t {
   kGjkIterationLimit = 1u << 0,
   kEpaIterationLimit = 1u << 1,
   kEpaDegenerate = 1u << 2,
-  kTerrainCellLimit = 1u << 3,   // a body over more terrain cells than a pair may visit
-  kPairManifoldLimit = 1u << 4,  // a pair of bodies touching along more manifolds than it keeps
+  kTerrainCellLimit = 1u << 3,  // a body over more terrain cells than a pair may visit
+  // A pair of bodies touching along more manifolds than it keeps, or with more pairs of parts
+  // near each other than it meets (kMaxPairManifolds, kMaxPartPairs).
+  kPairManifoldLimit = 1u << 4,
 };
 
 // Contacts between shape `a` at `pose_a` and shape `b` at `pose_b`. Returns the flags; `out->count`
