@@ -785,23 +785,23 @@ void World::find_contacts(double dt) {
   // Pairs with terrain or a compound get room for several manifolds, numbered in pair order.
   if (many_manifold_bodies_ > 0) {
     resize_reusing(s.many_slot, pairs_.size());
-    std::uint32_t many_pairs = 0, room = 0;
-    for (std::size_t i = 0; i < pairs_.size(); ++i) {
-      const Shape& a = bodies_[pairs_[i].a].body.shape;
-      const Shape& b = bodies_[pairs_[i].b].body.shape;
-      s.many_slot[i] = is_many_manifold_pair(a, b) ? many_pairs++ : StepScratch::kNotMany;
-    }
     // Doubled when they grow: a pile still landing on terrain adds a few such pairs most steps.
     const auto grow = [](auto& buffer, std::size_t size) {
       if (size > buffer.capacity()) buffer.reserve(std::max(size, 2 * buffer.capacity()));
       buffer.resize(size);
     };
-    grow(s.many_found, many_pairs);
+    s.many_found.clear();  // keeps its room; push_back doubles it like grow
+    std::uint32_t room = 0;
     for (std::size_t i = 0; i < pairs_.size(); ++i) {
-      if (s.many_slot[i] == StepScratch::kNotMany) continue;
-      const auto most = static_cast<std::uint32_t>(
-          most_manifolds(bodies_[pairs_[i].a].body.shape, bodies_[pairs_[i].b].body.shape));
-      s.many_found[s.many_slot[i]] = {room, most, 0};
+      const Shape& a = bodies_[pairs_[i].a].body.shape;
+      const Shape& b = bodies_[pairs_[i].b].body.shape;
+      if (!is_many_manifold_pair(a, b)) {
+        s.many_slot[i] = StepScratch::kNotMany;
+        continue;
+      }
+      const auto most = static_cast<std::uint32_t>(most_manifolds(a, b));
+      s.many_slot[i] = static_cast<std::uint32_t>(s.many_found.size());
+      s.many_found.push_back({room, most, 0});
       room += most;
     }
     grow(s.many_manifolds, room);
