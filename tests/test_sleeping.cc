@@ -379,3 +379,64 @@ TEST(Sleeping, KeptRestingCellsGiveTheSweepAndPrunePairs) {
 }
 
 }  // namespace tumble::testing
+
+namespace tumble::testing {
+namespace {
+
+// A 1 kg box on a frictionless slider held by a 100 N/m spring to the world (no damping): it
+// swings about where the spring rests with amplitude `amplitude` at 10 rad/s, its speed peaking
+// at 10 times the amplitude.
+World swinging_box(double amplitude) {
+  World world;
+  BodyDef box;
+  box.shape = BoxDef{Vec3::Constant(0.1)};
+  box.mass = 1;
+  box.position = Vec3(0, 0, 1);
+  box.linear_velocity = Vec3(10 * amplitude, 0, 0);
+  JointDef slider;
+  slider.kind = JointKind::kSlider;
+  slider.a = world.create_body(box).value();
+  slider.anchor = box.position;
+  slider.axis = Vec3::UnitX();
+  slider.spring = {true, 0, 100, 0};
+  EXPECT_TRUE(world.create_joint(slider).ok());
+  return world;
+}
+
+// When (s, from now) the world's bodies are all asleep, or -1 if they are not after 5 s.
+double falls_asleep_after(World& world) {
+  for (int step = 1; step <= 300; ++step) {
+    EXPECT_TRUE(world.step(1.0 / 60).is_ok());
+    if (all_asleep(world)) return step / 60.0;
+  }
+  return -1;
+}
+
+// What a body moved counts, not how fast it moves: a box swinging 1 cm either way at up to 0.1
+// m/s (twice the sleep speed at every peak; a speed test alone never lets it sleep) stays within
+// 2.5 cm of where it was and falls asleep after the 0.5 s delay; one swinging 5 cm either way
+// (0.5 m/s) keeps leaving that reach and stays awake.
+TEST(Sleeping, ABodySwingingInPlaceFallsAsleepAndOneSwingingFarDoesNot) {
+  World small = swinging_box(0.01);
+  const double asleep_after = falls_asleep_after(small);
+  EXPECT_GE(asleep_after, 0.5);
+  EXPECT_LE(asleep_after, 1.0);
+  World far = swinging_box(0.05);
+  EXPECT_EQ(falls_asleep_after(far), -1);
+}
+
+// The sleep anchor is part of the saved state: a world restored a quarter of a second into a
+// swinging box's quiet time falls asleep on the same step as the world it was saved from (were
+// the anchor lost, the box would be far from it and its quiet time would begin again).
+TEST(Sleeping, ARestoredWorldKeepsItsBodiesSleepAnchors) {
+  World world = swinging_box(0.01);
+  run(world, 1.0 / 60, 15);
+  ASSERT_FALSE(all_asleep(world));
+  World restored = World::from_state(world.settings(), world.save_state()).value();
+  const double expected = falls_asleep_after(world);
+  ASSERT_GT(expected, 0);
+  EXPECT_EQ(falls_asleep_after(restored), expected);
+}
+
+}  // namespace
+}  // namespace tumble::testing

@@ -35,9 +35,12 @@ struct Body {
   CollisionFilter filter;
   // The inertia is a multiple of the identity (sphere, cube): no gyroscopic torque.
   bool spherical_inertia = false;
-  // Sleeping: how long the body has been slower than the sleep thresholds (s), whether it sleeps,
-  // and the island it fell asleep with (its lowest slot), which wakes as one.
+  // Sleeping: how long the body has stayed near where its quiet time began (s; 0 starts it anew),
+  // that pose (the sleep anchor), whether it sleeps, and the island it fell asleep with (its
+  // lowest slot), which wakes as one.
   double sleep_timer = 0;
+  Vec3 sleep_anchor_position = Vec3::Zero();
+  Quat sleep_anchor_orientation = Quat::Identity();
   bool asleep = false;
   std::uint32_t sleep_island = 0;
 

@@ -26,6 +26,13 @@ inline Quat rotated(const Quat& q, const Vec3& theta) {
   return (rotation_quaternion(theta) * q).normalized();
 }
 
+// The angle (rad, 0 to pi) of the rotation that takes orientation `from` to `to`: atan2 of the
+// half-angle's sine and cosine, accurate for tiny turns where acos of the cosine is not.
+inline double angle_between(const Quat& from, const Quat& to) {
+  const Quat turn = from.conjugate() * to;
+  return 2 * std::atan2(turn.vec().norm(), std::abs(turn.w()));
+}
+
 // Where a pose moved at constant velocities (v: m/s of the origin, w: rad/s, world axes) is
 // after dt: exact, as a kinematic body moves.
 inline Pose moved_by(const Pose& pose, const Vec3& v, const Vec3& w, double dt) {

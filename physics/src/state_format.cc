@@ -263,6 +263,8 @@ void put_body(Writer& w, const Body& b) {
   w.put(b.restitution);
   w.put(static_cast<std::uint8_t>(b.spherical_inertia));
   w.put(b.sleep_timer);
+  w.put(b.sleep_anchor_position);
+  w.put(b.sleep_anchor_orientation);
   w.put(static_cast<std::uint8_t>(b.asleep));
   w.put(b.sleep_island);
 }
@@ -317,6 +319,8 @@ Status take_body(Reader& r, Body* b) {
   b->restitution = r.take<double>("restitution");
   b->spherical_inertia = take_flag(r, "spherical_inertia");
   b->sleep_timer = r.take<double>("sleep_timer");
+  b->sleep_anchor_position = r.vec3("sleep_anchor_position");
+  b->sleep_anchor_orientation = r.quat("sleep_anchor_orientation");
   b->asleep = take_flag(r, "asleep");
   b->sleep_island = r.take<std::uint32_t>("sleep_island");
   return r.status();  // the values are checked with the whole state (world_from)

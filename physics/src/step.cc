@@ -896,15 +896,34 @@ void World::update_sleep(double dt) {
       if (s.bodies[row.b].kinematic) s.carried[row.a] = 1;
     }
   }
+  // A body is quiet while it is slower than the sleep speeds or stays within the distance and the
+  // turn those speeds cover in the sleep delay of its sleep anchor (where it was when that test
+  // last began): a box that rocks or jitters in place on uneven ground, faster than the speeds at
+  // the peaks, counts as quiet too, as it does in Jolt (Body::UpdateSleepStateInternal keeps its
+  // bodies' points inside spheres over the delay), and a body creeping slower than the speeds
+  // counts as before.
+  const double window = std::max(solver.sleep_delay, dt);
+  const double reach = solver.sleep_linear_speed * window;
+  const double turn = solver.sleep_angular_speed * window;
   bool fell_asleep = false;
   for (std::size_t i = 0; i < s.islands.count(); ++i) {
     double shortest = std::numeric_limits<double>::infinity();
     for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
       Body& body = bodies_[s.solver_slot[s.islands.bodies[k]]].body;
+      if (body.sleep_timer == 0) {
+        body.sleep_anchor_position = body.position;
+        body.sleep_anchor_orientation = body.orientation;
+      }
       const bool slow = body.linear_velocity.norm() < solver.sleep_linear_speed &&
-                        body.angular_velocity.norm() < solver.sleep_angular_speed &&
-                        (s.carried.empty() || !s.carried[s.islands.bodies[k]]);
-      body.sleep_timer = slow ? body.sleep_timer + dt : 0.0;
+                        body.angular_velocity.norm() < solver.sleep_angular_speed;
+      const bool near = (body.position - body.sleep_anchor_position).norm() <= reach &&
+                        angle_between(body.sleep_anchor_orientation, body.orientation) <= turn;
+      const bool carried = !s.carried.empty() && s.carried[s.islands.bodies[k]];
+      body.sleep_timer = (slow || near) && !carried ? body.sleep_timer + dt : 0.0;
+      if (!near) {
+        body.sleep_anchor_position = body.position;
+        body.sleep_anchor_orientation = body.orientation;
+      }
       shortest = std::min(shortest, body.sleep_timer);
     }
     if (!solver.sleeping || shortest < solver.sleep_delay) continue;

@@ -73,6 +73,11 @@ Status check_body(const Body& body, std::uint32_t slot_count) {
   }
   if (!(body.sleep_timer >= 0) || !std::isfinite(body.sleep_timer))
     return Status::error("sleep_timer: must be finite and >= 0");
+  if (!is_finite(body.sleep_anchor_position))
+    return Status::error("sleep_anchor_position: must be finite");
+  const double anchor_norm = body.sleep_anchor_orientation.norm();
+  if (!std::isfinite(anchor_norm) || std::abs(anchor_norm - 1) > 1e-6)
+    return Status::error("sleep_anchor_orientation: must be a unit quaternion");
   if (body.sleep_island >= slot_count) return Status::error("sleep_island: out of range");
   return Status::ok();
 }

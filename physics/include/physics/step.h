@@ -45,8 +45,10 @@ struct SolverSettings {
   // Exact solver: the largest velocity error (m/s) an answer may have, measured on the problem
   // without its regularisation; a worse answer is refused and the island falls back to pgs.
   double exact_velocity_tolerance = 5e-3;
-  // Islands whose bodies all stay below both speeds for `sleep_delay` fall asleep and cost nothing
-  // until a moving body touches them or a body they rest on is removed.
+  // Islands whose bodies have all been quiet for `sleep_delay` fall asleep and cost nothing until
+  // a moving body touches them or a body they rest on is removed. A body is quiet while it is
+  // slower than both speeds, or while it stays within the distance and the turn they cover in the
+  // delay (2.5 cm and 0.025 rad by default) of where it was: one rocking in place counts too.
   bool sleeping = true;
   double sleep_linear_speed = 0.05;    // m/s
   double sleep_angular_speed = 0.05;   // rad/s

@@ -165,7 +165,7 @@ class World {
   // is wrong; bytes of another format version are refused with a message naming both versions.
   // restore_state replaces this world's bodies, contacts and clock, keeping its settings, and
   // changes nothing when it fails.
-  static constexpr std::uint32_t kStateFormatVersion = 1;
+  static constexpr std::uint32_t kStateFormatVersion = 2;
   std::string save_state() const;
   // What saved bytes hold, from their header alone (checked as from_state checks it), so that a
   // caller can bound what restoring them would cost before paying it.
