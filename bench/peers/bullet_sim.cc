@@ -3,9 +3,12 @@
 // twice: into the benchmarks against Debian's float build, and with BT_USE_DOUBLE_PRECISION into
 // a module of its own against the float64 build (both export the same symbols, so the module is
 // loaded with RTLD_DEEPBIND and hands out its simulations through one C entry point).
+#include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <algorithm>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <vector>
 
@@ -113,8 +116,23 @@ class BulletSimulation final : public Simulation {
                                to_bt(mesh->vertices[t[2]]));
       shape = std::make_unique<btBvhTriangleMeshShape>(triangles.get(), true);
       meshes_.push_back(std::move(triangles));
+    } else if (const auto* field = std::get_if<HeightFieldDef>(&def.shape)) {
+      // Bullet's heightfield reads the heights where they lie (kept here, in double) and centres
+      // itself on its bounds, the up axis included: the body's frame is shifted up by the middle
+      // of the heights so that the grid lies where ours does. Its quads split along
+      // (x, y)-(x + 1, y + 1), as ours do, with flipQuadEdges.
+      height_fields_.push_back(field->heights);
+      const std::vector<double>& heights = height_fields_.back();
+      const auto [low, high] = std::minmax_element(heights.begin(), heights.end());
+      auto terrain = std::make_unique<btHeightfieldTerrainShape>(
+          static_cast<int>(field->samples_x), static_cast<int>(field->samples_y), heights.data(),
+          *low, *high, 2, true);
+      terrain->setLocalScaling(btVector3(field->spacing_x, field->spacing_y, 1));
+      pose.setOrigin(pose.getOrigin() +
+                     pose.getBasis() * btVector3(0, 0, 0.5 * (*low + *high)));
+      shape = std::move(terrain);
     } else {
-      *why_not = "hulls and heightfields are not mapped to Bullet";
+      *why_not = "hulls are not mapped to Bullet";
       return false;
     }
     // A kinematic body is Bullet's: no mass, CF_KINEMATIC_OBJECT, moved through its motion state
@@ -256,6 +274,8 @@ class BulletSimulation final : public Simulation {
   double dt_;
   // The triangles of shapes_' meshes, declared first so that the shapes go before them.
   std::vector<std::unique_ptr<btTriangleMesh>> meshes_;
+  // The heights of shapes_' heightfields, which Bullet reads in place (a deque: they stay put).
+  std::deque<std::vector<double>> height_fields_;
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btDefaultMotionState>> states_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
