@@ -33,11 +33,15 @@ std::uint32_t collide_height_field(const Shape& a, const Mat3& rotation, const V
     for (std::uint32_t i = i0; i <= i1; ++i) {
       for (std::uint32_t k = 0; k < 2; ++k) {
         const std::size_t t = 2 * (std::size_t{j} * field.cells_x() + i) + k;
+        const std::uint8_t active = field.active_edges(t);
+        // A polytope meets a triangle's face through its vertices (below) and its edges only
+        // where they are active: on gently rolling ground most are not, and the triangle costs
+        // nothing more.
+        if (!body.round && active == 0) continue;
         const std::array<Vec3, 3> v = field.triangle(t);
         if (std::max({v[0].z(), v[1].z(), v[2].z()}) < box.min.z()) continue;
         const Vec3 n = normal_of(v);
         if (body.round) contacts.round_face_points(body, v, n);
-        const std::uint8_t active = field.active_edges(t);
         for (int e = 0; e < 3; ++e) {
           // Each edge once: from the lower of its two triangles.
           const std::int64_t other = field.neighbour(t, e);

@@ -25,6 +25,23 @@ struct FrontFace {
   std::array<Vec3, 3> v;
   Vec3 n;
   double centre_height;  // of the body's centre over the plane, > 0
+  // n x (v[e+1] - v[e]): pointing into the triangle from edge e, and the tolerance of
+  // inside_triangle (triangle_contacts.h): worked out once for the several vertices tested.
+  std::array<Vec3, 3> inwards;
+  double tolerance;
+
+  FrontFace(const std::array<Vec3, 3>& v, const Vec3& n, double centre_height)
+      : v(v), n(n), centre_height(centre_height) {
+    for (int e = 0; e < 3; ++e)
+      inwards[e] = n.cross(v[(e + 1) % 3] - v[e]);
+    tolerance = -1e-12 * (v[1] - v[0]).cross(v[2] - v[0]).dot(n);
+  }
+  // inside_triangle's test, the triple products taken in another order.
+  bool holds(const Vec3& p) const {
+    for (int e = 0; e < 3; ++e)
+      if ((p - v[e]).dot(inwards[e]) < tolerance) return false;
+    return true;
+  }
 };
 
 // A face a vertex counts for, and where the line from the body's centre to the vertex crosses
@@ -93,7 +110,7 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
     if (front && body.round) {
       contacts.round_face_points(body, v, n);
     } else if (front) {
-      s.faces.push_back({v, n, (translation - v[0]).dot(n)});
+      s.faces.emplace_back(v, n, (translation - v[0]).dot(n));
     }
     const std::uint8_t active = mesh.active_edges(t);
     for (int e = 0; e < 3; ++e) {
@@ -124,7 +141,7 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
       const double at = face.centre_height / (face.centre_height - height);
       const Vec3 point = height < 0 ? Vec3(translation + (x - translation) * at)
                                     : Vec3(x - height * face.n);
-      if (inside_triangle(face.v, face.n, point)) s.crossings.push_back({&face, at});
+      if (face.holds(point)) s.crossings.push_back({&face, at});
     }
     for (const Crossing& c : s.crossings) {
       const bool entered_elsewhere = std::any_of(

@@ -50,17 +50,17 @@ Result<TriangleMesh> TriangleMesh::create(const TriangleMeshDef& def) {
   }
   mesh.def_ = def;
   mesh.feature_size_ = longest_edge;
+  mesh.normals_.resize(def.triangles.size());
+  for (std::size_t t = 0; t < def.triangles.size(); ++t) {
+    const std::array<Vec3, 3> v = mesh.triangle(t);
+    mesh.normals_[t] = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+  }
   for (const auto& triangle : def.triangles)
     for (std::uint32_t index : triangle)
       mesh.bounds_.grow(def.vertices[index]);
   mesh.build_adjacency();
   mesh.build_tree();
   return mesh;
-}
-
-Vec3 TriangleMesh::normal(std::size_t t) const {
-  const std::array<Vec3, 3> v = triangle(t);
-  return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
 }
 
 void TriangleMesh::build_adjacency() {
