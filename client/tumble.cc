@@ -67,6 +67,8 @@ struct SpawnOptions {
   v1::Mesh mesh;
   std::vector<std::string> parts;  // compound: "box:1,1,0.1@0,0,1[@w,x,y,z]" each
   v1::Compound compound;
+  std::vector<std::string> points;  // hull: "x,y,z" each
+  v1::Hull hull;
   std::optional<double> gravity_scale, linear_damping, angular_damping;
   std::vector<double> force, torque;
   std::optional<std::uint32_t> layers, mask;
@@ -87,6 +89,8 @@ struct SpawnOptions {
       spec.set_type(v1::BODY_TYPE_STATIC);
     } else if (shape == "compound") {
       *spec.mutable_shape()->mutable_compound() = compound;
+    } else if (shape == "hull") {
+      *spec.mutable_shape()->mutable_hull() = hull;
     } else {
       spec.mutable_shape()->mutable_capsule()->set_radius(radius);
       spec.mutable_shape()->mutable_capsule()->set_half_height(half_height);
@@ -116,6 +120,8 @@ constexpr int kMaxHeightSamples = 1 << 22;
 // kMaxMeshTriangles: the server refuses more).
 constexpr std::size_t kMaxMeshVertices = std::size_t{1} << 21;
 constexpr std::size_t kMaxMeshTriangles = std::size_t{1} << 21;
+// The most points a hull may be given (the engine's kMaxHullPoints: the server refuses more).
+constexpr std::size_t kMaxHullPoints = 1024;
 
 // A heightfield's heights from a text file: one row of samples along x per line, the rows along
 // y from the lowest y up, numbers parted by spaces or commas; blank lines and lines starting with
@@ -220,16 +226,46 @@ Status read_parts(SpawnOptions* options) {
   return Status::ok();
 }
 
+// A hull's --point options into its points; --point belongs to a hull only. The server builds the
+// hull and names what is wrong with it (fewer than four points spanning a volume).
+Status read_points(SpawnOptions* options) {
+  if (options->shape != "hull") {
+    if (!options->points.empty()) return Status::error("--point: only a hull has points");
+    return Status::ok();
+  }
+  if (options->points.empty())
+    return Status::error("--point: a hull needs its points (X,Y,Z each, at least four)");
+  if (options->points.size() > kMaxHullPoints)
+    return Status::error("--point: " + std::to_string(options->points.size()) +
+                         " points, more than the " + std::to_string(kMaxHullPoints) +
+                         " a hull may have");
+  for (std::size_t i = 0; i < options->points.size(); ++i) {
+    std::vector<double> xyz;
+    if (!read_numbers(options->points[i], &xyz) || xyz.size() != 3)
+      return Status::error("--point[" + std::to_string(i) + "]: '" + options->points[i] +
+                           "' is not X,Y,Z");
+    for (double value : xyz)
+      options->hull.add_points(value);
+  }
+  return Status::ok();
+}
+
+// The options a shape spawn, overlap and cast share lists: a compound's parts, a hull's points.
+Status read_listed_shape(SpawnOptions* options) {
+  if (Status s = read_parts(options); !s) return s;
+  return read_points(options);
+}
+
 // The shape's options spawn and overlap share; spawn also takes terrain.
 void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = false) {
   const std::vector<std::string> shapes =
-      terrain
-          ? std::vector<std::string>{"box", "sphere", "capsule", "heightfield", "mesh", "compound"}
-          : std::vector<std::string>{"box", "sphere", "capsule", "compound"};
+      terrain ? std::vector<std::string>{"box",         "sphere", "capsule", "hull",
+                                         "heightfield", "mesh",   "compound"}
+              : std::vector<std::string>{"box", "sphere", "capsule", "hull", "compound"};
   command
       ->add_option("shape", options->shape,
-                   terrain ? "box, sphere, capsule, heightfield, mesh or compound"
-                           : "box, sphere, capsule or compound")
+                   terrain ? "box, sphere, capsule, hull, heightfield, mesh or compound"
+                           : "box, sphere, capsule, hull or compound")
       ->required()
       ->check(CLI::IsMember(shapes));
   if (terrain) {
@@ -252,6 +288,9 @@ void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = 
   command->add_option("--part", options->parts,
                       "compound: one part, KIND:SIZES@X,Y,Z[@W,X,Y,Z] (box:SX,SY,SZ, sphere:R or "
                       "capsule:R,HALF_HEIGHT at X,Y,Z in the body's frame); repeat for each");
+  command->add_option("--point", options->points,
+                      "hull: one point X,Y,Z (m, in the body's frame; the body is their convex "
+                      "hull); repeat for each, at least four");
   command->add_option("--size", options->size, "box: full extents x,y,z (m)")
       ->delimiter(',')
       ->expected(3);
@@ -662,7 +701,7 @@ int main(int argc, char** argv) {
     print_line(serving.value() ? "SERVING" : "NOT_SERVING");
     return serving.value() ? 0 : 1;
   } else if (*spawn) {
-    if (Status s = read_parts(&body); !s) return fail("spawn", s);
+    if (Status s = read_listed_shape(&body); !s) return fail("spawn", s);
     if (body.shape == "heightfield") {
       if (body.heights_file.empty())
         return fail("spawn", Status::error("--heights: required for a heightfield"));
@@ -834,7 +873,7 @@ int main(int argc, char** argv) {
   } else if (*overlap) {
     v1::QueryRequest request;
     v1::OverlapQuery* query = request.add_overlaps();
-    if (Status s = read_parts(&probe); !s) return fail("overlap", s);
+    if (Status s = read_listed_shape(&probe); !s) return fail("overlap", s);
     const v1::BodySpec spec = probe.spec();
     *query->mutable_shape() = spec.shape();
     *query->mutable_position() = spec.position();
@@ -845,7 +884,7 @@ int main(int argc, char** argv) {
   } else if (*cast) {
     v1::QueryRequest request;
     v1::ShapeCastQuery* query = request.add_shape_casts();
-    if (Status s = read_parts(&swept); !s) return fail("cast", s);
+    if (Status s = read_listed_shape(&swept); !s) return fail("cast", s);
     const v1::BodySpec spec = swept.spec();
     *query->mutable_shape() = spec.shape();
     *query->mutable_position() = spec.position();

@@ -352,6 +352,48 @@ TEST(ServerProcess, CliSpawnsACompoundOfParts) {
       << none.text;
 }
 
+// A hull from the CLI: a square pyramid, its apex up, far from the default scene. The stream
+// describes it by its hull's vertices; a ray down through the apex's side hits it and one past
+// the base misses; overlap and cast take a hull too; points that do not parse, a flat hull and
+// points given to a box are named.
+TEST(ServerProcess, CliSpawnsAHullOfPoints) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  const std::string pyramid =
+      "--point -0.5,-0.5,0 --point 0.5,-0.5,0 --point 0.5,0.5,0 --point -0.5,0.5,0 "
+      "--point 0,0,1 --point 0,0,0.5 ";
+  const Output spawned = run(tumble + "spawn hull " + pyramid + "--pos 100,0,5");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  const std::string id = spawned.text.substr(0, spawned.text.find('\n'));
+  const Output described = run(tumble + "stream --frames 1 --ids " + id);
+  ASSERT_EQ(described.code, 0) << described.text;
+  EXPECT_NE(described.text.find("\"hull\""), std::string::npos) << described.text;
+  const Output hit = run(tumble + "ray --from 100.2,0,8 --dir 0,0,-1");
+  ASSERT_EQ(hit.code, 0) << hit.text;
+  EXPECT_NE(hit.text.find(id), std::string::npos) << hit.text;
+  const Output miss = run(tumble + "ray --from 100.6,0,8 --dir 0,0,-1 --max-distance 5");
+  ASSERT_EQ(miss.code, 0) << miss.text;
+  EXPECT_EQ(miss.text.find(id), std::string::npos) << miss.text;
+  const Output overlapping = run(tumble + "overlap hull " + pyramid + "--pos 100,0,5.2");
+  ASSERT_EQ(overlapping.code, 0) << overlapping.text;
+  EXPECT_NE(overlapping.text.find(id), std::string::npos) << overlapping.text;
+  const Output cast = run(tumble + "cast hull " + pyramid + "--pos 100,0,9 --by 0,0,-5");
+  ASSERT_EQ(cast.code, 0) << cast.text;
+  EXPECT_NE(cast.text.find(id), std::string::npos) << cast.text;
+  const Output garbled = run(tumble + "spawn hull --point 0,0,0 --point 1,0");
+  EXPECT_NE(garbled.code, 0);
+  EXPECT_NE(garbled.text.find("--point[1]: '1,0' is not X,Y,Z"), std::string::npos) << garbled.text;
+  const Output flat =
+      run(tumble + "spawn hull --point 0,0,0 --point 1,0,0 --point 0,1,0 --point 1,1,0");
+  EXPECT_NE(flat.code, 0);
+  EXPECT_NE(flat.text.find("shape.points: coplanar or collinear"), std::string::npos) << flat.text;
+  const Output misplaced = run(tumble + "spawn box --point 0,0,0");
+  EXPECT_NE(misplaced.code, 0);
+  EXPECT_NE(misplaced.text.find("--point: only a hull has points"), std::string::npos)
+      << misplaced.text;
+}
+
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {
   Server server;
   ASSERT_NO_FATAL_FAILURE(server.start({"--paused", "--max-message-mb", "1"}));
