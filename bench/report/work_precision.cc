@@ -50,18 +50,15 @@ HeightFieldDef flat_floor() {
   return floor;
 }
 
-// The same slide across a floor of triangles (a triangle mesh): the same stop distance if no
-// inner edge catches the box.
-Reference mesh_slide() {
+// The slide on `floor` in place of the plane, named `name`: the same stop distance if no inner
+// edge between the floor's triangles catches the box.
+Reference slide_across(const std::string& name, const std::string& floor_words, ShapeDef floor) {
   SceneDef scene = slide_scene();
-  scene.name = "slide-on-mesh";
+  scene.name = name;
   for (BodyDef& body : scene.bodies)
-    if (std::holds_alternative<HalfSpaceDef>(body.shape))
-      body.shape = mesh_of_height_field(HeightField::create(flat_floor()).value());
+    if (std::holds_alternative<HalfSpaceDef>(body.shape)) body.shape = floor;
   const double exact = 25.0 / (2 * 0.5 * 9.81);
-  return {{"slide-on-mesh",
-           "stop distance of the slide's box across a floor of 3,200 triangles (a mesh, 0.5 m "
-           "cells), after 3 s",
+  return {{name, "stop distance of the slide's box across " + floor_words + ", after 3 s",
            "v0^2/(2 mu g) = 2.548 m", "relative"},
           scene,
           [exact] {
@@ -70,22 +67,16 @@ Reference mesh_slide() {
           }};
 }
 
-// The same slide across the same floor as a heightfield (Bullet's btHeightfieldTerrainShape).
+// Across the floor as a triangle mesh, and as a heightfield (Bullet's btHeightfieldTerrainShape).
+Reference mesh_slide() {
+  return slide_across("slide-on-mesh", "a floor of 3,200 triangles (a mesh, 0.5 m cells)",
+                      mesh_of_height_field(HeightField::create(flat_floor()).value()));
+}
+
 Reference height_field_slide() {
-  SceneDef scene = slide_scene();
-  scene.name = "slide-on-heightfield";
-  for (BodyDef& body : scene.bodies)
-    if (std::holds_alternative<HalfSpaceDef>(body.shape)) body.shape = flat_floor();
-  const double exact = 25.0 / (2 * 0.5 * 9.81);
-  return {{"slide-on-heightfield",
-           "stop distance of the slide's box across a heightfield of 41 x 41 samples (0.5 m "
-           "cells, 3,200 triangles), after 3 s",
-           "v0^2/(2 mu g) = 2.548 m", "relative"},
-          scene,
-          [exact] {
-            return std::make_unique<FinalValue>(
-                [](const bench::Simulation& s) { return s.body(0).position.x(); }, exact);
-          }};
+  return slide_across("slide-on-heightfield",
+                      "a heightfield of 41 x 41 samples (0.5 m cells, 3,200 triangles)",
+                      flat_floor());
 }
 
 // A box dropped from 1 m with e = 0.5 rises to e^2 h = 0.25 m after its first bounce.
