@@ -910,20 +910,18 @@ void World::update_sleep(double dt) {
     double shortest = std::numeric_limits<double>::infinity();
     for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
       Body& body = bodies_[s.solver_slot[s.islands.bodies[k]]].body;
-      if (body.sleep_timer == 0) {
+      const auto anchor_here = [&body] {
         body.sleep_anchor_position = body.position;
         body.sleep_anchor_orientation = body.orientation;
-      }
+      };
+      if (body.sleep_timer == 0) anchor_here();
       const bool slow = body.linear_velocity.norm() < solver.sleep_linear_speed &&
                         body.angular_velocity.norm() < solver.sleep_angular_speed;
       const bool near = (body.position - body.sleep_anchor_position).norm() <= reach &&
                         angle_between(body.sleep_anchor_orientation, body.orientation) <= turn;
       const bool carried = !s.carried.empty() && s.carried[s.islands.bodies[k]];
       body.sleep_timer = (slow || near) && !carried ? body.sleep_timer + dt : 0.0;
-      if (!near) {
-        body.sleep_anchor_position = body.position;
-        body.sleep_anchor_orientation = body.orientation;
-      }
+      if (!near) anchor_here();
       shortest = std::min(shortest, body.sleep_timer);
     }
     if (!solver.sleeping || shortest < solver.sleep_delay) continue;
