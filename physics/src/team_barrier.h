@@ -1,6 +1,6 @@
 // A barrier for the step's team inside the solver's regions, where a step waits at hundreds of
 // them (the soft solve ends every colour of a large island with one, 16 or 17 colours times 24
-// sweeps): it spins for a few microseconds, then sleeps.
+// sweeps): it spins for a while, then sleeps.
 //
 // libgomp's own barrier sleeps in a futex at once when OMP_WAIT_POLICY is passive, which our
 // programs set so that spinning threads do not starve a busy machine between steps; waking the
@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 
 #if defined(__x86_64__)
@@ -43,32 +44,41 @@ class TeamBarrier {
       generation_.notify_all();
       return;
     }
-    const std::uint32_t limit = spin_limit_.load(std::memory_order_relaxed);
-    for (std::uint32_t spins = 0; spins < limit; ++spins) {
+    const Clock::time_point start = Clock::now();
+    Clock::time_point now = start;
+    const Clock::duration budget = spin_budget;
+    for (std::uint32_t spins = 1;; ++spins) {
       if (generation_.load(std::memory_order_acquire) != generation) {
         // The spin was worth it: spin a little longer next time, up to the bound.
-        spin_limit_.store(std::min(kMostSpins, limit + limit / 16 + 1), std::memory_order_relaxed);
+        spin_budget = std::min(kLongestSpin, budget + budget / 8 + kShortestSpin);
         return;
       }
       pause();
+      // The clock costs tens of pauses' time; read it now and then.
+      if (spins % kSpinsPerReading == 0 && (now = Clock::now()) - start >= budget) break;
     }
-    // Still waiting: the team's slowest thread may have lost its core (a busy machine), so sleep
-    // until the generation moves (a futex on Linux), and spin less next time.
-    spin_limit_.store(std::max(kFewestSpins, limit / 4), std::memory_order_relaxed);
     while (generation_.load(std::memory_order_acquire) == generation)
       generation_.wait(generation, std::memory_order_acquire);
+    // A wait far past any wake-up's delay means a team thread lost its core (a busy machine):
+    // spin less, so that waiting leaves the core to it. Shorter ones are the team's own (a colour
+    // out of balance, the sleepers' wake-ups), where shrinking would make each wait a sleep and
+    // each sleep a late arrival at the next barrier: on 16 cores that spiral took the pile of
+    // 4000's solve from 17 ms on one thread to 67 ms (PERFORMANCE.md).
+    if (Clock::now() - start > kLostCore) spin_budget = std::max(kShortestSpin, budget / 4);
   }
 
  private:
-  // How long a thread spins before it sleeps adapts, as glibc's adaptive mutexes do: waits that
-  // end within the spin lengthen it a little (to some tens of µs of pauses at most), waits that
-  // outlast it cut it to a quarter. On a quiet machine most colours end within the spin; on one
-  // where another busy process takes a core, the team's threads lose theirs in turn, waits
-  // outlast the spin, and it shrinks to almost nothing. Measured on the landed piles (two threads
-  // against one, OMP_WAIT_POLICY=passive; PERFORMANCE.md): a fixed spin of 1000 pauses 1.61x
-  // quiet but 0.54x beside one busy process; no spin 0.92x and 1.12x; this 1.42-1.52x and
-  // 0.60-1.01x, where libgomp's barrier gave 0.72-0.92x and 0.71-0.98x.
-  static constexpr std::uint32_t kMostSpins = 2000, kFewestSpins = 16;
+  using Clock = std::chrono::steady_clock;
+  // How long a thread spins before it sleeps, its own (a thread_local: what its waits found on
+  // this machine lately), adapting as glibc's adaptive mutexes do: waits that end within the spin
+  // lengthen it a little, to 100 µs at most; a wait of over half a millisecond, a scheduler's
+  // slice rather than a wake-up, cuts it to a quarter. Measured by the clock, since a pause lasts
+  // from a few to 140 cycles from one processor to the next.
+  static constexpr Clock::duration kShortestSpin = std::chrono::microseconds(1);
+  static constexpr Clock::duration kLongestSpin = std::chrono::microseconds(100);
+  static constexpr Clock::duration kLostCore = std::chrono::microseconds(500);
+  static constexpr std::uint32_t kSpinsPerReading = 16;
+  static inline thread_local Clock::duration spin_budget = kLongestSpin;
   static void pause() {
 #if defined(__x86_64__)
     _mm_pause();
@@ -77,7 +87,6 @@ class TeamBarrier {
 
   alignas(64) std::atomic<std::uint32_t> arrived_{0};
   alignas(64) std::atomic<std::uint32_t> generation_{0};
-  alignas(64) std::atomic<std::uint32_t> spin_limit_{kMostSpins};
   int team_ = 1;
 };
 
