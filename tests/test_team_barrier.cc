@@ -29,10 +29,15 @@ TEST(TeamBarrier, NoThreadLeavesAPhaseBeforeEveryThreadFinishedIt) {
         threads_seen = omp_get_num_threads();
       }
       for (int phase = 0; phase < kPhases; ++phase) {
-        // Uneven work, so that some threads wait long enough to sleep and others not at all.
-        if ((phase + omp_get_thread_num()) % 7 == 0)
-          for (int k = 0; k < 20000; ++k)
-            sink = k;
+        // Uneven work, so that some threads wait within their spin, some long enough to sleep
+        // (past the 100 µs spin) and some past the half millisecond that shortens it.
+        const int turn = phase + omp_get_thread_num();
+        const int work = turn % 97 == 0   ? 2000000
+                         : turn % 31 == 0 ? 300000
+                         : turn % 7 == 0  ? 20000
+                                          : 0;
+        for (int k = 0; k < work; ++k)
+          sink = k;
         arrived[phase].fetch_add(1);
         barrier.wait();
         if (arrived[phase].load() != omp_get_num_threads()) wrong.fetch_add(1);
