@@ -14,6 +14,7 @@ struct Run {
   std::uint64_t hash = 0;
   std::uint32_t coloured_islands = 0;  // in the last step
   double residual = 0;                 // the last step's
+  std::uint32_t coloured_islands_alone = 0;
 };
 
 Run run_with_threads(const SceneDef& base, int threads, long steps) {
@@ -21,7 +22,8 @@ Run run_with_threads(const SceneDef& base, int threads, long steps) {
   scene.world.threads = threads;
   World world = build(scene);
   run(world, scene.dt, steps);
-  return {state_hash(world), world.last_step().coloured_islands, world.last_step().residual};
+  return {state_hash(world), world.last_step().coloured_islands, world.last_step().residual,
+          world.last_step().coloured_islands_alone};
 }
 
 void expect_same_bits(const SceneDef& scene, long steps) {
@@ -43,6 +45,30 @@ TEST(Determinism, PyramidSplitByColoursSameBitsForAnyThreadCountAndRun) {
   pyramid.world.solver.sleeping = false;
   EXPECT_GT(run_with_threads(pyramid, 2, 1).coloured_islands, 0u);
   expect_same_bits(pyramid, 120);
+}
+
+// A coloured island too small for the team (fewer than 32 manifolds a thread: a pyramid of 120
+// boxes' few hundred on a team of 16) is solved by one of its threads, colour by colour: the bits
+// of the whole team's solve and of one thread's, with every iterative solver (pgs corrects
+// positions by colour too).
+TEST(Determinism, AColouredIslandSolvedByOneThreadOfTheTeamGivesTheSameBits) {
+  SceneDef pyramid = pyramid_scene(15);
+  pyramid.world.solver.sleeping = false;
+  for (SolverKind kind : {SolverKind::kAuto, SolverKind::kPgs}) {
+    SCOPED_TRACE(solver_name(kind));
+    pyramid.world.solver.kind = kind;
+    const auto one = run_with_threads(pyramid, 1, 60);
+    const auto team = run_with_threads(pyramid, 2, 60);
+    const auto alone = run_with_threads(pyramid, 16, 60);
+    EXPECT_EQ(team.coloured_islands, 1u);
+    EXPECT_EQ(team.coloured_islands_alone, 0u);
+    EXPECT_EQ(alone.coloured_islands, 1u);
+    EXPECT_EQ(alone.coloured_islands_alone, 1u);
+    EXPECT_EQ(one.coloured_islands_alone, 0u);
+    EXPECT_EQ(team.hash, one.hash);
+    EXPECT_EQ(alone.hash, one.hash);
+    EXPECT_EQ(alone.residual, one.residual);
+  }
 }
 
 // Boxes, a ball and a capsule, some of them swept by continuous collision on the way down.

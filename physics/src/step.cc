@@ -518,12 +518,30 @@ ManifoldRows manifold_rows_of(const StepScratch& s, std::uint32_t manifold) {
 // spares the two barriers of the reduction).
 template <class PackFn, class ManifoldFn>
 double visit_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                     bool packed, PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce) {
+                     bool packed, bool solo, PackFn&& pack_fn, ManifoldFn&& manifold_fn,
+                     bool reduce) {
   const Colouring& colouring = s.colouring;
   double local = 0;
   for (std::uint32_t k = first; k < last; ++k) {
     const std::uint32_t c = backward ? first + last - 1 - k : k;
     const std::int64_t begin = colouring.colour_begin[c], end = colouring.colour_begin[c + 1];
+    if (solo) {
+      // One thread, the same order: each colour's manifolds share no moving body, so visiting
+      // them in turn gives the bits the team gives.
+      if (colouring.serial[c]) {
+        for (std::int64_t i = begin; i < end; ++i) {
+          const std::int64_t at = backward ? begin + end - 1 - i : i;
+          local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[at])));
+        }
+      } else if (!packed) {
+        for (std::int64_t i = begin; i < end; ++i)
+          local = std::max(local, manifold_fn(manifold_rows_of(s, colouring.manifolds[i])));
+      } else {
+        for (std::int64_t p = s.colour_pack_begin[c]; p < s.colour_pack_begin[c + 1]; ++p)
+          local = std::max(local, pack_fn(s.packs[p]));
+      }
+      continue;
+    }
     // Each colour ends at the team's barrier (team_barrier.h), not OpenMP's.
     if (colouring.serial[c]) {
 #pragma omp single nowait
@@ -544,48 +562,74 @@ double visit_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
     }
     s.barrier.wait();
   }
+  if (solo) return reduce ? local : 0.0;
   return reduce ? team_max(local, s) : 0.0;
 }
 
 // The step's packs where it sweeps them, else the rows.
 template <class PackFn, class ManifoldFn>
 double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                   PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce = true) {
-  return visit_colours(s, first, last, backward, s.packed, pack_fn, manifold_fn, reduce);
+                   bool solo, PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce = true) {
+  return visit_colours(s, first, last, backward, s.packed, solo, pack_fn, manifold_fn, reduce);
 }
 
 // fn(row ids of a manifold) for every manifold, through the rows.
 template <class Fn>
 double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                     Fn&& fn, bool reduce = true) {
+                     bool solo, Fn&& fn, bool reduce = true) {
   return visit_colours(
-      s, first, last, backward, false, [](const ContactPack&) { return 0.0; },
+      s, first, last, backward, false, solo, [](const ContactPack&) { return 0.0; },
       [&](const ManifoldRows& m) { return fn(std::span<const std::uint32_t>(m.ids, m.count)); },
       reduce);
 }
 
-std::uint32_t team_integrate_velocities(const IslandContext& c, double h) {
+std::uint32_t team_integrate_velocities(const IslandContext& c, double h, bool solo) {
   std::uint32_t hits = 0;
   const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
-#pragma omp for schedule(static) nowait
-  for (std::int64_t k = 0; k < n; ++k) {
+  const auto integrate = [&](std::int64_t k) {
     const std::uint32_t body = c.bodies[k];
     if (!integrate_velocity(*c.body_of[body], c.scratch.poses[body].orientation, c.settings.gravity,
                             h, &c.scratch.bodies[body]))
       ++hits;
+  };
+  if (solo) {
+    for (std::int64_t k = 0; k < n; ++k)
+      integrate(k);
+    return hits;
   }
+#pragma omp for schedule(static) nowait
+  for (std::int64_t k = 0; k < n; ++k)
+    integrate(k);
   c.scratch.barrier.wait();
   return hits;
 }
 
-void team_integrate_positions(const IslandContext& c, double h) {
+void team_integrate_positions(const IslandContext& c, double h, bool solo) {
   const std::int64_t n = static_cast<std::int64_t>(c.bodies.size());
-#pragma omp for schedule(static) nowait
-  for (std::int64_t k = 0; k < n; ++k) {
+  const auto integrate = [&](std::int64_t k) {
     const std::uint32_t body = c.bodies[k];
     integrate_position(h, &c.scratch.bodies[body], &c.scratch.poses[body]);
+  };
+  if (solo) {
+    for (std::int64_t k = 0; k < n; ++k)
+      integrate(k);
+    return;
   }
+#pragma omp for schedule(static) nowait
+  for (std::int64_t k = 0; k < n; ++k)
+    integrate(k);
   c.scratch.barrier.wait();
+}
+
+// Whether a coloured island of `manifolds` is solved by the whole team, colour by colour, or by
+// one thread beside the other islands (the same bits either way: visit_colours). Each colour ends
+// at a barrier, which costs a few microseconds on a team of 16; an island must give each thread
+// enough of every colour to pay for it. On 16 cores the landed pile of 4000 (17 coloured islands,
+// 4,440 manifolds in all, about 4 colours each) spent its solve at barriers (PERFORMANCE.md,
+// "Measured on 16 cores"). Two threads take every coloured island as before.
+constexpr std::uint32_t kTeamManifoldsPerThread = 32;
+bool team_runs(int threads, std::uint32_t manifolds) {
+  return manifolds >= static_cast<std::uint32_t>(threads) * kTeamManifoldsPerThread;
 }
 
 // advance_with's parts for a coloured island (soft or pgs) over the whole team: every member
@@ -593,20 +637,23 @@ void team_integrate_positions(const IslandContext& c, double h) {
 class TeamIsland {
  public:
   static constexpr bool kSolvesExact = false;
-  TeamIsland(const IslandContext& c, std::uint32_t first, std::uint32_t last, IslandReport* report)
-      : c_(c), s_(c.scratch), first_(first), last_(last), report_(report) {}
+  // `solo`: the island is one thread's, inside or outside a team (one too small to be worth the
+  // team's barriers at every colour); else every thread of the team calls every member.
+  TeamIsland(const IslandContext& c, std::uint32_t first, std::uint32_t last, IslandReport* report,
+             bool solo)
+      : c_(c), s_(c.scratch), first_(first), last_(last), report_(report), solo_(solo) {}
 
   bool has_rows() const { return true; }  // coloured islands have many
-  void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h); }
+  void integrate_velocities(double h) { hits_ += team_integrate_velocities(c_, h, solo_); }
   void integrate_positions(double h) {
     moved_for_ += h;
-    team_integrate_positions(c_, h);
+    team_integrate_positions(c_, h, solo_);
   }
   double kinematic_time() const { return s_.kinematic_contacts ? moved_for_ : 0.0; }
   // The packs solve; the rows take their impulses at the end, for the residual and restitution.
   void refresh_separations() {
     sweep_packs(
-        s_, first_, last_, false,
+        s_, first_, last_, false, solo_,
         [&](ContactPack& pack) {
           update_separations(pack, s_.bodies, kinematic_time());
           return 0.0;
@@ -620,7 +667,7 @@ class TeamIsland {
   }
   void warm_start(bool keep_last_substep) {
     sweep_packs(
-        s_, first_, last_, false,
+        s_, first_, last_, false, solo_,
         [&](ContactPack& pack) {
           tumble::warm_start(pack, s_.bodies, keep_last_substep, kinematic_time());
           return 0.0;
@@ -635,7 +682,7 @@ class TeamIsland {
   double sweep(const Softness* soft, double h, bool backward) {
     ++iterations_;
     return sweep_packs(
-        s_, first_, last_, backward,
+        s_, first_, last_, backward, solo_,
         [&](ContactPack& pack) {
           return solve_pack(pack, kAllLanes, s_.bodies, c_.settings.solver, soft, h);
         },
@@ -649,7 +696,7 @@ class TeamIsland {
       double h, Move move = [] {}) {
     // One pass over the packs for both: a large island's packs come from memory each pass.
     const double residual = sweep_packs(
-        s_, first_, last_, false,
+        s_, first_, last_, false, solo_,
         [&](const ContactPack& pack) {
           store_impulses(pack, s_.rows, s_.cold_rows);
           double lane_residuals[kWideLanes];
@@ -666,7 +713,7 @@ class TeamIsland {
     });
 #pragma omp atomic
     report_->gyroscopic_limit_hits += hits_;
-    if (omp_get_thread_num() == 0) {
+    if (solo_ || omp_get_thread_num() == 0) {
       report_->velocity_iterations = iterations_;
       report_->residual = residual;
     }
@@ -676,7 +723,7 @@ class TeamIsland {
   template <class Fn>
   void each_manifold(Fn&& fn) {
     sweep_colours(
-        s_, first_, last_, false,
+        s_, first_, last_, false, solo_,
         [&](std::span<const std::uint32_t> ids) {
           fn(ids);
           return 0.0;
@@ -687,6 +734,7 @@ class TeamIsland {
   StepScratch& s_;
   std::uint32_t first_, last_;
   IslandReport* report_;
+  bool solo_;
   std::uint64_t iterations_ = 0;
   std::uint32_t hits_ = 0;
   double moved_for_ = 0;  // s: the moves so far this step
@@ -714,9 +762,27 @@ void World::solve_islands(double dt) {
   auto manifold_count = [&](std::uint32_t i) {
     return s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
   };
+  auto coloured = [&](std::uint32_t i) {
+    return s.island_colour_begin[i + 1] > s.island_colour_begin[i];
+  };
   // Tall pgs islands sweep their own count to the end (tall_stacks.h): only islands with the same
   // count share an item.
   auto sweeps = [&](std::uint32_t i) { return s.reports[i].pgs_iterations; };
+  // Coloured islands too small for the team go first, one thread each, largest first.
+  s.lane_candidates.clear();
+  for (std::uint32_t i : s.team_islands)
+    if (!team_runs(threads, manifold_count(i))) s.lane_candidates.push_back(i);
+  std::sort(s.lane_candidates.begin(), s.lane_candidates.end(),
+            [&](std::uint32_t x, std::uint32_t y) {
+              if (manifold_count(x) != manifold_count(y))
+                return manifold_count(x) > manifold_count(y);
+              return x < y;
+            });
+  for (std::uint32_t i : s.lane_candidates) {
+    s.work_islands.push_back(i);
+    s.work_begin.push_back(static_cast<std::uint32_t>(s.work_islands.size()));
+  }
+  stats_.coloured_islands_alone = static_cast<std::uint32_t>(s.lane_candidates.size());
   for (int kind = 0; kind < 2; ++kind) {
     // Islands of like sizes side by side, largest first: a pack's lanes then run out of
     // manifolds together (four islands of 30, 5, 5 and 2 manifolds would fill 30 packs, 42
@@ -772,15 +838,21 @@ void World::solve_islands(double dt) {
 #pragma omp single
     s.barrier.reset(omp_get_num_threads());
     for (std::uint32_t i : s.team_islands) {
+      if (!team_runs(threads, manifold_count(i))) continue;
       const IslandContext context = island_context(s, settings_, i);
       TeamIsland team(context, s.island_colour_begin[i], s.island_colour_begin[i + 1],
-                      &s.reports[i]);
+                      &s.reports[i], false);
       advance_with(team, &s.reports[i], settings_.solver, dt);
     }
     team_for_dynamic(work, [&](std::int64_t k) {
       const std::span<const std::uint32_t> islands =
           std::span(s.work_islands).subspan(s.work_begin[k], s.work_begin[k + 1] - s.work_begin[k]);
-      if (islands.size() == 1) {
+      if (islands.size() == 1 && coloured(islands[0])) {
+        const IslandContext context = island_context(s, settings_, islands[0]);
+        TeamIsland alone(context, s.island_colour_begin[islands[0]],
+                         s.island_colour_begin[islands[0] + 1], &s.reports[islands[0]], true);
+        advance_with(alone, &s.reports[islands[0]], settings_.solver, dt);
+      } else if (islands.size() == 1) {
         const IslandContext context = island_context(s, settings_, islands[0]);
         SerialIsland island(context, &s.reports[islands[0]]);
         advance_with(island, &s.reports[islands[0]], settings_.solver, dt);
@@ -834,20 +906,29 @@ void World::correct_positions(double dt) {
   if (!any || solver.position_iterations == 0) return;
   const int threads = team_size(settings_.threads);
   const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
+  const std::int64_t coloured = static_cast<std::int64_t>(s.team_islands.size());
+  const auto manifold_count = [&](std::uint32_t i) {
+    return s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
+  };
   run_region(threads, true, [&] {
 #pragma omp single
     s.barrier.reset(omp_get_num_threads());
-    for (std::uint32_t i : s.team_islands) {
-      if (!needs_correction(i)) continue;
+    auto correct_coloured = [&](std::uint32_t i, bool solo) {
       for (int k = 0; k < solver.position_iterations; ++k)
         sweep_colours(
-            s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false,
+            s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false, solo,
             [&](std::span<const std::uint32_t> ids) {
               tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses, solver);
               return 0.0;
             },
             false);
-    }
+    };
+    for (std::uint32_t i : s.team_islands)
+      if (needs_correction(i) && team_runs(threads, manifold_count(i))) correct_coloured(i, false);
+    team_for_dynamic(coloured, [&](std::int64_t k) {
+      const std::uint32_t i = s.team_islands[k];
+      if (needs_correction(i) && !team_runs(threads, manifold_count(i))) correct_coloured(i, true);
+    });
     team_for_dynamic(singles, [&](std::int64_t k) {
       const std::uint32_t i = s.single_islands[k];
       if (!needs_correction(i)) return;

@@ -92,6 +92,9 @@ struct StepStats {
   // Large islands split over the team by graph colouring: how many, their colours in all, and
   // the manifolds left to the serial overflow colour.
   std::uint32_t coloured_islands = 0, colours = 0, overflow_manifolds = 0;
+  // Coloured islands solved by one thread beside the others, colour by colour, the same bits:
+  // too small to give each thread of the team 32 manifolds (each colour costs the team a barrier).
+  std::uint32_t coloured_islands_alone = 0;
   // Manifolds swept four at a time in SIMD lanes (a colour's, or small islands' side by side).
   std::uint32_t packed_manifolds = 0;
   // Manifolds clipped on the feature a pair kept instead of searching all features again
