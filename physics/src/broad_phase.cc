@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -66,16 +67,54 @@ bool is_dead(const Aabb& box) {
   return !(box.min.x() <= box.max.x());
 }
 
-// The sorted runs[0 .. count) merged into one sorted `out`; `buffer` is scratch.
+// The sorted runs[0 .. count) merged into one sorted `out` (equal items in run order); `buffer`
+// is scratch. The runs are laid side by side, then merged in pairs, round after round, each
+// round's merges spread over the team: the serial part is the last merge, not every run merged in
+// turn into a growing list, which copies the items count / 2 times over on one thread (on 16
+// cores a fifth of the broad phase's serial time: PERFORMANCE.md, "Measured on 16 cores").
+constexpr int kMostRuns = 1024;
 template <class T>
-void merge_sorted(const std::vector<std::vector<T>>& runs, int count, std::vector<T>* out,
-                  std::vector<T>* buffer) {
-  out->clear();
-  for (int t = 0; t < count; ++t) {
-    buffer->swap(*out);
-    out->resize(buffer->size() + runs[t].size());
-    std::merge(buffer->begin(), buffer->end(), runs[t].begin(), runs[t].end(), out->begin());
+void merge_sorted(const std::vector<std::vector<T>>& runs, int count, int threads,
+                  std::vector<T>* out, std::vector<T>* buffer) {
+  if (count <= 1) {
+    out->assign(runs[0].begin(), runs[0].end());
+    return;
   }
+  count = std::min(count, kMostRuns);
+  std::array<std::size_t, kMostRuns + 1> begin;
+  begin[0] = 0;
+  for (int t = 0; t < count; ++t)
+    begin[t + 1] = begin[t] + runs[t].size();
+  const std::size_t total = begin[count];
+  int rounds = 0;
+  for (int width = 1; width < count; width *= 2)
+    ++rounds;
+  // The rounds alternate between the two arrays and end in `out`.
+  std::vector<T>* first = rounds % 2 == 0 ? out : buffer;
+  std::vector<T>* second = rounds % 2 == 0 ? buffer : out;
+  first->resize(total);
+  second->resize(total);
+  run_region(threads, total > 4096, [&] {
+    const auto at = [](std::vector<T>* items, std::size_t k) {
+      return items->begin() + static_cast<std::ptrdiff_t>(k);
+    };
+#pragma omp for schedule(static)
+    for (int t = 0; t < count; ++t)
+      std::copy(runs[t].begin(), runs[t].end(), at(first, begin[t]));
+    std::vector<T>* from = first;
+    std::vector<T>* to = second;
+    for (int width = 1; width < count; width *= 2) {
+      const int merges = (count + 2 * width - 1) / (2 * width);
+#pragma omp for schedule(static)
+      for (int m = 0; m < merges; ++m) {
+        const int low = 2 * width * m, middle = std::min(low + width, count),
+                  high = std::min(low + 2 * width, count);
+        std::merge(at(from, begin[low]), at(from, begin[middle]), at(from, begin[middle]),
+                   at(from, begin[high]), at(to, begin[low]));
+      }
+      std::swap(from, to);
+    }
+  });
 }
 
 // A body is on the grid unless it is unbounded (the ground half-space), larger than the top
@@ -138,7 +177,7 @@ void HashGrid::list_cells(std::span<const Aabb> bounds, std::span<const std::uin
     sort_by_high_half(&mine, &thread_scratch_[t]);
   });
   // One sorted array: the threads' sorted runs merged in thread order.
-  merge_sorted(thread_entries_, count > 256 ? threads : 1, out, &merge_buffer_);
+  merge_sorted(thread_entries_, count > 256 ? threads : 1, threads, out, &merge_buffer_);
   *occupied = levels;
 }
 
@@ -404,7 +443,7 @@ bool HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
     if (keep_first_pairs(&out, max_pairs)) cut.store(true, std::memory_order_relaxed);
   });
   // (3) Reduction: merge the threads' sorted lists, then drop pairs found by several threads.
-  merge_sorted(thread_pairs_, threads, pairs, &pair_buffer_);
+  merge_sorted(thread_pairs_, threads, threads, pairs, &pair_buffer_);
   pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
   if (pairs->size() > max_pairs) {
     pairs->resize(max_pairs);

@@ -986,26 +986,31 @@ void World::update_sleep(double dt) {
   const double window = std::max(solver.sleep_delay, dt);
   const double reach = solver.sleep_linear_speed * window;
   const double turn = solver.sleep_angular_speed * window;
+  // Each body's timer over the team (each its own), then each island's shortest.
+  const std::int64_t island_bodies = static_cast<std::int64_t>(s.islands.bodies.size());
+  for_indices(
+      team_size(settings_.threads), island_bodies > 1024, island_bodies, [&](std::int64_t k) {
+        Body& body = bodies_[s.solver_slot[s.islands.bodies[k]]].body;
+        const auto anchor_here = [&body] {
+          body.sleep_anchor_position = body.position;
+          body.sleep_anchor_orientation = body.orientation;
+        };
+        if (body.sleep_timer == 0) anchor_here();
+        const bool slow = body.linear_velocity.norm() < solver.sleep_linear_speed &&
+                          body.angular_velocity.norm() < solver.sleep_angular_speed;
+        const bool near = (body.position - body.sleep_anchor_position).norm() <= reach &&
+                          angle_between(body.sleep_anchor_orientation, body.orientation) <= turn;
+        const bool carried = !s.carried.empty() && s.carried[s.islands.bodies[k]];
+        body.sleep_timer = (slow || near) && !carried ? body.sleep_timer + dt : 0.0;
+        if (!near) anchor_here();
+      });
   bool fell_asleep = false;
   for (std::size_t i = 0; i < s.islands.count(); ++i) {
+    if (!solver.sleeping) break;
     double shortest = std::numeric_limits<double>::infinity();
-    for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k) {
-      Body& body = bodies_[s.solver_slot[s.islands.bodies[k]]].body;
-      const auto anchor_here = [&body] {
-        body.sleep_anchor_position = body.position;
-        body.sleep_anchor_orientation = body.orientation;
-      };
-      if (body.sleep_timer == 0) anchor_here();
-      const bool slow = body.linear_velocity.norm() < solver.sleep_linear_speed &&
-                        body.angular_velocity.norm() < solver.sleep_angular_speed;
-      const bool near = (body.position - body.sleep_anchor_position).norm() <= reach &&
-                        angle_between(body.sleep_anchor_orientation, body.orientation) <= turn;
-      const bool carried = !s.carried.empty() && s.carried[s.islands.bodies[k]];
-      body.sleep_timer = (slow || near) && !carried ? body.sleep_timer + dt : 0.0;
-      if (!near) anchor_here();
-      shortest = std::min(shortest, body.sleep_timer);
-    }
-    if (!solver.sleeping || shortest < solver.sleep_delay) continue;
+    for (std::uint32_t k = s.islands.body_begin[i]; k < s.islands.body_begin[i + 1]; ++k)
+      shortest = std::min(shortest, bodies_[s.solver_slot[s.islands.bodies[k]]].body.sleep_timer);
+    if (shortest < solver.sleep_delay) continue;
     // Named by its lowest slot (solver indices keep the slots' order).
     const std::uint32_t island = s.solver_slot[s.islands.bodies[s.islands.body_begin[i]]];
     keep_resting_contacts(island, static_cast<std::uint32_t>(i), dt);
