@@ -345,6 +345,7 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
   out->set_coloured_islands(s.coloured_islands);
   out->set_colours(s.colours);
   out->set_overflow_manifolds(s.overflow_manifolds);
+  out->set_coloured_islands_alone(s.coloured_islands_alone);
   out->set_packed_manifolds(s.packed_manifolds);
   out->set_reused_manifolds(s.reused_manifolds);
   out->set_stiffened_islands(s.stiffened_islands);

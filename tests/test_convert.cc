@@ -127,6 +127,7 @@ TEST(Convert, StepStatsCarryEveryCounter) {
   set("coloured_islands", s.coloured_islands);
   set("colours", s.colours);
   set("overflow_manifolds", s.overflow_manifolds);
+  set("coloured_islands_alone", s.coloured_islands_alone);
   set("packed_manifolds", s.packed_manifolds);
   set("reused_manifolds", s.reused_manifolds);
   set("exact_fallbacks", s.exact_fallbacks);

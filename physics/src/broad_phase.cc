@@ -80,7 +80,15 @@ void merge_sorted(const std::vector<std::vector<T>>& runs, int count, int thread
     out->assign(runs[0].begin(), runs[0].end());
     return;
   }
-  count = std::min(count, kMostRuns);
+  if (count > kMostRuns) {  // a team larger than any machine we know: one run after another
+    out->clear();
+    for (int t = 0; t < count; ++t) {
+      buffer->swap(*out);
+      out->resize(buffer->size() + runs[t].size());
+      std::merge(buffer->begin(), buffer->end(), runs[t].begin(), runs[t].end(), out->begin());
+    }
+    return;
+  }
   std::array<std::size_t, kMostRuns + 1> begin;
   begin[0] = 0;
   for (int t = 0; t < count; ++t)
@@ -150,6 +158,9 @@ void HashGrid::list_cells(std::span<const Aabb> bounds, std::span<const std::uin
                           int threads, std::vector<Entry>* out, std::uint64_t* occupied) {
   std::uint64_t levels = 0;
   const std::int64_t count = static_cast<std::int64_t>(bodies.size());
+  // Emptied here too, for a team smaller than asked for (find_pairs).
+  for (std::vector<Entry>& run : thread_entries_)
+    run.clear();
   run_region(threads, count > 256, [&] {
     const int t = omp_get_thread_num();
     auto& mine = thread_entries_[t];
@@ -301,6 +312,10 @@ bool HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   thread_entries_.resize(threads);
   thread_scratch_.resize(threads);
   thread_pairs_.resize(threads);
+  // Every run emptied here, not only by the threads that fill them: a team smaller than asked
+  // for (OMP_THREAD_LIMIT) would leave a run of an earlier step to be merged.
+  for (std::vector<BodyPair>& run : thread_pairs_)
+    run.clear();
 
   std::span<const std::uint32_t> moving = input.moving;
   if (!input.moving_listed) {
