@@ -37,6 +37,11 @@ struct IslandContext {
   std::span<const Body* const> body_of;  // by solver index
 };
 
+// How many manifolds island i has.
+std::uint32_t manifolds_in(const StepScratch& s, std::size_t i) {
+  return s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
+}
+
 // The velocity recipe of one island, written once for every solver and thread count. `run`
 // carries each part out: over the island's rows in order on one thread (SerialIsland, which alone
 // has the exact solver's LCP: exact islands are small), or colour by colour over the whole team
@@ -388,7 +393,7 @@ class IslandLanes {
       contexts_[k].emplace(island_context(s, settings, i));
       lanes_[k].emplace(*contexts_[k], &s.reports[i]);
       reports_[k] = &s.reports[i];
-      manifolds_[k] = s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
+      manifolds_[k] = manifolds_in(s, i);
     }
     for (std::size_t j = 0; j < packs_.size(); ++j) {
       std::uint32_t lanes[kWideLanes];
@@ -759,9 +764,7 @@ void World::solve_islands(double dt) {
     if (report.solver == IslandSolver::kPgs) return 1;
     return -1;
   };
-  auto manifold_count = [&](std::uint32_t i) {
-    return s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
-  };
+  auto manifold_count = [&](std::uint32_t i) { return manifolds_in(s, i); };
   auto coloured = [&](std::uint32_t i) {
     return s.island_colour_begin[i + 1] > s.island_colour_begin[i];
   };
@@ -907,9 +910,6 @@ void World::correct_positions(double dt) {
   const int threads = team_size(settings_.threads);
   const std::int64_t singles = static_cast<std::int64_t>(s.single_islands.size());
   const std::int64_t coloured = static_cast<std::int64_t>(s.team_islands.size());
-  const auto manifold_count = [&](std::uint32_t i) {
-    return s.island_manifold_begin[i + 1] - s.island_manifold_begin[i];
-  };
   run_region(threads, true, [&] {
 #pragma omp single
     s.barrier.reset(omp_get_num_threads());
@@ -924,10 +924,10 @@ void World::correct_positions(double dt) {
             false);
     };
     for (std::uint32_t i : s.team_islands)
-      if (needs_correction(i) && team_runs(threads, manifold_count(i))) correct_coloured(i, false);
+      if (needs_correction(i) && team_runs(threads, manifolds_in(s, i))) correct_coloured(i, false);
     team_for_dynamic(coloured, [&](std::int64_t k) {
       const std::uint32_t i = s.team_islands[k];
-      if (needs_correction(i) && !team_runs(threads, manifold_count(i))) correct_coloured(i, true);
+      if (needs_correction(i) && !team_runs(threads, manifolds_in(s, i))) correct_coloured(i, true);
     });
     team_for_dynamic(singles, [&](std::int64_t k) {
       const std::uint32_t i = s.single_islands[k];
