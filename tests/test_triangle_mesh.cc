@@ -212,6 +212,80 @@ TEST(TriangleMesh, RaysMeetTheNearestFrontAsBruteForceDoes) {
   EXPECT_GT(hits, 1000);
 }
 
+// The tree's nodes meet four children at once, lanes of which may be empty (a mesh of a few
+// triangles) and rays along the axes give infinite and undefined slab distances: rays along
+// every axis and diagonal from a grid of origins (some on the triangles' own coordinates) meet
+// what the brute force meets, on meshes of 1 to 40 triangles and on terrain.
+TEST(TriangleMesh, RaysAlongTheAxesAndOnMeshesOfAFewTrianglesMeetWhatBruteForceMeets) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const TriangleMeshDef terrain = mesh_of(
+      field_of(9, 7, 0.5, [&](double x, double y) { return 0.3 * std::sin(2 * x) * std::cos(y); }));
+  for (const std::size_t count : {1, 2, 3, 5, 9, 17, 40, 96}) {
+    TriangleMeshDef def;
+    def.vertices = terrain.vertices;
+    def.triangles.assign(terrain.triangles.begin(), terrain.triangles.begin() + count);
+    const TriangleMesh mesh = TriangleMesh::create(def).value();
+    World world;
+    add_static(&world, def, Vec3::Zero());
+    int hits = 0;
+    for (double x = -2.5; x <= 2.5; x += 0.25) {
+      for (double y = -2; y <= 2; y += 0.25) {
+        for (const Vec3& direction : {Vec3(0, 0, -1), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(-1, 0, 0),
+                                      Vec3(0, 0, 1), Vec3(1, 1, -1).normalized(),
+                                      Vec3(1, 0, -1).normalized(), Vec3(0, -1, -1).normalized()}) {
+          const Vec3 origin(x, y, 0.5 * unit(random) + (direction.z() < 0 ? 1.0 : -1.0));
+          RayCast ray;
+          ray.origin = origin;
+          ray.direction = direction;
+          ray.max_distance = 20;
+          const RayHit hit = world.cast_ray(ray).value();
+          const bool met = hit.hit();
+          const double expected = brute_force_ray(
+              mesh.triangle_count(), [&](std::size_t t) { return mesh.triangle(t); }, origin,
+              direction, 20);
+          ASSERT_EQ(met, expected <= 20) << count << " " << origin.transpose();
+          if (!met) continue;
+          EXPECT_NEAR(hit.distance, expected, 1e-9);
+          ++hits;
+        }
+      }
+    }
+    EXPECT_GT(hits, 0) << count;
+  }
+}
+
+// The triangles a box meets: every triangle whose bounds meet the box, each once.
+TEST(TriangleMesh, ABoxMeetsEveryTriangleWhoseBoundsItMeets) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const TriangleMesh mesh =
+      TriangleMesh::create(mesh_of(field_of(41, 37, 0.25, [&](double x, double y) {
+        return 0.3 * std::sin(2 * x) * std::cos(y);
+      }))).value();
+  std::vector<std::uint32_t> found;
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 centre(5 * unit(random), 4.5 * unit(random), 0.4 * unit(random));
+    const Vec3 half =
+        Vec3(0.05, 0.05, 0.05) + 0.3 * Vec3(1 + unit(random), 1 + unit(random), 1 + unit(random));
+    const Aabb box{centre - half, centre + half};
+    ASSERT_TRUE(mesh.triangles_meeting(box, &found, mesh.triangle_count()));
+    std::vector<char> seen(mesh.triangle_count(), 0);
+    for (std::uint32_t t : found) {
+      ASSERT_EQ(seen[t], 0) << t;
+      seen[t] = 1;
+    }
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+      Aabb bounds;
+      for (const Vec3& v : mesh.triangle(t))
+        bounds.grow(v);
+      const bool meets = (bounds.min.array() <= box.max.array()).all() &&
+                         (box.min.array() <= bounds.max.array()).all();
+      if (meets) EXPECT_EQ(seen[t], 1) << k << " " << t;
+    }
+  }
+}
+
 // 64 boxes dropped on bumpy terrain made a mesh: no centre ever comes nearer the surface under
 // it than half a box's thickness allows, and they come to rest.
 TEST(TriangleMesh, PileOfBoxesComesToRestOnTerrainMadeAMesh) {

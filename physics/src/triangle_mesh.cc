@@ -130,17 +130,23 @@ void TriangleMesh::build_adjacency() {
 
 void TriangleMesh::build_tree() {
   const std::size_t count = triangle_count();
-  order_.resize(count);
+  std::vector<std::uint32_t> order(count);
   std::vector<Vec3> centres(count);
   for (std::size_t t = 0; t < count; ++t) {
-    order_[t] = static_cast<std::uint32_t>(t);
+    order[t] = static_cast<std::uint32_t>(t);
     const std::array<Vec3, 3> v = triangle(t);
     centres[t] = (v[0] + v[1] + v[2]) / 3;
   }
-  nodes_.clear();
-  nodes_.reserve(2 * (count / kLeafTriangles + 1));
-  nodes_.push_back({});
-  // Each entry: a node to fill from order_[first, first + count). Splitting at the median keeps
+  // First a binary tree: each node's bounds and either two children (count 0: at first and
+  // first + 1) or `count` triangles of `order` from first.
+  struct BinaryNode {
+    std::array<float, 3> min, max;
+    std::uint32_t first = 0, count = 0;
+  };
+  std::vector<BinaryNode> binary;
+  binary.reserve(2 * (count / kLeafTriangles + 1));
+  binary.push_back({});
+  // Each entry: a node to fill from `order`[first, first + count). Splitting at the median keeps
   // the tree balanced, so its depth is bounded by the logarithm of the triangle count.
   struct Task {
     std::uint32_t node, first, count;
@@ -151,12 +157,12 @@ void TriangleMesh::build_tree() {
     tasks.pop_back();
     Aabb box, centre_box;
     for (std::uint32_t k = task.first; k < task.first + task.count; ++k) {
-      const auto& triangle = def_.triangles[order_[k]];
+      const auto& triangle = def_.triangles[order[k]];
       for (std::uint32_t index : triangle)
         box.grow(def_.vertices[index]);
-      centre_box.grow(centres[order_[k]]);
+      centre_box.grow(centres[order[k]]);
     }
-    Node& node = nodes_[task.node];
+    BinaryNode& node = binary[task.node];
     for (int k = 0; k < 3; ++k) {
       node.min[k] = round_down(box.min[k]);
       node.max[k] = round_up(box.max[k]);
@@ -170,18 +176,74 @@ void TriangleMesh::build_tree() {
     centre_box.extent().maxCoeff(&axis);
     const std::uint32_t half = task.count / 2;
     std::nth_element(
-        order_.begin() + task.first, order_.begin() + task.first + half,
-        order_.begin() + task.first + task.count, [&](std::uint32_t x, std::uint32_t y) {
+        order.begin() + task.first, order.begin() + task.first + half,
+        order.begin() + task.first + task.count, [&](std::uint32_t x, std::uint32_t y) {
           return centres[x][axis] != centres[y][axis] ? centres[x][axis] < centres[y][axis] : x < y;
         });
-    const auto left = static_cast<std::uint32_t>(nodes_.size());
+    const auto left = static_cast<std::uint32_t>(binary.size());
     node.first = left;
     node.count = 0;
-    nodes_.push_back({});
-    nodes_.push_back({});
+    binary.push_back({});
+    binary.push_back({});
     tasks.push_back({left, task.first, half});
     tasks.push_back({left + 1, task.first + half, task.count - half});
   }
+  // Then every other level of it dropped: a node's children are its binary node's grandchildren
+  // (or its children where they are leaves), in their left-to-right order. Each child's bounds
+  // lie within those of the level dropped, so the walks meet the same triangles. A node's inner
+  // children are made one after another (siblings side by side in memory).
+  nodes_.clear();
+  nodes_.reserve(binary.size() / 3 + 1);
+  nodes_.push_back({});
+  struct Collapse {
+    std::uint32_t node, binary;
+  };
+  std::vector<Collapse> pending{{0, 0}};
+  for (std::size_t next = 0; next < pending.size(); ++next) {
+    const auto [at, from] = pending[next];
+    std::array<std::uint32_t, 4> children{};
+    int child_count = 0;
+    if (binary[from].count != 0) {
+      children[child_count++] = from;  // a mesh of a few triangles: the root is one leaf
+    } else {
+      for (std::uint32_t c : {binary[from].first, binary[from].first + 1}) {
+        if (binary[c].count == 0) {
+          children[child_count++] = binary[c].first;
+          children[child_count++] = binary[c].first + 1;
+        } else {
+          children[child_count++] = c;
+        }
+      }
+    }
+    for (int k = 0; k < 4; ++k) {
+      // Empty bounds (min above max) meet no box and no ray.
+      Node& node = nodes_[at];
+      if (k >= child_count) {
+        for (int axis = 0; axis < 3; ++axis) {
+          node.min[axis][k] = HUGE_VALF;
+          node.max[axis][k] = -HUGE_VALF;
+        }
+        node.first[k] = 0;
+        node.count[k] = kNoChild;
+        continue;
+      }
+      const BinaryNode& child = binary[children[k]];
+      for (int axis = 0; axis < 3; ++axis) {
+        node.min[axis][k] = child.min[axis];
+        node.max[axis][k] = child.max[axis];
+      }
+      node.count[k] = static_cast<std::uint8_t>(child.count);
+      node.first[k] = child.first;
+      if (child.count == 0) {
+        node.first[k] = static_cast<std::uint32_t>(nodes_.size());
+        pending.push_back({node.first[k], children[k]});
+        nodes_.push_back({});  // may move nodes_: `node` is not used after it
+      }
+    }
+  }
+  leaf_triangles_.resize(count);
+  for (std::size_t k = 0; k < count; ++k)
+    leaf_triangles_[k] = {order[k], def_.triangles[order[k]]};
 }
 
 TriangleMeshDef mesh_of_height_field(const HeightField& field) {
@@ -205,25 +267,30 @@ TriangleMeshDef mesh_of_height_field(const HeightField& field) {
 bool TriangleMesh::triangles_meeting(const Aabb& box, std::vector<std::uint32_t>* out,
                                      std::size_t limit) const {
   out->clear();
-  const auto meets = [&box](const Node& node) {
-    for (int k = 0; k < 3; ++k)
-      if (!(node.min[k] <= box.max[k] && box.min[k] <= node.max[k])) return false;
-    return true;
+  // Children (nodes and leaves) pushed in order and popped last first: the order in which the
+  // binary tree of old was walked (it popped a node's second child first), so the contacts meet
+  // the triangles in the same order as before.
+  struct Pending {
+    std::uint32_t first, count;
   };
-  std::array<std::uint32_t, 2 * kMaxDepth> stack;
+  std::array<Pending, 4 * kMaxDepth> stack;
   int size = 0;
-  stack[size++] = 0;
+  stack[size++] = {0, 0};
   while (size > 0) {
-    const Node& node = nodes_[stack[--size]];
-    if (!meets(node)) continue;
-    if (node.count == 0) {
-      stack[size++] = node.first;
-      stack[size++] = node.first + 1;
+    const Pending pending = stack[--size];
+    if (pending.count != 0) {
+      for (std::uint32_t k = pending.first; k < pending.first + pending.count; ++k) {
+        if (out->size() == limit) return false;
+        out->push_back(leaf_triangles_[k].triangle);
+      }
       continue;
     }
-    for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-      if (out->size() == limit) return false;
-      out->push_back(order_[k]);
+    const Node& node = nodes_[pending.first];
+    for (int k = 0; k < 4; ++k) {
+      bool meets = node.count[k] != kNoChild;
+      for (int axis = 0; axis < 3; ++axis)
+        meets = meets && node.min[axis][k] <= box.max[axis] && box.min[axis] <= node.max[axis][k];
+      if (meets) stack[size++] = {node.first[k], node.count[k]};
     }
   }
   return true;
