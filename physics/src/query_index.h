@@ -1,12 +1,14 @@
 // The bodies' bounds in a tree for queries (World::cast_ray and kin): a bounding-volume
 // hierarchy built on demand, top down by median splits along the widest axis of the boxes'
 // centres (O(n log n); a few leaves of at most kLeafSize bodies), and kept until a step or a
-// change of bodies makes it stale. A ray visits the nearer child first and skips boxes it enters
-// beyond the nearest hit so far. Bodies without bounds (half-spaces) are kept aside and tried by
-// every ray.
+// change of bodies makes it stale. A ray walks a copy of it with every other level dropped (four
+// children a node, met at once: the mesh's tree does the same, docs/COLLISION.md), nearer children
+// first, and skips boxes it enters beyond the nearest hit so far. Bodies without bounds
+// (half-spaces) are kept aside and tried by every ray.
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "physics/math.h"
+#include "wide.h"
 
 namespace tumble {
 
@@ -83,11 +86,25 @@ class QueryIndex {
     std::uint32_t first = 0;  // leaf: its first entry; inner: its second child (the first is next)
     std::uint32_t count = 0;  // leaf: entries; inner: 0
   };
+  // The rays' tree: lane k of a node is its child k's bounds (a node when count is 0, else a
+  // leaf's entries from first; count kNoChild: none, with empty bounds).
+  static constexpr std::uint32_t kNoChild = UINT32_MAX;
+  struct alignas(64) WideNode {
+    std::array<std::array<double, 4>, 3> min, max;
+    std::array<std::uint32_t, 4> first, count;
+  };
   std::uint32_t build_node(std::uint32_t begin, std::uint32_t end);
+  void build_wide();
   // Where the ray enters the box (t in [0, t_max]), or +infinity if it misses it.
   static double enter(const Aabb& box, const Vec3& origin, const Vec3& inverse, double t_max);
 
   std::vector<Node> nodes_;
+  std::vector<WideNode> wide_nodes_;
+  // The collapse's work list (kept: a world queried after every step builds without allocating).
+  struct Collapse {
+    std::uint32_t wide, binary;
+  };
+  std::vector<Collapse> collapsing_;
   std::vector<Entry> entries_;        // bounded, in the tree's order
   std::vector<std::uint32_t> unbounded_;  // slots of bodies without bounds
 };
@@ -97,31 +114,62 @@ void QueryIndex::visit_ray(const Vec3& origin, const Vec3& direction, double t_m
                            Visit&& visit) const {
   for (std::uint32_t slot : unbounded_)
     t_max = visit(slot, t_max);
-  if (nodes_.empty()) return;
+  if (wide_nodes_.empty()) return;
   const Vec3 inverse = direction.cwiseInverse();  // +-inf along an axis the ray does not move on
-  // Depth is O(log n) (median splits): 64 entries hold any tree of up to 2^60 bodies.
-  std::uint32_t stack[64];
+  const Wide from[3] = {wide(origin.x()), wide(origin.y()), wide(origin.z())};
+  const Wide scale[3] = {wide(inverse.x()), wide(inverse.y()), wide(inverse.z())};
+  // Depth is O(log n) (median splits); each node opened leaves at most three children waiting:
+  // 96 entries hold any tree of up to 2^60 bodies.
+  struct Pending {
+    std::uint32_t first, count;
+  };
+  Pending stack[96];
   int depth = 0;
-  if (enter(nodes_[0].bounds, origin, inverse, t_max) > t_max) return;
-  stack[depth++] = 0;
+  stack[depth++] = {0, 0};
   while (depth > 0) {
-    const std::uint32_t index = stack[--depth];
-    const Node& node = nodes_[index];
-    if (node.count > 0) {
-      for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+    const Pending pending = stack[--depth];
+    if (pending.count > 0) {
+      for (std::uint32_t k = pending.first; k < pending.first + pending.count; ++k)
         if (enter(entries_[k].bounds, origin, inverse, t_max) <= t_max)
           t_max = visit(entries_[k].slot, t_max);
       continue;
     }
-    const std::uint32_t near = index + 1, far = node.first;
-    const double t_near = enter(nodes_[near].bounds, origin, inverse, t_max);
-    const double t_far = enter(nodes_[far].bounds, origin, inverse, t_max);
-    // The nearer child is popped first; each is pushed only if the ray reaches it.
-    const bool swap = t_far < t_near;
-    const std::uint32_t first = swap ? far : near, second = swap ? near : far;
-    const double t_first = swap ? t_far : t_near, t_second = swap ? t_near : t_far;
-    if (t_second <= t_max) stack[depth++] = second;
-    if (t_first <= t_max) stack[depth++] = first;
+    // enter() on four boxes at once, lane by lane the same arithmetic: with inverse = +-inf the
+    // products are +-inf, or NaN on the slab's plane, which compares false and leaves the lane's
+    // interval as it was (inside, conservatively).
+    const WideNode& node = wide_nodes_[pending.first];
+    Wide near = wide(0), far = wide(t_max);
+    for (int axis = 0; axis < 3; ++axis) {
+      const Wide a =
+          (Wide{node.min[axis][0], node.min[axis][1], node.min[axis][2], node.min[axis][3]} -
+           from[axis]) *
+          scale[axis];
+      const Wide b =
+          (Wide{node.max[axis][0], node.max[axis][1], node.max[axis][2], node.max[axis][3]} -
+           from[axis]) *
+          scale[axis];
+      const WideMask swapped = a > b;
+      const Wide low = select(swapped, b, a), high = select(swapped, a, b);
+      near = select(near < low, low, near);
+      far = select(high < far, high, far);
+    }
+    const WideMask reached = near <= far;
+    // The children reached, farthest pushed first (an insertion sort of at most four).
+    int lanes[4];
+    double enters[4];
+    int count = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (!reached[k] || node.count[k] == kNoChild) continue;
+      int slot = count++;
+      for (; slot > 0 && enters[slot - 1] < near[k]; --slot) {
+        enters[slot] = enters[slot - 1];
+        lanes[slot] = lanes[slot - 1];
+      }
+      enters[slot] = near[k];
+      lanes[slot] = k;
+    }
+    for (int slot = 0; slot < count; ++slot)
+      stack[depth++] = {node.first[lanes[slot]], node.count[lanes[slot]]};
   }
 }
 
