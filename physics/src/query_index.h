@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "physics/math.h"
-#include "wide.h"
+#include "wide_slabs.h"
 
 namespace tumble {
 
@@ -116,8 +116,7 @@ void QueryIndex::visit_ray(const Vec3& origin, const Vec3& direction, double t_m
     t_max = visit(slot, t_max);
   if (wide_nodes_.empty()) return;
   const Vec3 inverse = direction.cwiseInverse();  // +-inf along an axis the ray does not move on
-  const Wide from[3] = {wide(origin.x()), wide(origin.y()), wide(origin.z())};
-  const Wide scale[3] = {wide(inverse.x()), wide(inverse.y()), wide(inverse.z())};
+  const WideRay ray = wide_ray(origin, inverse);
   // Depth is O(log n) (median splits); each node opened leaves at most three children waiting:
   // 96 entries hold any tree of up to 2^60 bodies.
   struct Pending {
@@ -134,42 +133,20 @@ void QueryIndex::visit_ray(const Vec3& origin, const Vec3& direction, double t_m
           t_max = visit(entries_[k].slot, t_max);
       continue;
     }
-    // enter() on four boxes at once, lane by lane the same arithmetic: with inverse = +-inf the
-    // products are +-inf, or NaN on the slab's plane, which compares false and leaves the lane's
-    // interval as it was (inside, conservatively).
+    // enter() on four boxes at once (wide_slabs.h).
     const WideNode& node = wide_nodes_[pending.first];
-    Wide near = wide(0), far = wide(t_max);
-    for (int axis = 0; axis < 3; ++axis) {
-      const Wide a =
-          (Wide{node.min[axis][0], node.min[axis][1], node.min[axis][2], node.min[axis][3]} -
-           from[axis]) *
-          scale[axis];
-      const Wide b =
-          (Wide{node.max[axis][0], node.max[axis][1], node.max[axis][2], node.max[axis][3]} -
-           from[axis]) *
-          scale[axis];
-      const WideMask swapped = a > b;
-      const Wide low = select(swapped, b, a), high = select(swapped, a, b);
-      near = select(near < low, low, near);
-      far = select(high < far, high, far);
-    }
-    const WideMask reached = near <= far;
-    // The children reached, farthest pushed first (an insertion sort of at most four).
-    int lanes[4];
-    double enters[4];
-    int count = 0;
-    for (int k = 0; k < 4; ++k) {
-      if (!reached[k] || node.count[k] == kNoChild) continue;
-      int slot = count++;
-      for (; slot > 0 && enters[slot - 1] < near[k]; --slot) {
-        enters[slot] = enters[slot - 1];
-        lanes[slot] = lanes[slot - 1];
-      }
-      enters[slot] = near[k];
-      lanes[slot] = k;
-    }
-    for (int slot = 0; slot < count; ++slot)
-      stack[depth++] = {node.first[lanes[slot]], node.count[lanes[slot]]};
+    const auto lanes = [](const std::array<double, 4>& bound) {
+      return Wide{bound[0], bound[1], bound[2], bound[3]};
+    };
+    WideMask reached;
+    const Wide near =
+        enter_boxes(ray, {lanes(node.min[0]), lanes(node.min[1]), lanes(node.min[2])},
+                    {lanes(node.max[0]), lanes(node.max[1]), lanes(node.max[2])}, t_max, &reached);
+    farthest_first(
+        reached, near, [&](int k) { return node.count[k] != kNoChild; },
+        [&](int k) {
+          stack[depth++] = {node.first[k], node.count[k]};
+        });
   }
 }
 

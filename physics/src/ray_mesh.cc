@@ -9,7 +9,7 @@
 
 #include "physics/triangle_mesh.h"
 #include "ray_shape.h"
-#include "wide.h"
+#include "wide_slabs.h"
 
 namespace tumble {
 namespace {
@@ -21,14 +21,12 @@ TUMBLE_INLINE Wide lanes_of(const std::array<float, 4>& bound) {
 
 }  // namespace
 
-// The four children's slabs are met at once, each lane the scalar slab test's arithmetic in
-// double (the same entry distances, so the same walk and hit on any machine).
+// The four children's slabs are met at once, in double (wide_slabs.h).
 TUMBLE_PER_CPU
 bool ray_mesh(const TriangleMesh& mesh, const Vec3& origin, const Vec3& direction, double max_t,
               ShapeRayHit* hit) {
   const Vec3 inverse = direction.cwiseInverse();
-  const Wide from[3] = {wide(origin.x()), wide(origin.y()), wide(origin.z())};
-  const Wide scale[3] = {wide(inverse.x()), wide(inverse.y()), wide(inverse.z())};
+  const WideRay ray = wide_ray(origin, inverse);
   const auto& nodes = mesh.nodes();
   const std::vector<Vec3>& vertices = mesh.def().vertices;
   double best = max_t;
@@ -57,34 +55,15 @@ bool ray_mesh(const TriangleMesh& mesh, const Vec3& origin, const Vec3& directio
       continue;
     }
     const TriangleMesh::Node& node = nodes[pending.first];
-    // Where the ray enters each child's box within [0, best]; a direction of 0 gives (±inf,
-    // ±inf) outside the slab and NaN on its plane, which compares false, keeping the ray.
-    Wide enter = wide(0), leave = wide(best);
-    for (int axis = 0; axis < 3; ++axis) {
-      const Wide low = (lanes_of(node.min[axis]) - from[axis]) * scale[axis];
-      const Wide high = (lanes_of(node.max[axis]) - from[axis]) * scale[axis];
-      const WideMask swapped = low > high;
-      const Wide near = select(swapped, high, low), far = select(swapped, low, high);
-      enter = select(near > enter, near, enter);
-      leave = select(far < leave, far, leave);
-    }
-    const WideMask met = enter <= leave;
-    // The children met, farthest first onto the stack (an insertion sort of at most four).
-    std::array<int, 4> lanes;
-    std::array<double, 4> enters;
-    int met_count = 0;
-    for (int k = 0; k < 4; ++k) {
-      if (!met[k] || node.count[k] == TriangleMesh::kNoChild) continue;
-      int slot = met_count++;
-      for (; slot > 0 && enters[slot - 1] < enter[k]; --slot) {
-        enters[slot] = enters[slot - 1];
-        lanes[slot] = lanes[slot - 1];
-      }
-      enters[slot] = enter[k];
-      lanes[slot] = k;
-    }
-    for (int slot = 0; slot < met_count; ++slot)
-      stack[size++] = {node.first[lanes[slot]], node.count[lanes[slot]]};
+    WideMask reached;
+    const Wide enter = enter_boxes(
+        ray, {lanes_of(node.min[0]), lanes_of(node.min[1]), lanes_of(node.min[2])},
+        {lanes_of(node.max[0]), lanes_of(node.max[1]), lanes_of(node.max[2])}, best, &reached);
+    farthest_first(
+        reached, enter, [&](int k) { return node.count[k] != TriangleMesh::kNoChild; },
+        [&](int k) {
+          stack[size++] = {node.first[k], node.count[k]};
+        });
   }
   if (best_triangle < 0) return false;
   hit->t = best;
