@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "four_wide_tree.h"
+
 namespace tumble {
 
 void QueryIndex::build(std::span<const Entry> entries) {
@@ -22,58 +24,37 @@ void QueryIndex::build(std::span<const Entry> entries) {
   build_wide();
 }
 
-// A node's children are its binary node's grandchildren, or its children where they are leaves
-// (each lies within the level dropped, so a ray reaches the same entries); inner children made
-// side by side.
+// The rays' copy of the tree (four_wide_tree.h).
 void QueryIndex::build_wide() {
   wide_nodes_.reserve(nodes_.size() / 3 + 1);
-  wide_nodes_.push_back({});
-  std::vector<Collapse>& pending = collapsing_;
-  pending.assign(1, {0, 0});
-  for (std::size_t next = 0; next < pending.size(); ++next) {
-    const auto [at, from] = pending[next];
-    std::array<std::uint32_t, 4> children{};
-    int child_count = 0;
-    auto children_of = [&](std::uint32_t index) {
-      return std::array<std::uint32_t, 2>{index + 1, nodes_[index].first};
-    };
-    if (nodes_[from].count > 0) {
-      children[child_count++] = from;  // a handful of bodies: the root is one leaf
-    } else {
-      for (std::uint32_t c : children_of(from)) {
-        if (nodes_[c].count == 0) {
-          for (std::uint32_t g : children_of(c))
-            children[child_count++] = g;
-        } else {
-          children[child_count++] = c;
-        }
-      }
-    }
-    for (int k = 0; k < 4; ++k) {
-      WideNode& node = wide_nodes_[at];
-      if (k >= child_count) {
-        for (int axis = 0; axis < 3; ++axis) {
-          node.min[axis][k] = std::numeric_limits<double>::infinity();
-          node.max[axis][k] = -std::numeric_limits<double>::infinity();
-        }
-        node.first[k] = 0;
-        node.count[k] = kNoChild;
-        continue;
-      }
-      const Node& child = nodes_[children[k]];
-      for (int axis = 0; axis < 3; ++axis) {
-        node.min[axis][k] = child.bounds.min[axis];
-        node.max[axis][k] = child.bounds.max[axis];
-      }
-      node.first[k] = child.first;
-      node.count[k] = child.count;
-      if (child.count == 0) {
-        node.first[k] = static_cast<std::uint32_t>(wide_nodes_.size());
-        pending.push_back({node.first[k], children[k]});
-        wide_nodes_.push_back({});  // may move wide_nodes_: `node` is not used after it
-      }
-    }
-  }
+  collapse_to_four_wide([&](std::uint32_t b) { return nodes_[b].count > 0; },
+                        [&](std::uint32_t b) {
+                          return std::array<std::uint32_t, 2>{b + 1, nodes_[b].first};
+                        },
+                        [&] {
+                          wide_nodes_.push_back({});
+                          return static_cast<std::uint32_t>(wide_nodes_.size() - 1);
+                        },
+                        [&](std::uint32_t at, int k, std::uint32_t b, std::uint32_t wide) {
+                          WideNode& node = wide_nodes_[at];
+                          if (b == kNoBinaryNode) {
+                            for (int axis = 0; axis < 3; ++axis) {
+                              node.min[axis][k] = std::numeric_limits<double>::infinity();
+                              node.max[axis][k] = -std::numeric_limits<double>::infinity();
+                            }
+                            node.first[k] = 0;
+                            node.count[k] = kNoChild;
+                            return;
+                          }
+                          const Node& child = nodes_[b];
+                          for (int axis = 0; axis < 3; ++axis) {
+                            node.min[axis][k] = child.bounds.min[axis];
+                            node.max[axis][k] = child.bounds.max[axis];
+                          }
+                          node.count[k] = child.count;
+                          node.first[k] = child.count == 0 ? wide : child.first;
+                        },
+                        &collapsing_);
 }
 
 std::uint32_t QueryIndex::build_node(std::uint32_t begin, std::uint32_t end) {

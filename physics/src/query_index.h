@@ -101,10 +101,7 @@ class QueryIndex {
   std::vector<Node> nodes_;
   std::vector<WideNode> wide_nodes_;
   // The collapse's work list (kept: a world queried after every step builds without allocating).
-  struct Collapse {
-    std::uint32_t wide, binary;
-  };
-  std::vector<Collapse> collapsing_;
+  std::vector<std::array<std::uint32_t, 2>> collapsing_;
   std::vector<Entry> entries_;        // bounded, in the tree's order
   std::vector<std::uint32_t> unbounded_;  // slots of bodies without bounds
 };

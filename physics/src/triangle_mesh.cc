@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "four_wide_tree.h"
+
 namespace tumble {
 namespace {
 
@@ -188,59 +190,39 @@ void TriangleMesh::build_tree() {
     tasks.push_back({left, task.first, half});
     tasks.push_back({left + 1, task.first + half, task.count - half});
   }
-  // Then every other level of it dropped: a node's children are its binary node's grandchildren
-  // (or its children where they are leaves), in their left-to-right order. Each child's bounds
-  // lie within those of the level dropped, so the walks meet the same triangles. A node's inner
-  // children are made one after another (siblings side by side in memory).
+  // Then read as four children a node (four_wide_tree.h).
   nodes_.clear();
   nodes_.reserve(binary.size() / 3 + 1);
-  nodes_.push_back({});
-  struct Collapse {
-    std::uint32_t node, binary;
-  };
-  std::vector<Collapse> pending{{0, 0}};
-  for (std::size_t next = 0; next < pending.size(); ++next) {
-    const auto [at, from] = pending[next];
-    std::array<std::uint32_t, 4> children{};
-    int child_count = 0;
-    if (binary[from].count != 0) {
-      children[child_count++] = from;  // a mesh of a few triangles: the root is one leaf
-    } else {
-      for (std::uint32_t c : {binary[from].first, binary[from].first + 1}) {
-        if (binary[c].count == 0) {
-          children[child_count++] = binary[c].first;
-          children[child_count++] = binary[c].first + 1;
-        } else {
-          children[child_count++] = c;
-        }
-      }
-    }
-    for (int k = 0; k < 4; ++k) {
-      // Empty bounds (min above max) meet no box and no ray.
-      Node& node = nodes_[at];
-      if (k >= child_count) {
-        for (int axis = 0; axis < 3; ++axis) {
-          node.min[axis][k] = HUGE_VALF;
-          node.max[axis][k] = -HUGE_VALF;
-        }
-        node.first[k] = 0;
-        node.count[k] = kNoChild;
-        continue;
-      }
-      const BinaryNode& child = binary[children[k]];
-      for (int axis = 0; axis < 3; ++axis) {
-        node.min[axis][k] = child.min[axis];
-        node.max[axis][k] = child.max[axis];
-      }
-      node.count[k] = static_cast<std::uint8_t>(child.count);
-      node.first[k] = child.first;
-      if (child.count == 0) {
-        node.first[k] = static_cast<std::uint32_t>(nodes_.size());
-        pending.push_back({node.first[k], children[k]});
-        nodes_.push_back({});  // may move nodes_: `node` is not used after it
-      }
-    }
-  }
+  std::vector<std::array<std::uint32_t, 2>> pending;
+  collapse_to_four_wide([&](std::uint32_t b) { return binary[b].count != 0; },
+                        [&](std::uint32_t b) {
+                          return std::array<std::uint32_t, 2>{binary[b].first, binary[b].first + 1};
+                        },
+                        [&] {
+                          nodes_.push_back({});
+                          return static_cast<std::uint32_t>(nodes_.size() - 1);
+                        },
+                        [&](std::uint32_t at, int k, std::uint32_t b, std::uint32_t wide) {
+                          Node& node = nodes_[at];
+                          if (b == kNoBinaryNode) {
+                            // Empty bounds (min above max) meet no box and no ray.
+                            for (int axis = 0; axis < 3; ++axis) {
+                              node.min[axis][k] = HUGE_VALF;
+                              node.max[axis][k] = -HUGE_VALF;
+                            }
+                            node.first[k] = 0;
+                            node.count[k] = kNoChild;
+                            return;
+                          }
+                          const BinaryNode& child = binary[b];
+                          for (int axis = 0; axis < 3; ++axis) {
+                            node.min[axis][k] = child.min[axis];
+                            node.max[axis][k] = child.max[axis];
+                          }
+                          node.count[k] = static_cast<std::uint8_t>(child.count);
+                          node.first[k] = child.count == 0 ? wide : child.first;
+                        },
+                        &pending);
   leaf_triangles_.resize(count);
   for (std::size_t k = 0; k < count; ++k)
     leaf_triangles_[k] = {order[k], def_.triangles[order[k]]};
