@@ -135,11 +135,14 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
     if (grounded(node) && !visited_[node]) forest = visit_tree(node);
   for (std::uint32_t node = 0; forest && node < n; ++node)
     if (!visited_[node]) forest = visit_tree(node);
-  if (!forest) {
+  auto give_up = [&] {
     nodes_.clear();
+    joints_.clear();
+    tree_bodies_.clear();
     built_shape_.clear();
     return false;
-  }
+  };
+  if (!forest) return give_up();
   // Children before parents: the visit's order reversed. Nodes are renumbered in that order.
   std::vector<std::uint32_t>& new_index = first_edge_;  // no longer needed as edges
   new_index.assign(n, kNone);
@@ -153,22 +156,106 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
     node.parent = parent_of[old] == kNone ? kNone : new_index[parent_of[old]];
   }
   nodes_.swap(ordered);
-  for (std::uint32_t body : bodies_used_)
-    node_of_body_[body] = new_index[node_of_body_[body]];
   equations_.resize(n);
+  if (!number_forest(rows, bodies)) return give_up();
   built_ = true;
   finish_build(rows, bodies);
   return true;
 }
 
+bool JointTree::number_forest(std::span<const JointRow> rows, std::span<const SolverBody> bodies) {
+  const std::size_t n = nodes_.size();
+  // Joints and bodies numbered in the nodes' order (children before parents).
+  std::vector<std::uint32_t>& numbered = numbered_;
+  numbered.assign(n, kNone);
+  joints_.clear();
+  tree_bodies_.clear();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Node& node = nodes_[k];
+    if (node.is_joint) {
+      numbered[k] = static_cast<std::uint32_t>(joints_.size());
+      joints_.push_back({});
+      joints_.back().row = node.index;
+    } else {
+      numbered[k] = static_cast<std::uint32_t>(tree_bodies_.size());
+      node_of_body_[node.index] = numbered[k];
+      tree_bodies_.push_back({});
+      tree_bodies_.back().index = node.index;
+    }
+  }
+  for (TreeJoint& joint : joints_) {
+    const JointRow& row = rows[joint.row];
+    if (moves(bodies, row.a)) joint.body_a = node_of_body_[row.a];
+    if (moves(bodies, row.b)) joint.body_b = node_of_body_[row.b];
+  }
+  // Each body's hub: the joints below it in order, then the joint above it.
+  std::vector<std::uint32_t>& child_count = child_count_;
+  child_count.assign(tree_bodies_.size() + 1, 0);
+  for (std::size_t k = 0; k < n; ++k)
+    if (nodes_[k].is_joint && nodes_[k].parent != kNone) ++child_count[numbered[nodes_[k].parent]];
+  hubs_.clear();
+  hub_members_.clear();
+  member_side_b_.clear();
+  pairs_.clear();
+  std::vector<std::uint32_t>& hub_of_body = first_edge_;  // no longer needed as edges
+  hub_of_body.assign(tree_bodies_.size(), kNone);
+  std::uint32_t pairs = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (nodes_[k].is_joint) continue;
+    const std::uint32_t body = numbered[k];
+    const std::uint32_t members = child_count[body] + (nodes_[k].parent != kNone ? 1 : 0);
+    if (members > kMostHubJoints) return false;
+    if (members < 2) continue;
+    hub_of_body[body] = static_cast<std::uint32_t>(hubs_.size());
+    hubs_.push_back({body, 0, 0, pairs});
+    pairs += members * (members - 1) / 2;
+  }
+  // Members: the children as the nodes' order meets them, the parent joint last.
+  std::uint32_t first = 0;
+  for (Hub& hub : hubs_) {
+    hub.first_member = first;
+    first += child_count[hub.body] + 1;
+  }
+  hub_members_.assign(first, kNone);
+  member_side_b_.assign(first, 0);
+  auto add_member = [&](Hub& hub, std::uint32_t joint) {
+    const std::uint32_t place = hub.members++;
+    hub_members_[hub.first_member + place] = joint;
+    const JointRow& row = rows[joints_[joint].row];
+    member_side_b_[hub.first_member + place] =
+        moves(bodies, row.b) && node_of_body_[row.b] == hub.body ? 1 : 0;
+  };
+  for (std::size_t k = 0; k < n; ++k) {
+    const Node& node = nodes_[k];
+    if (!node.is_joint || node.parent == kNone) continue;
+    const std::uint32_t hub = hub_of_body[numbered[node.parent]];
+    if (hub == kNone) continue;
+    add_member(hubs_[hub], numbered[k]);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const Node& node = nodes_[k];
+    if (node.is_joint || node.parent == kNone) continue;
+    const std::uint32_t hub = hub_of_body[numbered[k]];
+    if (hub != kNone) add_member(hubs_[hub], numbered[node.parent]);  // last: no later ones
+  }
+  // A joint's later neighbours are the members after it in its parent body's hub; the last
+  // member of a hub (the body's parent joint) has none there.
+  for (const Hub& hub : hubs_)
+    for (std::uint32_t i = 0; i + 1 < hub.members; ++i) {
+      TreeJoint& joint = joints_[hub_members_[hub.first_member + i]];
+      joint.hub = static_cast<std::uint32_t>(&hub - hubs_.data());
+      joint.place = i;
+    }
+  pairs_.resize(pairs);
+  return true;
+}
+
 void JointTree::finish_build(std::span<const JointRow> rows, std::span<const SolverBody> bodies) {
   has_motors_ = false;
-  for (Node& node : nodes_) {
-    if (node.is_joint)
-      has_motors_ = has_motors_ || rows[node.index].joint.motor.enabled;
-    else
-      node.inertia = bodies[node.index].inverse_inertia.inverse();
-  }
+  for (const TreeJoint& joint : joints_)
+    has_motors_ = has_motors_ || rows[joint.row].joint.motor.enabled;
+  for (TreeBody& body : tree_bodies_)
+    body.inertia = bodies[body.index].inverse_inertia.inverse();
   velocities_factored_ = false;
   targets_taken_ = false;
 }
@@ -196,15 +283,14 @@ constexpr double kConvergedTakes = 0.03;
 bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
                                         std::span<const Pose> poses, double h) {
-  for (Node& node : nodes_) {
-    node.linear_stiffness.setZero();
-    node.angular_stiffness.setZero();
-    node.longest_lever.setZero();
+  for (TreeBody& body : tree_bodies_) {
+    body.linear_stiffness.setZero();
+    body.angular_stiffness.setZero();
+    body.longest_lever.setZero();
   }
   const double h2 = h * h;
-  for (const Node& node : nodes_) {
-    if (!node.is_joint) continue;
-    const JointRow& row = rows[node.index];
+  for (const TreeJoint& tree_joint : joints_) {
+    const JointRow& row = rows[tree_joint.row];
     const Joint& joint = row.joint;
     if (!(joint.impulse_time > 0)) continue;
     const bool world_b = row.b == kWorldAnchor;
@@ -229,7 +315,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     for (const auto& [body, r, force] : {std::tuple{row.a, anchors.ra, Vec3(-force_on_b)},
                                          std::tuple{row.b, anchors.rb, force_on_b}}) {
       if (body == kWorldAnchor || node_of_body_[body] == kNone) continue;
-      Node& body_node = nodes_[node_of_body_[body]];
+      TreeBody& body_node = tree_bodies_[node_of_body_[body]];
       body_node.linear_stiffness += linear;
       const double arm = r.norm();
       if (arm > body_node.longest_lever.norm()) body_node.longest_lever = r;
@@ -260,8 +346,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     stiffness *= rho > resolved ? 1 - resolved / rho : 0.0;
     any = any || rho > resolved;
   };
-  for (Node& node : nodes_) {
-    if (node.is_joint) continue;
+  for (TreeBody& node : tree_bodies_) {
     const SolverBody& body = bodies[node.index];
     keep_excess(node.linear_stiffness, body.inverse_mass * Mat3::Identity());
     // A turn moves the anchors, and the joints move the body with them: against its longest
@@ -269,142 +354,226 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     // its pivot, not its centre).
     const Vec3& r = node.longest_lever;
     const Mat3 turning =
-        body.inverse_inertia.inverse() +
-        (r.squaredNorm() * Mat3::Identity() - r * r.transpose()) / body.inverse_mass;
+        node.inertia + (r.squaredNorm() * Mat3::Identity() - r * r.transpose()) / body.inverse_mass;
     keep_excess(node.angular_stiffness, turning.inverse());
   }
   return any;
 }
 
+namespace {
+
+// Calls f.template operator()<W>() with the fixed width W (3 or 6) of a joint's rows.
+template <class F>
+void with_width(int width, F&& f) {
+  if (width == 3)
+    f.template operator()<3>();
+  else
+    f.template operator()<6>();
+}
+template <class F>
+void with_widths(int first, int second, F&& f) {
+  with_width(first,
+             [&]<int A>() { with_width(second, [&]<int B>() { f.template operator()<A, B>(); }); });
+}
+
+}  // namespace
+
 template <class Equations>
-void JointTree::factor(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
-                       bool velocities, Equations equations) {
-  const std::size_t n = nodes_.size();
-  // The blocks: a body's mass matrix (with its stiffness for velocities), a joint's zero (its
-  // unused rows -1, so that each pivot is definite), and each node's block with its parent.
-  for (std::size_t k = 0; k < n; ++k) {
-    Node& node = nodes_[k];
-    node.pivot.setZero();
-    if (node.is_joint) {
-      equations_[k] = equations(k);
-      for (int r = equations_[k].rows; r < 6; ++r)
-        node.pivot(r, r) = -1;
+void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equations equations) {
+  for (TreeBody& body : tree_bodies_) {
+    const SolverBody& solver_body = bodies[body.index];
+    body.stiff =
+        velocities && (!body.linear_stiffness.isZero() || !body.angular_stiffness.isZero());
+    if (body.stiff) {
+      body.linear_inverse =
+          (Mat3(Mat3::Identity() / solver_body.inverse_mass) + body.linear_stiffness).inverse();
+      body.angular_inverse = (body.inertia + body.angular_stiffness).inverse();
     } else {
-      const SolverBody& body = bodies[node.index];
-      node.pivot.topLeftCorner<3, 3>().diagonal().setConstant(1 / body.inverse_mass);
-      node.pivot.bottomRightCorner<3, 3>() = node.inertia;
-      if (velocities) {
-        node.pivot.topLeftCorner<3, 3>() += node.linear_stiffness;
-        node.pivot.bottomRightCorner<3, 3>() += node.angular_stiffness;
+      body.angular_inverse = solver_body.inverse_inertia;
+    }
+    body.inverse_mass = solver_body.inverse_mass;
+  }
+  // Each joint's rows, its response on each body (W J^T) and its diagonal block J W J^T.
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    TreeJoint& joint = joints_[k];
+    equations_[k] = equations(k);
+    joint.width = equations_[k].rows <= 3 ? 3 : 6;
+    with_width(joint.width, [&]<int W>() {
+      Eigen::Matrix<double, W, W> pivot = Eigen::Matrix<double, W, W>::Zero();
+      for (const bool side_b : {false, true}) {
+        const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
+        if (b == kNone) continue;
+        const TreeBody& body = tree_bodies_[b];
+        const auto rows_on_body = jacobian(k, side_b).template topRows<W>();
+        Mat6& response = side_b ? joint.response_b : joint.response_a;
+        if (body.stiff)
+          response.template topLeftCorner<3, W>().noalias() =
+              body.linear_inverse.lazyProduct(rows_on_body.template leftCols<3>().transpose());
+        else
+          response.template topLeftCorner<3, W>() =
+              body.inverse_mass * rows_on_body.template leftCols<3>().transpose();
+        response.template bottomLeftCorner<3, W>().noalias() =
+            body.angular_inverse.lazyProduct(rows_on_body.template rightCols<3>().transpose());
+        pivot.noalias() += rows_on_body.lazyProduct(response.template leftCols<W>());
+      }
+      for (int r = equations_[k].rows; r < W; ++r)
+        pivot(r, r) = 1;
+      joint.pivot.template topLeftCorner<W, W>() = pivot;
+    });
+  }
+  // The blocks between joints of a hub: through the hub's body alone.
+  for (const Hub& hub : hubs_) {
+    for (std::uint32_t i = 0; i + 1 < hub.members; ++i) {
+      const std::uint32_t first = hub_members_[hub.first_member + i];
+      const bool first_b = member_side_b_[hub.first_member + i] != 0;
+      for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+        const std::uint32_t second = hub_members_[hub.first_member + j];
+        const bool second_b = member_side_b_[hub.first_member + j] != 0;
+        const Mat6& response = second_b ? joints_[second].response_b : joints_[second].response_a;
+        with_widths(joints_[first].width, joints_[second].width, [&]<int A, int B>() {
+          pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>().noalias() =
+              jacobian(first, first_b)
+                  .template topRows<A>()
+                  .lazyProduct(response.template leftCols<B>());
+        });
       }
     }
   }
-  for (std::size_t k = 0; k < n; ++k) {
-    Node& node = nodes_[k];
-    node.narrow = false;
-    if (node.parent == kNone) continue;
-    // The joint's Jacobian on the body (the joint is this node or its parent).
-    const std::size_t joint = node.is_joint ? k : node.parent;
-    node.narrow = equations_[joint].rows <= 3;
-    const std::uint32_t body = node.is_joint ? nodes_[node.parent].index : node.index;
-    const JointRow& row = rows[nodes_[joint].index];
-    const Mat6& jacobian = row.a == body ? equations_[joint].on_a : equations_[joint].on_b;
-    if (node.is_joint)
-      node.to_parent = jacobian;
-    else
-      node.to_parent = jacobian.transpose();
+  // Each joint eliminated into its later neighbours (each pivot kept as its inverse).
+  for (TreeJoint& joint : joints_) {
+    with_width(joint.width, [&]<int W>() {
+      if constexpr (W == 3)
+        joint.pivot.topLeftCorner<3, 3>() = Mat3(joint.pivot.topLeftCorner<3, 3>()).inverse();
+      else
+        joint.pivot = inverse_of_definite(joint.pivot);
+    });
+    if (joint.hub == kNone) continue;
+    const Hub& hub = hubs_[joint.hub];
+    const std::uint32_t i = joint.place;
+    for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+      HubPair& pair = pairs_[pair_index(hub, i, j)];
+      with_widths(joint.width, joints_[hub_members_[hub.first_member + j]].width,
+                  [&]<int A, int B>() {
+                    pair.reach.template topLeftCorner<A, B>().noalias() =
+                        joint.pivot.template topLeftCorner<A, A>().lazyProduct(
+                            pair.block.template topLeftCorner<A, B>());
+                  });
+    }
+    for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+      const HubPair& with_j = pairs_[pair_index(hub, i, j)];
+      TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
+      with_widths(joint.width, later.width, [&]<int A, int B>() {
+        later.pivot.template topLeftCorner<B, B>().noalias() -=
+            with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
+                with_j.reach.template topLeftCorner<A, B>());
+      });
+      for (std::uint32_t l = j + 1; l < hub.members; ++l) {
+        const HubPair& with_l = pairs_[pair_index(hub, i, l)];
+        HubPair& between = pairs_[pair_index(hub, j, l)];
+        with_widths(later.width, joints_[hub_members_[hub.first_member + l]].width,
+                    [&]<int B, int C>() {
+                      with_width(joint.width, [&]<int A>() {
+                        between.block.template topLeftCorner<B, C>().noalias() -=
+                            with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
+                                with_l.reach.template topLeftCorner<A, C>());
+                      });
+                    });
+      }
+    }
   }
-  // Children eliminated into their parents (each pivot kept as its inverse).
-  for (std::size_t k = 0; k < n; ++k) {
-    Node& node = nodes_[k];
-    Mat6& parent_pivot = nodes_[node.parent == kNone ? k : node.parent].pivot;
-    if (node.is_joint && equations_[k].rows <= 3) {
-      // diag(A, -1, -1, -1): A's inverse alone (a singular A gives non-finite entries).
-      const Mat3 corner = node.pivot.topLeftCorner<3, 3>().inverse();
-      node.pivot.setZero();
-      node.pivot.topLeftCorner<3, 3>() = corner;
-      node.pivot.bottomRightCorner<3, 3>() = -Mat3::Identity();
-    } else {
-      node.pivot = inverse_of_definite(node.pivot);
+}
+
+void JointTree::set_velocity_base(std::span<const SolverBody> bodies) {
+  for (TreeBody& body : tree_bodies_) {
+    const SolverBody& solver_body = bodies[body.index];
+    if (!body.stiff) {
+      body.base << solver_body.v, solver_body.w;
+      continue;
     }
-    if (node.parent == kNone) continue;
-    if (!node.narrow) {
-      node.reach = node.pivot * node.to_parent;
-      parent_pivot -= node.to_parent.transpose() * node.reach;
-    } else if (node.is_joint) {
-      node.reach.setZero();
-      node.reach.topRows<3>() = node.pivot.topLeftCorner<3, 3>() * node.to_parent.topRows<3>();
-      parent_pivot -= node.to_parent.topRows<3>().transpose() * node.reach.topRows<3>();
-    } else {
-      node.reach.setZero();
-      node.reach.leftCols<3>() = node.pivot * node.to_parent.leftCols<3>();
-      parent_pivot.topLeftCorner<3, 3>() -=
-          node.to_parent.leftCols<3>().transpose() * node.reach.leftCols<3>();
-    }
+    // (M + K)^-1 M v: the stiffness damps what moves against it.
+    body.base << body.linear_inverse * (solver_body.v / solver_body.inverse_mass),
+        body.angular_inverse * (body.inertia * solver_body.w);
   }
 }
 
 template <class Targets>
-void JointTree::solve(std::span<const SolverBody> bodies, bool velocities, Targets targets) {
-  const std::size_t n = nodes_.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    Node& node = nodes_[k];
-    if (node.is_joint) {
-      node.rhs = targets(k);
-    } else if (velocities) {
-      const SolverBody& body = bodies[node.index];
-      node.rhs.head<3>() = body.v / body.inverse_mass;
-      node.rhs.tail<3>() = node.inertia * body.w;
-    } else {
-      node.rhs.setZero();
-    }
+void JointTree::solve(bool from_base, Targets targets) {
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    TreeJoint& joint = joints_[k];
+    joint.rhs = -targets(k);
+    if (!from_base) continue;
+    with_width(joint.width, [&]<int W>() {
+      for (const bool side_b : {false, true}) {
+        const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
+        if (b == kNone) continue;
+        joint.rhs.template head<W>().noalias() +=
+            jacobian(k, side_b).template topRows<W>().lazyProduct(tree_bodies_[b].base);
+      }
+    });
   }
   substitute();
+  for (TreeBody& body : tree_bodies_) {
+    if (from_base)
+      body.result = body.base;
+    else
+      body.result.setZero();
+  }
+  for (const TreeJoint& joint : joints_) {
+    with_width(joint.width, [&]<int W>() {
+      if (joint.body_a != kNone)
+        tree_bodies_[joint.body_a].result.noalias() -=
+            joint.response_a.template leftCols<W>().lazyProduct(joint.rhs.template head<W>());
+      if (joint.body_b != kNone)
+        tree_bodies_[joint.body_b].result.noalias() -=
+            joint.response_b.template leftCols<W>().lazyProduct(joint.rhs.template head<W>());
+    });
+  }
 }
 
 void JointTree::substitute() {
-  const std::size_t n = nodes_.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    const Node& node = nodes_[k];
-    if (node.parent == kNone) continue;
-    Vec6& parent_rhs = nodes_[node.parent].rhs;
-    if (!node.narrow) {
-      parent_rhs -= node.reach.transpose() * node.rhs;
-    } else if (node.is_joint) {
-      parent_rhs -= node.reach.topRows<3>().transpose() * node.rhs.head<3>();
-    } else {
-      parent_rhs.head<3>() -= node.reach.leftCols<3>().transpose() * node.rhs;
+  for (const TreeJoint& joint : joints_) {
+    if (joint.hub == kNone) continue;
+    const Hub& hub = hubs_[joint.hub];
+    for (std::uint32_t j = joint.place + 1; j < hub.members; ++j) {
+      TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
+      const HubPair& pair = pairs_[pair_index(hub, joint.place, j)];
+      with_widths(joint.width, later.width, [&]<int A, int B>() {
+        later.rhs.template head<B>().noalias() -=
+            pair.reach.template topLeftCorner<A, B>().transpose().lazyProduct(
+                joint.rhs.template head<A>());
+      });
     }
   }
-  for (std::size_t k = n; k-- > 0;) {
-    Node& node = nodes_[k];
-    if (node.parent == kNone) {
-      node.rhs = node.pivot * node.rhs;
-      continue;
-    }
-    const Vec6& parent_rhs = nodes_[node.parent].rhs;
-    if (!node.narrow) {
-      node.rhs = node.pivot * node.rhs - node.reach * parent_rhs;
-    } else if (node.is_joint) {
-      node.rhs.head<3>() = node.pivot.topLeftCorner<3, 3>() * node.rhs.head<3>() -
-                           node.reach.topRows<3>() * parent_rhs;
-      node.rhs.tail<3>() = -node.rhs.tail<3>();
-    } else {
-      node.rhs = node.pivot * node.rhs - node.reach.leftCols<3>() * parent_rhs.head<3>();
-    }
+  for (std::size_t k = joints_.size(); k-- > 0;) {
+    TreeJoint& joint = joints_[k];
+    with_width(joint.width, [&]<int W>() {
+      const Eigen::Matrix<double, W, 1> scaled =
+          joint.pivot.template topLeftCorner<W, W>().lazyProduct(joint.rhs.template head<W>());
+      joint.rhs.template head<W>() = scaled;
+      if (joint.hub == kNone) return;
+      const Hub& hub = hubs_[joint.hub];
+      for (std::uint32_t j = joint.place + 1; j < hub.members; ++j) {
+        const TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
+        const HubPair& pair = pairs_[pair_index(hub, joint.place, j)];
+        with_width(later.width, [&]<int B>() {
+          joint.rhs.template head<W>().noalias() -=
+              pair.reach.template topLeftCorner<W, B>().lazyProduct(later.rhs.template head<B>());
+        });
+      }
+    });
   }
 }
 
 double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBody> bodies,
                                    std::span<const Pose> poses, const JointTarget& target) {
-  if (nodes_.empty()) return 0;
+  if (joints_.empty()) return 0;
   // The poses stay put between moves: one factoring serves every sweep until the next.
   if (!velocities_factored_) {
     stiffened_ = set_geometric_stiffness(rows, bodies, poses, target.substep);
-    factor(rows, bodies, true, [&](std::size_t k) {
+    factor(bodies, true, [&](std::size_t k) {
       JointTarget plain = target;
       plain.h = 0;
-      return velocity_equations(rows[nodes_[k].index], bodies, poses, plain);
+      return velocity_equations(rows[joints_[k].row], bodies, poses, plain);
     });
     velocities_factored_ = true;
   }
@@ -422,7 +591,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   // Without a move ahead the rows' rates are held at zero.
   auto rates_of = [&](std::size_t k, const std::vector<Vec6>& targets) {
     Vec6 rates = target.h > 0 ? targets[k] : Vec6(Vec6::Zero());
-    const JointRow& row = rows[nodes_[k].index];
+    const JointRow& row = rows[joints_[k].row];
     if (motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
     return rates;
   };
@@ -430,26 +599,23 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     JointTarget plain = target;
     plain.h = 0;
     solve_velocities(rows, bodies, poses, plain);
-    kept_targets_.resize(nodes_.size());
-    for (std::size_t k = 0; k < nodes_.size(); ++k)
-      if (nodes_[k].is_joint)
-        kept_targets_[k] = velocity_targets(rows[nodes_[k].index], bodies, poses, target);
+    kept_targets_.resize(joints_.size());
+    for (std::size_t k = 0; k < joints_.size(); ++k)
+      kept_targets_[k] = velocity_targets(rows[joints_[k].row], bodies, poses, target);
     take_second_targets(rows, bodies, poses, target, rates_of);
     targets_taken_ = true;
   }
-  solve(bodies, true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
+  set_velocity_base(bodies);
+  solve(true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
   // A degenerate joint (its rows dependent) leaves a pivot without an inverse: nothing is
   // applied, and the Gauss-Seidel position passes and next sweeps carry on.
   if (!solution_finite()) return 0;
   double change = 0;
-  for (std::size_t k = 0; k < nodes_.size(); ++k) {
-    const Node& node = nodes_[k];
-    if (node.is_joint) {
-      add_equation_impulses(rows[node.index], equations_[k], -node.rhs);
-      continue;
-    }
-    SolverBody& body = bodies[node.index];
-    const Vec3 v = node.rhs.head<3>(), w = node.rhs.tail<3>();
+  for (std::size_t k = 0; k < joints_.size(); ++k)
+    add_equation_impulses(rows[joints_[k].row], equations_[k], -joints_[k].rhs);
+  for (const TreeBody& tree_body : tree_bodies_) {
+    SolverBody& body = bodies[tree_body.index];
+    const Vec3 v = tree_body.result.head<3>(), w = tree_body.result.tail<3>();
     change = std::max(
         {change, (v - body.v).lpNorm<Eigen::Infinity>(), (w - body.w).lpNorm<Eigen::Infinity>()});
     body.v = v;
@@ -459,9 +625,8 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   // excess taken back from the bodies) and it goes on as a Gauss-Seidel row, the others solved
   // again without it.
   bool saturated = false;
-  for (std::size_t k = 0; k < nodes_.size(); ++k) {
-    if (!nodes_[k].is_joint) continue;
-    JointRow& row = rows[nodes_[k].index];
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    JointRow& row = rows[joints_[k].row];
     if (!motor_row(row, equations_[k])) continue;
     const double most = row.joint.motor.max_force * target.substep;
     const double held = std::clamp(row.joint.motor_impulse, -most, most);
@@ -488,27 +653,27 @@ template <class Rates>
 void JointTree::take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                                     std::span<const Pose> poses, const JointTarget& target,
                                     Rates rates_of) {
-  const std::size_t n = nodes_.size();
-  held_velocities_.resize(n);
-  second_targets_.resize(n);
-  solve(bodies, true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
-  for (std::size_t k = 0; k < n; ++k) {
-    if (nodes_[k].is_joint || !nodes_[k].rhs.allFinite()) continue;
-    SolverBody& body = bodies[nodes_[k].index];
+  const std::size_t joints = joints_.size(), tree_bodies = tree_bodies_.size();
+  held_velocities_.resize(tree_bodies);
+  second_targets_.resize(joints);
+  set_velocity_base(bodies);
+  solve(true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
+  for (std::size_t k = 0; k < tree_bodies; ++k) {
+    if (!tree_bodies_[k].result.allFinite()) continue;
+    SolverBody& body = bodies[tree_bodies_[k].index];
     held_velocities_[k] << body.v, body.w;
-    body.v = nodes_[k].rhs.head<3>();
-    body.w = nodes_[k].rhs.tail<3>();
+    body.v = tree_bodies_[k].result.head<3>();
+    body.w = tree_bodies_[k].result.tail<3>();
   }
   double first = 0, change = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!nodes_[k].is_joint) continue;
-    second_targets_[k] = velocity_targets(rows[nodes_[k].index], bodies, poses, target);
+  for (std::size_t k = 0; k < joints; ++k) {
+    second_targets_[k] = velocity_targets(rows[joints_[k].row], bodies, poses, target);
     first = std::max(first, kept_targets_[k].lpNorm<Eigen::Infinity>());
     change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
   }
-  for (std::size_t k = 0; k < n; ++k) {
-    if (nodes_[k].is_joint || !nodes_[k].rhs.allFinite()) continue;
-    SolverBody& body = bodies[nodes_[k].index];
+  for (std::size_t k = 0; k < tree_bodies; ++k) {
+    if (!tree_bodies_[k].result.allFinite()) continue;
+    SolverBody& body = bodies[tree_bodies_[k].index];
     body.v = held_velocities_[k].head<3>();
     body.w = held_velocities_[k].tail<3>();
   }
@@ -517,7 +682,7 @@ void JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
 
 void JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                                 std::span<Pose> poses, bool refactor, double velocity_substep) {
-  if (nodes_.empty()) return;
+  if (joints_.empty()) return;
   // A move came before: the next sweeps take their targets afresh, and factor again unless this
   // pass or one before it since the move factored for them.
   targets_taken_ = false;
@@ -529,46 +694,56 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
                                 !set_geometric_stiffness(rows, bodies, poses, velocity_substep);
     velocities_factored_ = for_velocities;
     if (for_velocities) stiffened_ = false;
-    factor(rows, bodies, false,
-           [&](std::size_t k) { return position_equations(rows[nodes_[k].index], bodies, poses); });
-    solve(bodies, false, [&](std::size_t k) { return equations_[k].target; });
+    factor(bodies, false,
+           [&](std::size_t k) { return position_equations(rows[joints_[k].row], bodies, poses); });
+    solve(false, [&](std::size_t k) { return equations_[k].target; });
   } else {
-    solve(bodies, false,
-          [&](std::size_t k) { return position_targets(rows[nodes_[k].index], bodies, poses); });
+    solve(false,
+          [&](std::size_t k) { return position_targets(rows[joints_[k].row], bodies, poses); });
   }
   if (!solution_finite()) return;
-  for (const Node& node : nodes_)
-    if (!node.is_joint)
-      joint_detail::move_body(&bodies[node.index], &poses[node.index], node.rhs.head<3>(),
-                              node.rhs.tail<3>());
+  for (const TreeBody& body : tree_bodies_)
+    joint_detail::move_body(&bodies[body.index], &poses[body.index], body.result.head<3>(),
+                            body.result.tail<3>());
 }
 
 bool JointTree::solution_finite() const {
-  for (const Node& node : nodes_)
-    if (!node.rhs.allFinite()) return false;
+  for (const TreeJoint& joint : joints_)
+    if (!joint.rhs.allFinite()) return false;
+  for (const TreeBody& body : tree_bodies_)
+    if (!body.result.allFinite()) return false;
   return true;
 }
 
 bool JointTree::respond(std::span<const BodyImpulse> impulses) {
-  for (Node& node : nodes_)
-    node.rhs.setZero();
-  for (const BodyImpulse& push : impulses)
-    nodes_[node_of_body_[push.body]].rhs += push.impulse;
-  substitute();
+  for (TreeBody& body : tree_bodies_)
+    body.base.setZero();
+  for (const BodyImpulse& push : impulses) {
+    TreeBody& body = tree_bodies_[node_of_body_[push.body]];
+    body.base.head<3>() += push.impulse.head<3>();
+    body.base.tail<3>() += push.impulse.tail<3>();
+  }
+  // The impulses as the bodies' velocity change, with the masses of the last factoring.
+  for (TreeBody& body : tree_bodies_) {
+    if (body.base.isZero()) continue;
+    const Vec3 linear = body.base.head<3>(), angular = body.base.tail<3>();
+    body.base.head<3>() =
+        body.stiff ? Vec3(body.linear_inverse * linear) : Vec3(body.inverse_mass * linear);
+    body.base.tail<3>() = body.angular_inverse * angular;
+  }
+  solve(true, [](std::size_t) { return Vec6(Vec6::Zero()); });
   return solution_finite();
 }
 
 void JointTree::apply_response(std::span<JointRow> rows, std::span<SolverBody> bodies,
                                bool pseudo) const {
-  for (std::size_t k = 0; k < nodes_.size(); ++k) {
-    const Node& node = nodes_[k];
-    if (node.is_joint) {
-      if (!pseudo) add_equation_impulses(rows[node.index], equations_[k], -node.rhs);
-      continue;
-    }
-    SolverBody& body = bodies[node.index];
-    (pseudo ? body.push_v : body.v) += node.rhs.head<3>();
-    (pseudo ? body.push_w : body.w) += node.rhs.tail<3>();
+  if (!pseudo)
+    for (std::size_t k = 0; k < joints_.size(); ++k)
+      add_equation_impulses(rows[joints_[k].row], equations_[k], -joints_[k].rhs);
+  for (const TreeBody& tree_body : tree_bodies_) {
+    SolverBody& body = bodies[tree_body.index];
+    (pseudo ? body.push_v : body.v) += tree_body.result.head<3>();
+    (pseudo ? body.push_w : body.w) += tree_body.result.tail<3>();
   }
 }
 

@@ -5,11 +5,14 @@
 // solved directly, with the joints' geometric stiffness (joint_tree.cc), it holds whatever the
 // masses.
 //
-// The system is the block matrix [M J^T; J 0] over the jointed moving bodies and the joints, a
-// tree (a forest) when the joints close no loop: each body and each joint a node, a joint joined
-// to its moving bodies. Eliminating every node after its children fills nothing in. Statics and
-// the world are no nodes: their velocity is fixed. Limits, motors and springs stay Gauss-Seidel
-// rows swept before it.
+// Baraff's system [M J^T; J 0] over the moving bodies and the joints is a tree (a forest) when
+// the joints close no loop. It is solved here in the joints' impulses alone: J W J^T lambda = b
+// (W the bodies' inverse masses, known in closed form). Two joints meet in that matrix only where
+// they share a body, so the joints of one body form a clique, and the cliques a tree; eliminating
+// each joint after the joints below it (its children's) fills nothing in. The blocks are the
+// joints' rows (3 for a ball or distance joint, up to 6), not the bodies' 6 x 6 masses: a chain
+// of ball joints is block tridiagonal in 3 x 3 blocks. Statics and the world are no bodies of
+// it: their velocity is fixed. Limits, motors and springs stay Gauss-Seidel rows swept before it.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,8 +28,8 @@ namespace tumble {
 class JointTree {
  public:
   // The forest of the island's joints (indices into `rows`); false when the joints close a loop
-  // (the island keeps Gauss-Seidel). `body_count`: the step's solver bodies. Keeps its memory
-  // from one island to the next.
+  // or a body holds more than 32 of them (JointTree::Hub; the island keeps Gauss-Seidel).
+  // `body_count`: the step's solver bodies. Keeps its memory from one island to the next.
   bool build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
              std::span<const SolverBody> bodies, std::size_t body_count);
 
@@ -66,7 +69,7 @@ class JointTree {
   bool respond(std::span<const BodyImpulse> impulses);
   // After respond: a body's velocity change (linear, angular);
   Eigen::Matrix<double, 6, 1> change_of(std::uint32_t body) const {
-    return nodes_[node_of_body_[body]].rhs;
+    return tree_bodies_[node_of_body_[body]].result;
   }
   // and the response given to the bodies (as velocities, or as the push-out's pseudo-velocities)
   // with, for velocities, the joints' impulses added to their rows.
@@ -76,47 +79,86 @@ class JointTree {
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   static constexpr std::uint32_t kNone = UINT32_MAX;
+  static constexpr std::uint32_t kMostHubJoints = 32;
 
-  // A body (its solver index) or a joint (its index into the rows).
+  // The forest as built: a body (its solver index) or a joint (its index into the rows), each
+  // joint joined to its moving bodies, children before their parents.
   struct Node {
     bool is_joint = false;
     std::uint32_t index = 0;
     std::uint32_t parent = kNone;  // a node
-    // The block of this node's rows and the parent's columns (a joint's Jacobian on its parent
-    // body, or a body's Jacobian columns of its parent joint, transposed).
-    Mat6 to_parent = Mat6::Zero();
-    Mat6 pivot = Mat6::Zero();  // the node's diagonal block once its children are eliminated
-    Mat6 reach = Mat6::Zero();  // pivot^-1 to_parent, once factored
-    Vec6 rhs = Vec6::Zero();
-    // The edge to the parent carries three rows or fewer (a ball or distance joint's): the
-    // joint's pivot is then its 3x3 corner and -1s, and the blocks' last three rows (a joint's)
-    // or columns (a body's) are zero, so the products take their first three alone.
-    bool narrow = false;
-    Mat3 inertia = Mat3::Zero();  // a body's, world axes (fixed for the step, as its inverse)
-    // A body's share of its joints' geometric stiffness, times h^2 (linear, angular), added to
-    // its mass in the velocity solve.
+  };
+  // A moving body of the forest.
+  struct TreeBody {
+    std::uint32_t index = 0;      // solver index
+    Mat3 inertia = Mat3::Zero();  // world axes (fixed for the step, as its inverse)
+    // Its share of its joints' geometric stiffness, times h^2 (linear, angular), added to its
+    // mass in the velocity solve.
     Mat3 linear_stiffness = Mat3::Zero(), angular_stiffness = Mat3::Zero();
     Vec3 longest_lever = Vec3::Zero();  // from the body's centre to its farthest joint anchor
+    // The inverse of the mass the last factoring used (with stiffness: `stiff`; else the
+    // body's inverse mass and inertia).
+    bool stiff = false;
+    double inverse_mass = 0;
+    Mat3 linear_inverse = Mat3::Zero(), angular_inverse = Mat3::Zero();
+    Vec6 base = Vec6::Zero();    // the velocity (or move) before the joints act
+    Vec6 result = Vec6::Zero();  // and after
   };
+  // A joint of the forest, in elimination order (children before parents). Its rows are padded
+  // to a width of 3 or 6 (a padded row: 1 on the diagonal, 0 elsewhere), so that every block
+  // has a fixed size.
+  struct TreeJoint {
+    std::uint32_t row = 0;                         // index into the rows
+    std::uint32_t body_a = kNone, body_b = kNone;  // tree bodies; kNone: static or the world
+    int width = 3;
+    // Where its later neighbours are: the hub of its parent body, and its place there (kNone:
+    // it has none).
+    std::uint32_t hub = kNone, place = 0;
+    Mat6 pivot = Mat6::Zero();  // J W J^T over both bodies, less its children's; then inverted
+    // W J^T on each body: a unit of each row's impulse as the body's velocity change.
+    Mat6 response_a = Mat6::Zero(), response_b = Mat6::Zero();
+    Vec6 rhs = Vec6::Zero();  // the right side, then the rows' impulses
+  };
+  // A moving body's joints (its children's joints in elimination order, then its parent joint):
+  // every two of them share the body, so their block of J W J^T is not zero. Eliminating one
+  // changes only the blocks among the others of the same hub: no fill (the joint graph of a tree
+  // is a tree of such cliques).
+  struct Hub {
+    std::uint32_t body = 0;  // tree body
+    std::uint32_t first_member = 0, members = 0, first_pair = 0;
+  };
+  // The block of J W J^T between two joints of a hub (rows of the earlier), and once factored
+  // its `reach`: the earlier's inverse pivot times the block.
+  struct HubPair {
+    Mat6 block = Mat6::Zero();
+    Mat6 reach = Mat6::Zero();
+  };
+  std::uint32_t pair_index(const Hub& hub, std::uint32_t i, std::uint32_t j) const {
+    return hub.first_pair + i * (2 * hub.members - i - 1) / 2 + (j - i - 1);
+  }
+  const Mat6& jacobian(std::size_t k, bool side_b) const {
+    return side_b ? equations_[k].on_b : equations_[k].on_a;
+  }
 
-  // Fills the joints' rows (equations(k) for joint node k) and the bodies' masses (with their
-  // stiffness for velocities) and eliminates the children into their parents.
+  // Fills the joints' rows (equations(k) for joint k) and the bodies' inverse masses (with their
+  // stiffness for velocities), forms J W J^T and factors it.
   template <class Equations>
-  void factor(std::span<const JointRow> rows, std::span<const SolverBody> bodies, bool velocities,
-              Equations equations);
-  // With the factors: the right side (a body's M v for velocities, else 0; a joint's rows'
-  // targets(k)) solved, the solution per node in rhs.
+  void factor(std::span<const SolverBody> bodies, bool velocities, Equations equations);
+  // With the factors: the joints' impulses that bring each joint's rows from the bodies' base
+  // velocities (or 0) to targets(k), and the bodies' results.
   template <class Targets>
-  void solve(std::span<const SolverBody> bodies, bool velocities, Targets targets);
-  // The elimination's forward and back passes over the right side in the nodes' rhs.
+  void solve(bool from_base, Targets targets);
+  // The elimination's forward and back passes over the joints' rhs.
   void substitute();
   bool solution_finite() const;
+  // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
+  void set_velocity_base(std::span<const SolverBody> bodies);
   // SHAKE's second iterate of the curvature targets in kept_targets_, where it converges
   // (solve_velocities); the bodies' velocities are left as they were.
   template <class Rates>
   void take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                            std::span<const Pose> poses, const JointTarget& target, Rates rates_of);
-  // Sets each body's stiffness (Node) for a substep of h (joint_tree.cc: why and how much);
+  // Sets each body's stiffness (TreeBody) for a substep of h (joint_tree.cc: why and how much);
   // whether any body has some.
   bool set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                                std::span<const Pose> poses, double h);
@@ -128,16 +170,26 @@ class JointTree {
     std::uint8_t flags;
     bool operator==(const JointEnds&) const = default;
   };
+  // The forest's joints, bodies and hubs from the ordered nodes; false where a hub holds more
+  // than kMostHubJoints (its blocks grow with the square of its joints, its elimination with the
+  // cube: a body holding a thousand joints would need half a million blocks).
+  bool number_forest(std::span<const JointRow> rows, std::span<const SolverBody> bodies);
   // The step's refresh of a forest built (or kept): inertias, motors, factors forgotten.
   void finish_build(std::span<const JointRow> rows, std::span<const SolverBody> bodies);
 
-  std::vector<JointEnds> shape_, built_shape_;  // this build's, and the forest's in nodes_
+  std::vector<JointEnds> shape_, built_shape_;  // this build's, and the forest's
   bool built_ = false;
   std::vector<Node> nodes_;                  // children before their parents
   std::vector<Node> reordered_;              // the build's renumbering (kept: no allocation)
-  std::vector<std::uint32_t> node_of_body_;  // by solver index: kNone if none
+  std::vector<TreeJoint> joints_;            // elimination order
+  std::vector<TreeBody> tree_bodies_;
+  std::vector<Hub> hubs_;
+  std::vector<std::uint32_t> hub_members_;   // joints
+  std::vector<std::uint8_t> member_side_b_;  // whether the hub's body is the member's b
+  std::vector<HubPair> pairs_;
+  std::vector<std::uint32_t> node_of_body_;  // by solver index: its tree body, kNone if none
   std::vector<std::uint32_t> bodies_used_;   // solver indices whose node_of_body_ is set
-  std::vector<JointEquations> equations_;    // by node, for joints
+  std::vector<JointEquations> equations_;    // by joint
   // A substep's targets for its sweeps before the move (solve_velocities).
   std::vector<Eigen::Matrix<double, 6, 1>> kept_targets_;
   // The targets of SHAKE's second iterate, and the bodies' velocities it starts from.
@@ -148,6 +200,7 @@ class JointTree {
   bool targets_taken_ = false;  // since the last move
   // For building: each node's neighbours and the visit.
   std::vector<std::uint32_t> first_edge_, next_edge_, edge_to_, pending_, parent_of_, order_;
+  std::vector<std::uint32_t> numbered_, child_count_;
   std::vector<std::uint8_t> visited_;
 };
 
