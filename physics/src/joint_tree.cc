@@ -595,6 +595,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     if (motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
     return rates;
   };
+  bool solved = false;
   if (target.h > 0 && !targets_taken_) {
     JointTarget plain = target;
     plain.h = 0;
@@ -602,11 +603,15 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     kept_targets_.resize(joints_.size());
     for (std::size_t k = 0; k < joints_.size(); ++k)
       kept_targets_[k] = velocity_targets(rows[joints_[k].row], bodies, poses, target);
-    take_second_targets(rows, bodies, poses, target, rates_of);
+    // Where the second iterate is not taken, its solve (from the same velocities, to the same
+    // targets) is this sweep's.
+    solved = !take_second_targets(rows, bodies, poses, target, rates_of);
     targets_taken_ = true;
   }
-  set_velocity_base(bodies);
-  solve(true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
+  if (!solved) {
+    set_velocity_base(bodies);
+    solve(true, [&](std::size_t k) { return rates_of(k, kept_targets_); });
+  }
   // A degenerate joint (its rows dependent) leaves a pivot without an inverse: nothing is
   // applied, and the Gauss-Seidel position passes and next sweeps carry on.
   if (!solution_finite()) return 0;
@@ -650,7 +655,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
 }
 
 template <class Rates>
-void JointTree::take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
+bool JointTree::take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                                     std::span<const Pose> poses, const JointTarget& target,
                                     Rates rates_of) {
   const std::size_t joints = joints_.size(), tree_bodies = tree_bodies_.size();
@@ -677,7 +682,9 @@ void JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
     body.v = held_velocities_[k].head<3>();
     body.w = held_velocities_[k].tail<3>();
   }
-  if (change <= kConvergedTakes * first) kept_targets_.swap(second_targets_);
+  if (!(change <= kConvergedTakes * first)) return false;
+  kept_targets_.swap(second_targets_);
+  return true;
 }
 
 void JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
@@ -708,11 +715,13 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
 }
 
 bool JointTree::solution_finite() const {
+  // One sum: an infinity or NaN anywhere leaves it non-finite (inf - inf is NaN).
+  double sum = 0;
   for (const TreeJoint& joint : joints_)
-    if (!joint.rhs.allFinite()) return false;
+    sum += joint.rhs.sum();
   for (const TreeBody& body : tree_bodies_)
-    if (!body.result.allFinite()) return false;
-  return true;
+    sum += body.result.sum();
+  return std::isfinite(sum);
 }
 
 bool JointTree::respond(std::span<const BodyImpulse> impulses) {

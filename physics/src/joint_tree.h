@@ -154,9 +154,10 @@ class JointTree {
   // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
   void set_velocity_base(std::span<const SolverBody> bodies);
   // SHAKE's second iterate of the curvature targets in kept_targets_, where it converges
-  // (solve_velocities); the bodies' velocities are left as they were.
+  // (solve_velocities); the bodies' velocities are left as they were. Whether it was taken (if
+  // not, the solution of the kept targets is left in the joints' and bodies' results).
   template <class Rates>
-  void take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
+  bool take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                            std::span<const Pose> poses, const JointTarget& target, Rates rates_of);
   // Sets each body's stiffness (TreeBody) for a substep of h (joint_tree.cc: why and how much);
   // whether any body has some.
