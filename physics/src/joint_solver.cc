@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <type_traits>
 
 #include "joint_axial.h"
 #include "joint_geometry.h"
@@ -18,6 +19,10 @@ using namespace joint_detail;
 // and its exact turn, as the move makes them.
 Vec3 anchor_move(const SolverBody& body, const Vec3& r, double h) {
   return h * body.v + (rotation_quaternion(h * body.w) * r - r);
+}
+// The same with the body's turn over the move, rotation_quaternion(h w), known.
+Vec3 anchor_move(const SolverBody& body, const Quat& turn, const Vec3& r, double h) {
+  return h * body.v + (turn * r - r);
 }
 
 // A velocity for a drift over h, at most `most` long (0 without a move ahead).
@@ -395,12 +400,29 @@ void set_rotation_rows(JointEquations& e, int first) {
   e.on_b.block<3, 3>(first, 3) = Mat3::Identity();
 }
 
-// Both: the rows at the present poses (kRows; else the targets alone); `velocities` asks for the
-// targets of a sweep (else the targets are minus the errors).
-template <bool kRows>
-JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bodies,
-                            std::span<const Pose> poses, const JointTarget* velocities) {
-  JointEquations e;
+void clear_equations(JointEquations* e) {
+  e->rows = 0;
+  e->on_a.setZero();
+  e->on_b.setZero();
+  e->target.setZero();
+}
+
+// What equations_of fills without the rows: their count and targets.
+struct JointTargets {
+  int rows = 0;
+  JointEquations::Vector target = JointEquations::Vector::Zero();
+};
+
+// Both: the rows at the present poses (into a JointEquations, whose rows must be zero; else the
+// targets alone); `velocities` asks for the targets of a sweep (else the targets are minus the
+// errors), with each body's turn over the move (rotation_quaternion(h w)) in `turns` by solver
+// index where given.
+template <class Out>
+void equations_of(Out& e, const JointRow& row, std::span<const SolverBody> bodies,
+                  std::span<const Pose> poses, const JointTarget* velocities,
+                  const Quat* turns = nullptr) {
+  constexpr bool kRows = std::is_same_v<Out, JointEquations>;
+  JointEquations::Vector& target = e.target;
   const Joint& joint = row.joint;
   const bool world_b = row.b == kWorldAnchor;
   const SolverBody& a = bodies[row.a];
@@ -411,48 +433,58 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
   const double h = velocities != nullptr ? velocities->h : 0;
   const double most = velocities != nullptr ? velocities->most_speed : 0;
   const Vec3 rate = (b.v + b.w.cross(anchors.rb)) - (a.v + a.w.cross(anchors.ra));
+  auto turn_of_a = [&] { return turns != nullptr ? turns[row.a] : rotation_quaternion(h * a.w); };
+  auto turn_of_b = [&] {
+    return turns != nullptr && !world_b ? turns[row.b] : rotation_quaternion(h * b.w);
+  };
+  auto move_of_a = [&](const Vec3& r) {
+    return turns != nullptr ? anchor_move(a, turns[row.a], r, h) : anchor_move(a, r, h);
+  };
+  auto move_of_b = [&](const Vec3& r) {
+    return turns != nullptr && !world_b ? anchor_move(b, turns[row.b], r, h) : anchor_move(b, r, h);
+  };
   auto point_target = [&] {
     if (velocities == nullptr) return Vec3(anchors.pa - anchors.pb);
     if (!(h > 0)) return Vec3(Vec3::Zero());
-    const Vec3 drift = anchor_move(b, anchors.rb, h) - anchor_move(a, anchors.ra, h) - h * rate;
+    const Vec3 drift = move_of_b(anchors.rb) - move_of_a(anchors.ra) - h * rate;
     return Vec3(-drift_velocity(drift, h, most));
   };
   switch (joint.kind) {
     case JointKind::kBall:
       e.rows = 3;
       if constexpr (kRows) set_point_rows(e, 0, anchors);
-      e.target.head<3>() = point_target();
+      target.head<3>() = point_target();
       break;
     case JointKind::kFixed: {
       e.rows = 6;
       if constexpr (kRows) set_point_rows(e, 0, anchors);
-      e.target.head<3>() = point_target();
+      target.head<3>() = point_target();
       if constexpr (kRows) set_rotation_rows(e, 3);
       if (velocities == nullptr)
-        e.target.tail<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
+        target.tail<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
       break;
     }
     case JointKind::kHinge: {
       e.rows = 5;
       if constexpr (kRows) set_point_rows(e, 0, anchors);
-      e.target.head<3>() = point_target();
+      target.head<3>() = point_target();
       const HingeRows hinge = hinge_rows(joint, pose_a.orientation,
                                          world_b ? nullptr : &pose_b.orientation, Mat3::Zero());
       if constexpr (kRows) set_row(e, 3, {Vec3::Zero(), -hinge.g1, hinge.g1});
       if constexpr (kRows) set_row(e, 4, {Vec3::Zero(), -hinge.g2, hinge.g2});
       if (velocities == nullptr) {
-        e.target.segment<2>(3) = -hinge.error();
+        target.segment<2>(3) = -hinge.error();
       } else if (h > 0) {
         // The turns' curvature over the move beyond the velocities' first order.
         const Vec3 relative_w = b.w - a.w;
-        const Quat turn_a = rotation_quaternion(h * a.w), turn_b = rotation_quaternion(h * b.w);
+        const Quat turn_a = turn_of_a(), turn_b = turn_of_b();
         const Vec3 a_next = turn_a * hinge.axis_a;
         const Vec3 drift(a_next.dot(turn_b * hinge.b2) - hinge.axis_a.dot(hinge.b2) -
                              h * relative_w.dot(hinge.g1),
                          a_next.dot(turn_b * hinge.c2) - hinge.axis_a.dot(hinge.c2) -
                              h * relative_w.dot(hinge.g2),
                          0);
-        e.target.segment<2>(3) = -drift_velocity(drift, h, most).head<2>();
+        target.segment<2>(3) = -drift_velocity(drift, h, most).head<2>();
       }
       break;
     }
@@ -463,8 +495,8 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
       if constexpr (kRows) set_row(e, 3, across.rows[0]);
       if constexpr (kRows) set_row(e, 4, across.rows[1]);
       if (velocities == nullptr) {
-        e.target.head<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
-        e.target.segment<2>(3) = -across.error;
+        target.head<3>() = -rotation_error(joint, pose_a.orientation, pose_b.orientation);
+        target.segment<2>(3) = -across.error;
       }
       break;
     }
@@ -477,39 +509,40 @@ JointEquations equations_of(const JointRow& row, std::span<const SolverBody> bod
       e.rows = 1;
       if constexpr (kRows) set_row(e, 0, {n, -anchors.ra.cross(n), anchors.rb.cross(n)});
       if (velocities == nullptr) {
-        e.target[0] = joint.length - length;
+        target[0] = joint.length - length;
       } else if (h > 0) {
-        const Vec3 d_next = d + anchor_move(b, anchors.rb, h) - anchor_move(a, anchors.ra, h);
-        e.target[0] = -drift_velocity(d_next.norm() - length - h * n.dot(rate), h, most);
+        const Vec3 d_next = d + move_of_b(anchors.rb) - move_of_a(anchors.ra);
+        target[0] = -drift_velocity(d_next.norm() - length - h * n.dot(rate), h, most);
       }
       break;
     }
   }
-  return e;
 }
 
 }  // namespace
 
-JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
-                                  std::span<const Pose> poses, const JointTarget& target) {
-  JointEquations e = equations_of<true>(row, bodies, poses, &target);
-  if (row.motor_in_tree && e.rows == 5) {
+void velocity_equations(JointEquations* e, const JointRow& row, std::span<const SolverBody> bodies,
+                        std::span<const Pose> poses, const JointTarget& target) {
+  clear_equations(e);
+  equations_of(*e, row, bodies, poses, &target);
+  if (row.motor_in_tree && e->rows == 5) {
     // The motor's row: the free coordinate's rate is its speed.
     const bool world_b = row.b == kWorldAnchor;
     const FreeCoordinate c =
         free_coordinate(row.joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b);
     if (c.exists) {
-      set_row(e, 5, c.row);
-      e.target[5] = row.joint.motor.speed;
-      e.rows = 6;
+      set_row(*e, 5, c.row);
+      e->target[5] = row.joint.motor.speed;
+      e->rows = 6;
     }
   }
-  return e;
 }
 
 JointEquations::Vector velocity_targets(const JointRow& row, std::span<const SolverBody> bodies,
-                                        std::span<const Pose> poses, const JointTarget& target) {
-  JointEquations e = equations_of<false>(row, bodies, poses, &target);
+                                        std::span<const Pose> poses, const JointTarget& target,
+                                        const Quat* turns) {
+  JointTargets e;
+  equations_of(e, row, bodies, poses, &target, turns);
   if (row.motor_in_tree && e.rows == 5) {
     const bool world_b = row.b == kWorldAnchor;
     if (free_coordinate(row.joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b).exists)
@@ -523,14 +556,17 @@ bool motor_row(const JointRow& row, const JointEquations& equations) {
          (row.joint.kind == JointKind::kHinge || row.joint.kind == JointKind::kSlider);
 }
 
-JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
-                                  std::span<const Pose> poses) {
-  return equations_of<true>(row, bodies, poses, nullptr);
+void position_equations(JointEquations* e, const JointRow& row, std::span<const SolverBody> bodies,
+                        std::span<const Pose> poses) {
+  clear_equations(e);
+  equations_of(*e, row, bodies, poses, nullptr);
 }
 
 JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,
                                         std::span<const Pose> poses) {
-  return equations_of<false>(row, bodies, poses, nullptr).target;
+  JointTargets e;
+  equations_of(e, row, bodies, poses, nullptr);
+  return e.target;
 }
 
 void add_equation_impulses(JointRow& row, const JointEquations& equations,

@@ -62,17 +62,21 @@ struct JointEquations {
   Eigen::Matrix<double, 6, 1> target = Eigen::Matrix<double, 6, 1>::Zero();
 };
 // For velocities, with the sweep's target (a move ahead: the rates that end it on the joint).
-JointEquations velocity_equations(const JointRow& row, std::span<const SolverBody> bodies,
-                                  std::span<const Pose> poses, const JointTarget& target);
-// Their targets alone (what velocity_equations(...).target is), without building the rows.
+void velocity_equations(JointEquations* equations, const JointRow& row,
+                        std::span<const SolverBody> bodies, std::span<const Pose> poses,
+                        const JointTarget& target);
+// Their targets alone (velocity_equations' target), without building the rows; `turns`, where
+// given, each body's rotation_quaternion(target.h w) by solver index (the same answer, without
+// a sine and cosine a joint end).
 JointEquations::Vector velocity_targets(const JointRow& row, std::span<const SolverBody> bodies,
-                                        std::span<const Pose> poses, const JointTarget& target);
+                                        std::span<const Pose> poses, const JointTarget& target,
+                                        const Quat* turns = nullptr);
 // Whether the equations' last row is the joint's motor (JointRow::motor_in_tree).
 bool motor_row(const JointRow& row, const JointEquations& equations);
 // For positions: target = minus the error.
-JointEquations position_equations(const JointRow& row, std::span<const SolverBody> bodies,
-                                  std::span<const Pose> poses);
-// Their targets alone (position_equations(...).target).
+void position_equations(JointEquations* equations, const JointRow& row,
+                        std::span<const SolverBody> bodies, std::span<const Pose> poses);
+// Their targets alone (position_equations' target).
 JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,
                                         std::span<const Pose> poses);
 // Adds the equations' impulses (one per row, on b; a takes the opposite) to the joint's warm

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "joint_geometry.h"
+#include "rotation.h"
 
 namespace tumble {
 namespace {
@@ -396,7 +397,7 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
   // Each joint's rows, its response on each body (W J^T) and its diagonal block J W J^T.
   for (std::size_t k = 0; k < joints_.size(); ++k) {
     TreeJoint& joint = joints_[k];
-    equations_[k] = equations(k);
+    equations(k, &equations_[k]);
     joint.width = equations_[k].rows <= 3 ? 3 : 6;
     with_width(joint.width, [&]<int W>() {
       Eigen::Matrix<double, W, W> pivot = Eigen::Matrix<double, W, W>::Zero();
@@ -570,10 +571,10 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   // The poses stay put between moves: one factoring serves every sweep until the next.
   if (!velocities_factored_) {
     stiffened_ = set_geometric_stiffness(rows, bodies, poses, target.substep);
-    factor(bodies, true, [&](std::size_t k) {
+    factor(bodies, true, [&](std::size_t k, JointEquations* equations) {
       JointTarget plain = target;
       plain.h = 0;
-      return velocity_equations(rows[joints_[k].row], bodies, poses, plain);
+      velocity_equations(equations, rows[joints_[k].row], bodies, poses, plain);
     });
     velocities_factored_ = true;
   }
@@ -601,8 +602,10 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     plain.h = 0;
     solve_velocities(rows, bodies, poses, plain);
     kept_targets_.resize(joints_.size());
+    set_turns(rows, bodies, target.h);
     for (std::size_t k = 0; k < joints_.size(); ++k)
-      kept_targets_[k] = velocity_targets(rows[joints_[k].row], bodies, poses, target);
+      kept_targets_[k] =
+          velocity_targets(rows[joints_[k].row], bodies, poses, target, turns_.data());
     // Where the second iterate is not taken, its solve (from the same velocities, to the same
     // targets) is this sweep's.
     solved = !take_second_targets(rows, bodies, poses, target, rates_of);
@@ -670,9 +673,11 @@ bool JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
     body.v = tree_bodies_[k].result.head<3>();
     body.w = tree_bodies_[k].result.tail<3>();
   }
+  set_turns(rows, bodies, target.h);
   double first = 0, change = 0;
   for (std::size_t k = 0; k < joints; ++k) {
-    second_targets_[k] = velocity_targets(rows[joints_[k].row], bodies, poses, target);
+    second_targets_[k] =
+        velocity_targets(rows[joints_[k].row], bodies, poses, target, turns_.data());
     first = std::max(first, kept_targets_[k].lpNorm<Eigen::Infinity>());
     change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
   }
@@ -701,8 +706,9 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
                                 !set_geometric_stiffness(rows, bodies, poses, velocity_substep);
     velocities_factored_ = for_velocities;
     if (for_velocities) stiffened_ = false;
-    factor(bodies, false,
-           [&](std::size_t k) { return position_equations(rows[joints_[k].row], bodies, poses); });
+    factor(bodies, false, [&](std::size_t k, JointEquations* equations) {
+      position_equations(equations, rows[joints_[k].row], bodies, poses);
+    });
     solve(false, [&](std::size_t k) { return equations_[k].target; });
   } else {
     solve(false,
@@ -712,6 +718,20 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
   for (const TreeBody& body : tree_bodies_)
     joint_detail::move_body(&bodies[body.index], &poses[body.index], body.result.head<3>(),
                             body.result.tail<3>());
+}
+
+void JointTree::set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
+                          double h) {
+  // Every joint's bodies: the tree's turn with their velocities; a static body or the world
+  // (kWorldAnchor: none stored) not at all.
+  if (turns_.size() < node_of_body_.size()) turns_.resize(node_of_body_.size());
+  for (const TreeJoint& joint : joints_) {
+    const JointRow& row = rows[joint.row];
+    turns_[row.a] = Quat::Identity();
+    if (row.b != kWorldAnchor) turns_[row.b] = Quat::Identity();
+  }
+  for (const TreeBody& body : tree_bodies_)
+    turns_[body.index] = rotation_quaternion(h * bodies[body.index].w);
 }
 
 bool JointTree::solution_finite() const {

@@ -140,8 +140,8 @@ class JointTree {
     return side_b ? equations_[k].on_b : equations_[k].on_a;
   }
 
-  // Fills the joints' rows (equations(k) for joint k) and the bodies' inverse masses (with their
-  // stiffness for velocities), forms J W J^T and factors it.
+  // Fills the joints' rows (equations(k, &row's equations) for joint k) and the bodies' inverse
+  // masses (with their stiffness for velocities), forms J W J^T and factors it.
   template <class Equations>
   void factor(std::span<const SolverBody> bodies, bool velocities, Equations equations);
   // With the factors: the joints' impulses that bring each joint's rows from the bodies' base
@@ -151,6 +151,10 @@ class JointTree {
   // The elimination's forward and back passes over the joints' rhs.
   void substitute();
   bool solution_finite() const;
+  // Each of the joints' bodies' turn over a move of h at its velocity (rotation_quaternion(h w);
+  // identity for a static body) in turns_, by solver index: the targets' arithmetic, once a
+  // body rather than once a joint end.
+  void set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies, double h);
   // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
   void set_velocity_base(std::span<const SolverBody> bodies);
   // SHAKE's second iterate of the curvature targets in kept_targets_, where it converges
@@ -191,6 +195,7 @@ class JointTree {
   std::vector<std::uint32_t> node_of_body_;  // by solver index: its tree body, kNone if none
   std::vector<std::uint32_t> bodies_used_;   // solver indices whose node_of_body_ is set
   std::vector<JointEquations> equations_;    // by joint
+  std::vector<Quat> turns_;                  // set_turns
   // A substep's targets for its sweeps before the move (solve_velocities).
   std::vector<Eigen::Matrix<double, 6, 1>> kept_targets_;
   // The targets of SHAKE's second iterate, and the bodies' velocities it starts from.
