@@ -521,12 +521,14 @@ void JointTree::solve(bool from_base, Targets targets) {
   }
   for (const TreeJoint& joint : joints_) {
     with_width(joint.width, [&]<int W>() {
-      if (joint.body_a != kNone)
-        tree_bodies_[joint.body_a].result.noalias() -=
-            joint.response_a.template leftCols<W>().lazyProduct(joint.rhs.template head<W>());
-      if (joint.body_b != kNone)
-        tree_bodies_[joint.body_b].result.noalias() -=
-            joint.response_b.template leftCols<W>().lazyProduct(joint.rhs.template head<W>());
+      // Column by column: each a 6-vector multiply-add that the compiler keeps in registers.
+      for (const auto& [b, response] : {std::pair{joint.body_a, &joint.response_a},
+                                        std::pair{joint.body_b, &joint.response_b}}) {
+        if (b == kNone) continue;
+        Vec6& result = tree_bodies_[b].result;
+        for (int c = 0; c < W; ++c)
+          result -= response->col(c) * joint.rhs[c];
+      }
     });
   }
 }
