@@ -235,7 +235,7 @@ ChainRun swing_star(int arms) {
 }
 
 // Every joint of a body meets every other in the direct solve (joint_tree.h): a body holding
-// nine joints is solved directly and exactly; one holding more than 32 would cost the square of
+// nine joints is solved directly and exactly; one holding more than 16 would cost the square of
 // its joints in memory and their cube in time, and keeps Gauss-Seidel instead, said in the
 // statistics.
 TEST(Joints, ABodyHoldingManyJointsIsSolvedDirectlyUpToABound) {

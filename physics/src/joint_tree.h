@@ -28,7 +28,7 @@ namespace tumble {
 class JointTree {
  public:
   // The forest of the island's joints (indices into `rows`); false when the joints close a loop
-  // or a body holds more than 32 of them (JointTree::Hub; the island keeps Gauss-Seidel).
+  // or a body holds more than 16 of them (JointTree::Hub; the island keeps Gauss-Seidel).
   // `body_count`: the step's solver bodies. Keeps its memory from one island to the next.
   bool build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
              std::span<const SolverBody> bodies, std::size_t body_count);
@@ -79,7 +79,9 @@ class JointTree {
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   static constexpr std::uint32_t kNone = UINT32_MAX;
-  static constexpr std::uint32_t kMostHubJoints = 32;
+  // Past it a hub's blocks (half its joints squared, 576 bytes each) would outgrow the rest of
+  // the tree's memory several times over, and their elimination grow with the cube.
+  static constexpr std::uint32_t kMostHubJoints = 16;
 
   // The forest as built: a body (its solver index) or a joint (its index into the rows), each
   // joint joined to its moving bodies, children before their parents.
