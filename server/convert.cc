@@ -1,9 +1,11 @@
 #include "convert.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <string_view>
 
 #include "physics/compound.h"
 
@@ -43,7 +45,8 @@ Result<Quat> unit_quat(const v1::Quat& q, const std::string& field) {
 
 Result<ShapeDef> shape_from_proto(const v1::Shape& shape);
 
-Result<ShapeDef> compound_from_proto(const v1::Compound& compound) {
+Result<ShapeDef> compound_from_proto(const v1::Shape& shape) {
+  const v1::Compound& compound = shape.compound();
   // Counted before anything is built: each part costs a shape.
   if (compound.parts().empty())
     return Status::error("shape.compound.parts: a compound needs at least one part");
@@ -80,16 +83,16 @@ Result<ShapeDef> compound_from_proto(const v1::Compound& compound) {
     }
     def.parts.push_back(std::move(part));
   }
-  // The engine checks the rest (offsets, sizes) and names the part.
+  // The engine checks the rest (offsets, sizes, a flat hull) and names the part in its terms.
   if (Result<Shape> built = Shape::create(def); !built)
-    return built.status().within("shape.compound.");
+    return in_api_terms(built.status().within("shape."), shape);
   return ShapeDef{std::move(def)};
 }
 
 Result<ShapeDef> shape_from_proto(const v1::Shape& shape) {
   switch (shape.kind_case()) {
     case v1::Shape::kCompound:
-      return compound_from_proto(shape.compound());
+      return compound_from_proto(shape);
     case v1::Shape::kBox: {
       const v1::Vec3& size = shape.box().size();
       for (auto [value, axis] : {std::pair{size.x(), "x"}, {size.y(), "y"}, {size.z(), "z"}})
@@ -162,6 +165,46 @@ Result<ShapeDef> shape_def_from_proto(const v1::Shape& shape) {
   return shape_from_proto(shape);
 }
 
+std::string in_api_terms(const std::string& message, const v1::Shape& shape) {
+  const std::string_view prefix = "shape.";
+  if (message.rfind(prefix, 0) != 0) return message;
+  const std::string rest = message.substr(prefix.size());
+  // Where the engine's field has the message's name within its kind (a box's half extents are
+  // not its size: left as the engine names them).
+  switch (shape.kind_case()) {
+    case v1::Shape::kHull:
+      if (rest.rfind("points", 0) == 0) return "shape.hull." + rest;
+      return message;
+    case v1::Shape::kSphere:
+      if (rest.rfind("radius", 0) == 0) return "shape.sphere." + rest;
+      return message;
+    case v1::Shape::kCapsule:
+      if (rest.rfind("radius", 0) == 0 || rest.rfind("half_height", 0) == 0)
+        return "shape.capsule." + rest;
+      return message;
+    default:
+      break;
+  }
+  if (shape.kind_case() != v1::Shape::kCompound || rest.rfind("parts", 0) != 0) return message;
+  // parts[i].shape.…: the part's own shape, in its kind's terms too.
+  const std::size_t close = rest.find(']');
+  int index = -1;
+  if (rest.rfind("parts[", 0) == 0 && close != std::string::npos) {
+    const char* first = rest.data() + 6;
+    const char* last = rest.data() + close;
+    if (std::from_chars(first, last, index).ptr != last) index = -1;
+  }
+  const std::string after = close == std::string::npos ? "" : rest.substr(close + 1);
+  if (index < 0 || index >= shape.compound().parts_size() || after.rfind(".shape.", 0) != 0)
+    return "shape.compound." + rest;
+  return "shape.compound." + rest.substr(0, close + 1) + "." +
+         in_api_terms(after.substr(1), shape.compound().parts(index).shape());
+}
+
+Status in_api_terms(const Status& status, const v1::Shape& shape) {
+  return status ? status : Status::error(in_api_terms(status.message(), shape), status.code());
+}
+
 Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   BodyDef def;
   Result<ShapeDef> shape = shape_from_proto(spec.shape());
@@ -225,7 +268,8 @@ Result<BodyDef> body_from_proto(const v1::BodySpec& spec) {
   if (spec.has_collision_layers()) def.filter.layers = spec.collision_layers();
   if (spec.has_collision_mask()) def.filter.mask = spec.collision_mask();
   if (def.type != BodyType::kDynamic) def.mass = 0;
-  if (Status s = validate(def); !s) return s;  // what only the engine can tell (a flat hull)
+  // What only the engine can tell (a flat hull), named as the message names it.
+  if (Status s = validate(def); !s) return in_api_terms(s, spec.shape());
   return def;
 }
 

@@ -22,6 +22,13 @@ BodyMotion motion_from_proto(const v1::BodyStateUpdate& update,
 
 // A shape as the engine defines it, or why the message is not one ("shape: required ...").
 Result<ShapeDef> shape_def_from_proto(const v1::Shape& shape);
+// An engine refusal of a shape's field in the API's terms: the engine names a hull's points
+// `shape.points` and a compound part `shape.parts[i]`, the API nests each kind in its own message
+// (`shape.hull.points`, `shape.compound.parts[i].shape.hull.points`; a sphere's and a capsule's
+// radius and half height likewise). A box's `shape.half_extents` (the message has its full size)
+// and other messages are left as they are.
+std::string in_api_terms(const std::string& message, const v1::Shape& shape);
+Status in_api_terms(const Status& status, const v1::Shape& shape);
 
 // What a viewer needs to draw the body with wire id `id`.
 v1::BodyType proto_body_type(BodyType type);

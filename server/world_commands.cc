@@ -1,6 +1,7 @@
 #include "world_commands.h"
 
 #include <algorithm>
+#include <charconv>
 #include <unordered_set>
 
 #include "convert.h"
@@ -85,7 +86,18 @@ Status spawn_bodies(HostedWorld& hosted, const std::vector<BodyDef>& defs,
                              std::to_string(max_bodies) + " bodies allowed",
                          StatusCode::kResourceExhausted);
   Result<std::vector<BodyId>> made = world.create_bodies(defs);
-  if (!made) return made.status();
+  if (!made) {
+    // "bodies[i].shape.…" (the world's limits): the field in the API's terms.
+    const std::string& message = made.error();
+    const std::size_t close = message.find("].");
+    int index = -1;
+    if (message.rfind("bodies[", 0) == 0 && close != std::string::npos)
+      std::from_chars(message.data() + 7, message.data() + close, index);
+    if (index < 0 || index >= request.bodies_size()) return made.status();
+    return Status::error(message.substr(0, close + 2) +
+                             in_api_terms(message.substr(close + 2), request.bodies(index).shape()),
+                         made.status().code());
+  }
   hosted.ids.sync(world);
   for (std::size_t i = 0; i < made.value().size(); ++i) {
     hosted.set_colour(made.value()[i], request.bodies(static_cast<int>(i)).color());

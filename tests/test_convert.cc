@@ -75,6 +75,27 @@ TEST(Convert, EveryBadFieldIsNamed) {
   }
 }
 
+// The engine's names for a shape's fields (its ShapeDef's) in the API's terms (the v1 messages').
+TEST(Convert, EngineRefusalsAreNamedInTheApisTerms) {
+  v1::Shape compound;
+  compound.mutable_compound()->add_parts()->mutable_shape()->mutable_sphere()->set_radius(1);
+  compound.mutable_compound()->add_parts()->mutable_shape()->mutable_hull()->add_points(0);
+  EXPECT_EQ(in_api_terms("shape.parts[1].shape.points: coplanar", compound),
+            "shape.compound.parts[1].shape.hull.points: coplanar");
+  EXPECT_EQ(in_api_terms("shape.parts[0].shape.radius: below min_size", compound),
+            "shape.compound.parts[0].shape.sphere.radius: below min_size");
+  EXPECT_EQ(in_api_terms("shape.parts[0].pose.orientation: must be unit", compound),
+            "shape.compound.parts[0].pose.orientation: must be unit");
+  // A part that is not in the message (no such index): the compound's name alone.
+  EXPECT_EQ(in_api_terms("shape.parts[7].shape.points: x", compound),
+            "shape.compound.parts[7].shape.points: x");
+  v1::Shape box;
+  box.mutable_box();
+  EXPECT_EQ(in_api_terms("shape.half_extents: below min_size", box),
+            "shape.half_extents: below min_size");
+  EXPECT_EQ(in_api_terms("mass: must be > 0", box), "mass: must be > 0");
+}
+
 TEST(Convert, FrameKeepsOnlyWhatTheSubscriberAskedFor) {
   FrameData frame;
   frame.step = 7;

@@ -387,7 +387,8 @@ TEST(ServerProcess, CliSpawnsAHullOfPoints) {
   const Output flat =
       run(tumble + "spawn hull --point 0,0,0 --point 1,0,0 --point 0,1,0 --point 1,1,0");
   EXPECT_NE(flat.code, 0);
-  EXPECT_NE(flat.text.find("shape.points: coplanar or collinear"), std::string::npos) << flat.text;
+  EXPECT_NE(flat.text.find("shape.hull.points: coplanar or collinear"), std::string::npos)
+      << flat.text;
   const Output misplaced = run(tumble + "spawn box --point 0,0,0");
   EXPECT_NE(misplaced.code, 0);
   EXPECT_NE(misplaced.text.find("--point: only a hull has points"), std::string::npos)

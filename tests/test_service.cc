@@ -109,6 +109,38 @@ TEST_F(ServiceTest, BadInputIsRefusedByFieldAndChangesNothing) {
     EXPECT_EQ(status.error_message().rfind("bodies[1].orientation:", 0), 0u)
         << status.error_message();
   }
+  // Refused by the engine, which names the fields as its own types have them (shape.radius,
+  // shape.points, shape.parts[1].shape.points): answered in the message's terms.
+  const auto flat_hull = [](v1::Shape* shape) {
+    for (double coordinate : {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0})
+      shape->mutable_hull()->add_points(coordinate);
+  };
+  const std::pair<std::function<void(v1::BodySpec*)>, const char*> engine_refusals[] = {
+      {[](v1::BodySpec* spec) {  // past the world's limits
+         spec->mutable_shape()->mutable_sphere()->set_radius(1e-7);
+         spec->set_mass(1);
+       },
+       "bodies[1].shape.sphere.radius: "},
+      {[&](v1::BodySpec* spec) { flat_hull(spec->mutable_shape()); },
+       "bodies[1].shape.hull.points: coplanar"},
+      {[&](v1::BodySpec* spec) {
+         v1::Compound* compound = spec->mutable_shape()->mutable_compound();
+         compound->add_parts()->mutable_shape()->mutable_sphere()->set_radius(0.5);
+         flat_hull(compound->add_parts()->mutable_shape());
+       },
+       "bodies[1].shape.compound.parts[1].shape.hull.points: coplanar"},
+  };
+  for (const auto& [spoil, field] : engine_refusals) {
+    v1::SpawnBodiesRequest request;
+    *request.add_bodies() = ball(3);
+    *request.add_bodies() = ball(4);
+    spoil(request.mutable_bodies(1));
+    grpc::ClientContext context;
+    v1::SpawnBodiesResponse response;
+    const grpc::Status status = stub_->SpawnBodies(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_EQ(status.error_message().rfind(field, 0), 0u) << status.error_message();
+  }
   {  // over the body limit
     v1::SpawnBodiesRequest request;
     for (int i = 0; i < 100; ++i)
