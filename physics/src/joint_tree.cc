@@ -157,8 +157,8 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
     node.parent = parent_of[old] == kNone ? kNone : new_index[parent_of[old]];
   }
   nodes_.swap(ordered);
-  equations_.resize(n);
   if (!number_forest(rows, bodies)) return give_up();
+  equations_.resize(joints_.size());
   built_ = true;
   finish_build(rows, bodies);
   return true;
