@@ -398,6 +398,7 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
   out->set_continuous_limit_hits(s.continuous_limit_hits);
   out->set_gyroscopic_limit_hits(s.gyroscopic_limit_hits);
   out->set_pair_limit_hits(s.pair_limit_hits);
+  out->set_impact_limit_hits(s.impact_limit_hits);
   out->set_resting_contact_points(s.resting_contact_points);
   out->set_solved_joints(s.solved_joints);
   out->set_joint_error(s.joint_error);

@@ -169,6 +169,7 @@ TEST(Convert, StepStatsCarryEveryCounter) {
   set("max_penetration", s.max_penetration);
   set("gyroscopic_limit_hits", s.gyroscopic_limit_hits);
   set("pair_limit_hits", s.pair_limit_hits);
+  set("impact_limit_hits", s.impact_limit_hits);
   set("resting_contact_points", s.resting_contact_points);
   set("non_finite_bodies", s.non_finite_bodies);
   set("slowed_bodies", s.slowed_bodies);

@@ -562,6 +562,73 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCol
   }
 }
 
+bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> cold,
+                  std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
+                  std::span<SolverBody> bodies, const SolverSettings& settings, double reach) {
+  const double threshold = settings.restitution_threshold;
+  int elastic_manifolds = 0, manifolds = 0;
+  bool bouncing = false;
+  for (std::size_t k = 0; k < ids.size(); k += rows[ids[k]].block_size) {
+    ++manifolds;
+    if (cold[ids[k]].restitution <= 0) continue;
+    ++elastic_manifolds;
+    for (int i = 0; i < rows[ids[k]].block_size; ++i)
+      bouncing |= cold[ids[k + i]].relative_velocity < -threshold;
+  }
+  if (!bouncing || elastic_manifolds < 2) return false;
+  // The approach speed of a contact that meets within `reach`, else 0.
+  const auto approach = [&](std::uint32_t id) {
+    const ContactRow& row = rows[id];
+    if (cold[id].restitution <= 0) return 0.0;
+    const double vn = normal_velocity(row, bodies);
+    return vn < -threshold && row.separation + vn * reach <= 0 ? -vn : 0.0;
+  };
+  const int most_sweeps = std::min(kMostImpactSweeps, 2 * manifolds + 8);
+  bool settled = false;
+  for (int sweep = 0; sweep < most_sweeps && !settled; ++sweep) {
+    settled = true;
+    for (std::size_t k = 0; k < ids.size();) {
+      const int count = rows[ids[k]].block_size;
+      const std::uint32_t* block = &ids[k];
+      k += count;
+      double speeds[4] = {};
+      int approaching = 0;
+      for (int i = 0; i < count; ++i) {
+        speeds[i] = approach(block[i]);
+        approaching += speeds[i] > 0 ? 1 : 0;
+      }
+      if (approaching == 0) continue;
+      settled = false;
+      // A face landing flat bounces as one (as in apply_restitution), where its impulses all push.
+      if (approaching == count && count > 1) {
+        Eigen::Vector4d error = Eigen::Vector4d::Zero();
+        for (int i = 0; i < count; ++i)
+          error[i] = -(1 + cold[block[i]].restitution) * speeds[i];
+        const Eigen::Vector4d impulse = -(blocks[rows[block[0]].manifold].inverse * error);
+        if ((impulse.head(count).array() >= 0).all()) {
+          for (int i = 0; i < count; ++i) {
+            apply_normal_impulse(rows[block[i]], impulse[i], bodies);
+            cold[block[i]].earlier_substeps_impulse += impulse[i];
+          }
+          continue;
+        }
+      }
+      for (int i = 0; i < count; ++i) {
+        const double speed = i == 0 ? speeds[0] : approach(block[i]);
+        if (speed <= 0) continue;
+        const ContactRow& row = rows[block[i]];
+        const double impulse = (1 + cold[block[i]].restitution) * row.normal_mass * speed;
+        apply_normal_impulse(row, impulse, bodies);
+        cold[block[i]].earlier_substeps_impulse += impulse;
+      }
+    }
+  }
+  if (!settled) return true;
+  for (std::uint32_t id : ids)
+    cold[id].relative_velocity = 0;
+  return false;
+}
+
 void correct_positions(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,
                        std::span<const std::uint32_t> ids, std::span<const SolverBody> bodies,
                        std::span<Pose> poses, const SolverSettings& settings) {

@@ -152,6 +152,22 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCol
                        std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
                        std::span<SolverBody> bodies, const SolverSettings& settings);
 
+// Impacts passed on through bodies that touch, before the solve (Guendelman, Bridson and Fedkiw
+// 2003, "Nonconvex rigid bodies with stacking", section 6): each contact that approaches faster
+// than the restitution threshold and closes within `reach` s takes, alone, the impulse that sends
+// it apart at e times its approach speed, from the velocities as they are by then; the contacts are
+// swept again until none approaches, so a blow travels along a row of touching bodies contact by
+// contact (Newton's cradle), where one solve of all of them at once moves the row off together.
+// Runs only where a blow can travel: some contact bounces and another manifold of the island has
+// restitution. Its impulses count in the step's (earlier_substeps_impulse); the contacts it settled
+// take no bounce after the solve (relative_velocity 0). Sweeps are bounded (twice the manifolds and
+// eight, at most kMostImpactSweeps): past that, the contacts still approaching are left to the
+// solve and apply_restitution, as without it, and it returns true.
+constexpr int kMostImpactSweeps = 256;
+bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> cold,
+                  std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
+                  std::span<SolverBody> bodies, const SolverSettings& settings, double reach);
+
 // Nonlinear Gauss-Seidel on positions (Catto, Box2D 2.x): moves bodies out of penetration
 // without touching velocities.
 void correct_positions(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,

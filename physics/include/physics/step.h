@@ -143,6 +143,10 @@ struct StepStats {
   // 1 when the broad phase found more pairs than World::max_pairs and kept the first ones (bodies
   // heaped inside one another).
   std::uint32_t pair_limit_hits = 0;
+  // Islands whose impacts, passed on contact by contact through touching bodies before the solve
+  // (Newton's cradle: docs/DYNAMICS.md, "Restitution"), were still travelling at the bound on
+  // their sweeps; the contacts still approaching were left to the solve.
+  std::uint32_t impact_limit_hits = 0;
   // The world's limits (WorldLimits) held by the step: bodies whose step produced a non-finite
   // value (they keep their pose from before the step, at rest), bodies slowed to the speed
   // limits, and bodies held at the edge of the world (max_coordinate).
