@@ -47,6 +47,22 @@ TEST(Determinism, PyramidSplitByColoursSameBitsForAnyThreadCountAndRun) {
   expect_same_bits(pyramid, 120);
 }
 
+// Impacts passed along touching bodies before the solve (pass_impacts) run on one thread of the
+// team in the rows' order: a bouncy box dropped onto the top of the bouncy pyramid (one coloured
+// island) gives the same bits on any team.
+TEST(Determinism, ImpactsPassedThroughAColouredIslandSameBitsForAnyThreadCount) {
+  SceneDef pyramid = pyramid_scene(20);
+  pyramid.world.solver.sleeping = false;
+  BodyDef dropped = pyramid.bodies.back();
+  for (const BodyDef& body : pyramid.bodies)
+    dropped.position.z() = std::max(dropped.position.z(), body.position.z() + 1.2);
+  pyramid.bodies.push_back(dropped);
+  for (BodyDef& body : pyramid.bodies)
+    body.restitution = 0.5;
+  EXPECT_GT(run_with_threads(pyramid, 2, 45).coloured_islands, 0u);
+  expect_same_bits(pyramid, 45);  // it strikes at about the 30th step
+}
+
 // A coloured island too small for the team (fewer than 32 manifolds a thread: a pyramid of 120
 // boxes' few hundred on a team of 16) is solved by one of its threads, colour by colour: the bits
 // of the whole team's solve and of one thread's, with every iterative solver (pgs corrects
