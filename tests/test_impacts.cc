@@ -8,35 +8,16 @@
 #include <numbers>
 
 #include "scene_runner.h"
+#include "scenes/standard.h"
 
 namespace tumble::testing {
 namespace {
 
 constexpr double kRadius = 0.05;
 
-// `count` balls of 1 kg (restitution 1, no friction) hanging touching on hinges 1 m above them,
-// the first pulled out 45 degrees: the report's cradle.
 SceneDef cradle(int count, SolverKind solver) {
-  SceneDef scene;
+  SceneDef scene = hinged_cradle_scene(count);
   scene.world.solver.kind = solver;
-  scene.world.solver.sleeping = false;
-  for (int i = 0; i < count; ++i) {
-    const Vec3 pivot(2 * kRadius * i, 0, 1.5);
-    const double angle = i == 0 ? -std::numbers::pi / 4 : 0;
-    BodyDef ball;
-    ball.shape = SphereDef{kRadius};
-    ball.mass = 1;
-    ball.restitution = 1;
-    ball.friction = 0;
-    ball.position = pivot + Vec3(std::sin(angle), 0, -std::cos(angle));
-    scene.bodies.push_back(ball);
-    SceneJoint hinge;
-    hinge.def.kind = JointKind::kHinge;
-    hinge.def.anchor = pivot;
-    hinge.def.axis = Vec3::UnitY();
-    hinge.a = scene.bodies.size() - 1;
-    scene.joints.push_back(hinge);
-  }
   return scene;
 }
 

@@ -213,28 +213,8 @@ Scenario cradle() {
             {2, 3, 5, 10, 20},
             true};
   s.build = [](double count) {
-    SceneDef scene;
+    SceneDef scene = hinged_cradle_scene(static_cast<int>(count));
     scene.name = "cradle";
-    scene.duration = 1.5;
-    scene.world.solver.sleeping = false;
-    const double radius = 0.05, top = 1.5;
-    for (int i = 0; i < static_cast<int>(count); ++i) {
-      const Vec3 pivot(2 * radius * i, 0, top);
-      const double angle = i == 0 ? -std::numbers::pi / 4 : 0;
-      BodyDef ball;
-      ball.shape = SphereDef{radius};
-      ball.mass = 1;
-      ball.restitution = 1;
-      ball.friction = 0;
-      ball.position = pivot + Vec3(std::sin(angle), 0, -std::cos(angle));
-      scene.bodies.push_back(ball);
-      SceneJoint hinge;
-      hinge.def.kind = JointKind::kHinge;
-      hinge.def.anchor = pivot;
-      hinge.def.axis = Vec3::UnitY();
-      hinge.a = scene.bodies.size() - 1;
-      scene.joints.push_back(hinge);
-    }
     return scene;
   };
   s.checker = [](double, const SceneDef& scene) {

@@ -326,6 +326,30 @@ SceneDef cradle_scene() {
   return scene;
 }
 
+SceneDef hinged_cradle_scene(int balls) {
+  SceneDef scene = base_scene("hinged-cradle", 1.5);
+  scene.world.solver.sleeping = false;
+  const double radius = 0.05, top = 1.5;
+  for (int i = 0; i < balls; ++i) {
+    const Vec3 pivot(2 * radius * i, 0, top);
+    const double angle = i == 0 ? -std::numbers::pi / 4 : 0;
+    BodyDef ball;
+    ball.shape = SphereDef{radius};
+    ball.mass = 1;
+    ball.restitution = 1;
+    ball.friction = 0;
+    ball.position = pivot + Vec3(std::sin(angle), 0, -std::cos(angle));
+    scene.bodies.push_back(ball);
+    SceneJoint hinge;
+    hinge.def.kind = JointKind::kHinge;
+    hinge.def.anchor = pivot;
+    hinge.def.axis = Vec3::UnitY();
+    hinge.a = scene.bodies.size() - 1;
+    scene.joints.push_back(hinge);
+  }
+  return scene;
+}
+
 SceneDef door_scene() {
   SceneDef scene = base_scene("door", 10);
   scene.bodies.push_back(ground());

@@ -60,6 +60,10 @@ SceneDef hanging_chain_scene(int links = 20, double end_ratio = 1);
 // held at both ends (a loop of joints), 10 s.
 SceneDef double_pendulum_scene();
 SceneDef cradle_scene();
+// The report's Newton's cradle: `balls` balls of 5 cm and 1 kg (restitution 1, no friction)
+// hanging touching on hinges 1 m above them, the first pulled out 45 degrees; no ground, sleeping
+// off, 1.5 s.
+SceneDef hinged_cradle_scene(int balls);
 SceneDef door_scene();
 SceneDef rope_bridge_scene(int planks = 20);
 // A six-joint arm (base yaw, shoulder, elbow, wrist roll, pitch and roll: hinges from the world
