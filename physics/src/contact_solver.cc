@@ -562,10 +562,8 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCol
   }
 }
 
-bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> cold,
-                  std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
-                  std::span<SolverBody> bodies, const SolverSettings& settings, double reach) {
-  const double threshold = settings.restitution_threshold;
+int impact_manifolds(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,
+                     std::span<const std::uint32_t> ids, const SolverSettings& settings) {
   int elastic_manifolds = 0, manifolds = 0;
   bool bouncing = false;
   for (std::size_t k = 0; k < ids.size(); k += rows[ids[k]].block_size) {
@@ -573,9 +571,17 @@ bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> co
     if (cold[ids[k]].restitution <= 0) continue;
     ++elastic_manifolds;
     for (int i = 0; i < rows[ids[k]].block_size; ++i)
-      bouncing |= cold[ids[k + i]].relative_velocity < -threshold;
+      bouncing |= cold[ids[k + i]].relative_velocity < -settings.restitution_threshold;
   }
-  if (!bouncing || elastic_manifolds < 2) return false;
+  return bouncing && elastic_manifolds >= 2 ? manifolds : 0;
+}
+
+bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> cold,
+                  std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
+                  std::span<SolverBody> bodies, const SolverSettings& settings, double reach) {
+  const double threshold = settings.restitution_threshold;
+  const int manifolds = impact_manifolds(rows, cold, ids, settings);
+  if (manifolds == 0) return false;
   // The approach speed of a contact that meets within `reach`, else 0.
   const auto approach = [&](std::uint32_t id) {
     const ContactRow& row = rows[id];

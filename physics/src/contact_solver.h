@@ -164,6 +164,9 @@ void apply_restitution(std::span<ContactRow> rows, std::span<const ContactRowCol
 // eight, at most kMostImpactSweeps): past that, the contacts still approaching are left to the
 // solve and apply_restitution, as without it, and it returns true.
 constexpr int kMostImpactSweeps = 256;
+// pass_impacts' gate: the island's manifolds where a blow can travel, else 0.
+int impact_manifolds(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,
+                     std::span<const std::uint32_t> ids, const SolverSettings& settings);
 bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> cold,
                   std::span<const std::uint32_t> ids, std::span<const NormalBlock> blocks,
                   std::span<SolverBody> bodies, const SolverSettings& settings, double reach);

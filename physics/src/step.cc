@@ -663,8 +663,12 @@ class TeamIsland {
       : c_(c), s_(c.scratch), first_(first), last_(last), report_(report), solo_(solo) {}
 
   bool has_rows() const { return true; }  // coloured islands have many
-  // In the rows' order, on one thread: each impact follows from the ones before it.
+  // In the rows' order, on one thread: each impact follows from the ones before it. Every thread
+  // reads the gate, so that an island where no blow travels (most) costs the team no barrier; the
+  // first barrier keeps the pass's writes from the gate's reads.
   void pass_impacts(double reach) {
+    if (impact_manifolds(s_.rows, s_.cold_rows, c_.rows, c_.settings.solver) == 0) return;
+    if (!solo_) s_.barrier.wait();
     if (solo_ || omp_get_thread_num() == 0) {
       if (tumble::pass_impacts(s_.rows, s_.cold_rows, c_.rows, s_.blocks, s_.bodies,
                                c_.settings.solver, reach))
