@@ -60,14 +60,9 @@ bool turn_friction(const Joint& joint) {
 // A ball's friction: the angular impulse that stops b's turn relative to a, its accumulated
 // whole held within the friction torque times the substep (the disc of Coulomb's law about
 // every axis at once, as a contact's friction holds its tangent impulse).
-double solve_turn_friction(JointBodies& j, Joint& joint, double h) {
-  const SolverBody& b = j.body_b();
-  Mat3 mobility = Mat3::Zero();
-  if (j.a->inverse_mass > 0) mobility += j.a->inverse_inertia;
-  if (b.inverse_mass > 0) mobility += b.inverse_inertia;
-  const Eigen::LDLT<Mat3> solver(mobility);
-  if (solver.info() != Eigen::Success || !(mobility.trace() > 0)) return 0;
-  const Vec3 wanted = joint.friction_impulse - solver.solve(b.w - j.a->w);
+double solve_turn_friction(JointBodies& j, Joint& joint, double h, const JointPoseTerms& terms) {
+  if (!terms.mobility_usable) return 0;
+  const Vec3 wanted = joint.friction_impulse - terms.mobility_solver.solve(j.body_b().w - j.a->w);
   if (!wanted.allFinite()) return 0;
   const double most = joint.friction * h;
   const double size = wanted.norm();
@@ -75,7 +70,13 @@ double solve_turn_friction(JointBodies& j, Joint& joint, double h) {
   const Vec3 applied = total - joint.friction_impulse;
   joint.friction_impulse = total;
   apply_angular(j, applied);
-  return (mobility * applied).lpNorm<Eigen::Infinity>();
+  return (terms.mobility * applied).lpNorm<Eigen::Infinity>();
+}
+
+// What solve_axial works along the free coordinate for.
+bool has_drives(const Joint& joint) {
+  return joint.spring.enabled || joint.motor.enabled || joint.limit.enabled ||
+         coordinate_friction(joint);
 }
 
 }  // namespace
@@ -91,30 +92,50 @@ double impulse_along(const Joint& joint) {
          (coordinate_friction(joint) ? joint.friction_impulse.x() : 0.0);
 }
 
-void warm_start_axial(const JointRow& row, JointBodies& j) {
-  const Joint& joint = row.joint;
-  if (has_cone(joint) && joint.swing_impulse != 0) {
-    const Swing swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
-    if (swing.exists) apply_row(j, negated(swing.row), joint.swing_impulse);
+void prepare_axial_terms(const Joint& joint, const JointBodies& j, JointPoseTerms* terms) {
+  const SolverBody& b = j.body_b();
+  terms->coordinate = FreeCoordinate{};
+  terms->coordinate_mass = 0;
+  if (has_drives(joint) || impulse_along(joint) != 0) {
+    terms->coordinate = free_coordinate(joint, j.pose_a, j.pose_b, j.world_b());
+    if (terms->coordinate.exists) terms->coordinate_mass = row_mass(terms->coordinate.row, *j.a, b);
   }
+  terms->swing = Swing{};
+  terms->cone_mass = 0;
+  if (has_cone(joint)) {
+    terms->swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
+    if (terms->swing.exists) terms->cone_mass = row_mass(terms->swing.row, *j.a, b);
+  }
+  terms->mobility_usable = false;
+  if (turn_friction(joint)) {
+    terms->mobility.setZero();
+    if (j.a->inverse_mass > 0) terms->mobility += j.a->inverse_inertia;
+    if (b.inverse_mass > 0) terms->mobility += b.inverse_inertia;
+    terms->mobility_solver.compute(terms->mobility);
+    terms->mobility_usable =
+        terms->mobility_solver.info() == Eigen::Success && terms->mobility.trace() > 0;
+  }
+}
+
+void warm_start_axial(const JointRow& row, JointBodies& j, const JointPoseTerms& terms) {
+  const Joint& joint = row.joint;
+  if (has_cone(joint) && joint.swing_impulse != 0 && terms.swing.exists)
+    apply_row(j, negated(terms.swing.row), joint.swing_impulse);
   if (turn_friction(joint)) apply_angular(j, joint.friction_impulse);
   // A rigid rod's own impulse is warm-started with the joint's rows (joint_solver.cc).
   const double along = rigid_distance(joint) ? 0.0 : impulse_along(joint);
   if (along == 0) return;
-  const FreeCoordinate c = free_coordinate(joint, j.pose_a, j.pose_b, j.world_b());
-  if (c.exists) apply_row(j, c.row, along);
+  if (terms.coordinate.exists) apply_row(j, terms.coordinate.row, along);
 }
 
-double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target, bool bounds) {
+double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target,
+                   const JointPoseTerms& terms, bool bounds) {
   Joint& joint = row.joint;
   const SolverBody& b = j.body_b();
   const double h = target.substep;
   double change = 0;
-  const bool drives = joint.spring.enabled || joint.motor.enabled || joint.limit.enabled ||
-                      coordinate_friction(joint);
-  const FreeCoordinate c =
-      drives ? free_coordinate(joint, j.pose_a, j.pose_b, j.world_b()) : FreeCoordinate{};
-  const double mass = c.exists ? row_mass(c.row, *j.a, b) : 0;
+  const FreeCoordinate& c = terms.coordinate;
+  const double mass = has_drives(joint) && c.exists ? terms.coordinate_mass : 0;
   if (mass > 0) {
     // The spring acts over the coming move, once: in the sweeps before it (a relaxation sweep's
     // visit would damp it twice over).
@@ -171,10 +192,10 @@ double solve_axial(JointRow& row, JointBodies& j, const JointTarget& target, boo
       }
     }
   }
-  if (turn_friction(joint)) change = std::max(change, solve_turn_friction(j, joint, h));
+  if (turn_friction(joint)) change = std::max(change, solve_turn_friction(j, joint, h, terms));
   if (bounds && has_cone(joint)) {
-    const Swing swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
-    const double cone_mass = swing.exists ? row_mass(swing.row, *j.a, b) : 0;
+    const Swing& swing = terms.swing;
+    const double cone_mass = terms.cone_mass;
     if (cone_mass > 0)
       change =
           std::max(change, solve_bound(j, negated(swing.row), cone_mass,

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "joint_geometry.h"
+#include "joint_terms.h"
 
 namespace tumble {
 
@@ -18,14 +19,19 @@ bool has_axial_rows(const Joint& joint);
 // slider's friction); a rigid rod's, along it.
 double impulse_along(const Joint& joint);
 
+// The terms these rows read (joint_terms.h: the free coordinate, the cone, a ball's friction).
+void prepare_axial_terms(const Joint& joint, const joint_detail::JointBodies& j,
+                         JointPoseTerms* terms);
+
 // Applies the free coordinate's rows' impulses from the last step: the warm start.
-void warm_start_axial(const JointRow& row, joint_detail::JointBodies& j);
+void warm_start_axial(const JointRow& row, joint_detail::JointBodies& j,
+                      const JointPoseTerms& terms);
 
 // One Gauss-Seidel visit of the rows (spring, motor, limit, cone, in that order: the limit has the
 // last word). Without `bounds`, a limit that is not locked and the cone are left out (the exact
 // solver holds them: bound_rows). Returns the largest velocity change it gave.
 double solve_axial(JointRow& row, joint_detail::JointBodies& j, const JointTarget& target,
-                   bool bounds = true);
+                   const JointPoseTerms& terms, bool bounds = true);
 
 // A joint's one-sided rows as the exact solver's LCP holds them (a limit that is not locked, a
 // ball's cone): the row, whose rate may close the gap over the coming move and no more, the gap

@@ -8,6 +8,7 @@
 
 #include "joint_axial.h"
 #include "joint_geometry.h"
+#include "joint_terms.h"
 #include "rotation.h"
 
 namespace tumble {
@@ -37,12 +38,18 @@ double drift_velocity(double drift, double h, double most) {
   return std::clamp(drift / h, -most, most);
 }
 
-// The point constraint of ball, hinge and fixed joints: three rows solved together.
-double solve_point(JointRow& row, JointBodies& j, const Anchors& anchors, const JointTarget& t) {
-  const SolverBody& b = j.body_b();
+// The point constraint of ball, hinge and fixed joints: three rows solved together; their block.
+Mat3 point_block(const SolverBody& a, const SolverBody& b, const Anchors& anchors) {
   const Mat3 ra_skew = skew(anchors.ra), rb_skew = skew(anchors.rb);
-  const Mat3 k = (j.a->inverse_mass + b.inverse_mass) * Mat3::Identity() -
-                 ra_skew * j.a->inverse_inertia * ra_skew - rb_skew * b.inverse_inertia * rb_skew;
+  return (a.inverse_mass + b.inverse_mass) * Mat3::Identity() -
+         ra_skew * a.inverse_inertia * ra_skew - rb_skew * b.inverse_inertia * rb_skew;
+}
+
+double solve_point(JointRow& row, JointBodies& j, const JointPoseTerms& terms,
+                   const JointTarget& t) {
+  const SolverBody& b = j.body_b();
+  const Anchors& anchors = terms.anchors;
+  const Mat3& k = terms.point;
   // The move's drift beyond the velocities' first order (the turns' curvature), which the
   // velocities must cancel to end the move on the joint.
   Vec3 drift = Vec3::Zero();
@@ -50,21 +57,14 @@ double solve_point(JointRow& row, JointBodies& j, const Anchors& anchors, const 
     drift = anchor_move(b, anchors.rb, t.h) - anchor_move(*j.a, anchors.ra, t.h) -
             t.h * anchor_velocity(j, anchors);
   }
-  const Vec3 impulse =
-      -k.ldlt().solve(anchor_velocity(j, anchors) + drift_velocity(drift, t.h, t.most_speed));
+  const Vec3 impulse = -terms.point_solver.solve(anchor_velocity(j, anchors) +
+                                                 drift_velocity(drift, t.h, t.most_speed));
   row.joint.linear_impulse += impulse;
   apply_linear(j, anchors.ra, anchors.rb, impulse);
   return (k * impulse).lpNorm<Eigen::Infinity>();
 }
 
-// A hinge's two angular rows: axis a stays perpendicular to two directions b2, c2 perpendicular
-// to axis b (Jolt's HingeRotationConstraintPart has the same rows). d/dt (axis_a . d) =
-// (w_b - w_a) . (d x axis_a) for d fixed in b, so the rows' directions are g = d x axis_a.
-struct HingeRows {
-  Vec3 axis_a, b2, c2, g1, g2;
-  Eigen::Matrix2d k;  // effective inverse mass of the two rows
-  Eigen::Vector2d error() const { return {axis_a.dot(b2), axis_a.dot(c2)}; }
-};
+}  // namespace
 
 HingeRows hinge_rows(const Joint& joint, const Quat& qa, const Quat* qb, const Mat3& inertia) {
   HingeRows rows;
@@ -80,15 +80,16 @@ HingeRows hinge_rows(const Joint& joint, const Quat& qa, const Quat* qb, const M
   return rows;
 }
 
-double solve_hinge_axes(JointRow& row, JointBodies& j, const JointTarget& t) {
+namespace {
+
+double solve_hinge_axes(JointRow& row, JointBodies& j, const JointTarget& t,
+                        const JointPoseTerms& terms) {
   const SolverBody& b = j.body_b();
-  const HingeRows rows =
-      hinge_rows(row.joint, j.pose_a.orientation, j.b == nullptr ? nullptr : &j.pose_b.orientation,
-                 j.a->inverse_inertia + b.inverse_inertia);
+  const HingeRows& rows = terms.hinge;
   const Vec3 &axis_a = rows.axis_a, &b2 = rows.b2, &c2 = rows.c2, &g1 = rows.g1, &g2 = rows.g2;
   const Eigen::Matrix2d& k = rows.k;
   const Vec3 relative_w = b.w - j.a->w;
-  if (!(k.determinant() > 0)) return 0;
+  if (!terms.hinge_usable) return 0;
   Eigen::Vector2d velocity(relative_w.dot(g1), relative_w.dot(g2));
   if (t.h > 0) {
     // The turns' curvature over the move, beyond the velocities' first order.
@@ -100,7 +101,7 @@ double solve_hinge_axes(JointRow& row, JointBodies& j, const JointTarget& t) {
     const Vec3 extra = drift_velocity(drift, t.h, t.most_speed);
     velocity += Eigen::Vector2d(extra.x(), extra.y());
   }
-  const Eigen::Vector2d lambda = -k.ldlt().solve(velocity);
+  const Eigen::Vector2d lambda = -terms.hinge_solver.solve(velocity);
   const Vec3 angular = lambda.x() * g1 + lambda.y() * g2;
   row.joint.angular_impulse += angular;
   apply_angular(j, angular);
@@ -116,11 +117,11 @@ Vec3 rotation_error(const Joint& joint, const Quat& qa, const Quat& qb) {
 }
 
 // (The relative turn's curvature over a move is third order: nothing to add for a move ahead.)
-double solve_fixed_rotation(JointRow& row, JointBodies& j) {
+double solve_fixed_rotation(JointRow& row, JointBodies& j, const JointPoseTerms& terms) {
   const SolverBody& b = j.body_b();
-  const Mat3 k = j.a->inverse_inertia + b.inverse_inertia;
-  if (!(k.determinant() > 0)) return 0;
-  const Vec3 impulse = -k.ldlt().solve(Vec3(b.w - j.a->w));
+  const Mat3& k = terms.rotation;
+  if (!terms.rotation_usable) return 0;
+  const Vec3 impulse = -terms.rotation_solver.solve(Vec3(b.w - j.a->w));
   row.joint.angular_impulse += impulse;
   apply_angular(j, impulse);
   return (k * impulse).lpNorm<Eigen::Infinity>();
@@ -152,13 +153,7 @@ double solve_distance(JointRow& row, JointBodies& j, const Anchors& anchors, con
   return std::abs(impulse) * k;
 }
 
-// A slider's two rows across its axis: b's anchor stays on the line through a's anchor along
-// a's axis (the rows' lever arm on a reaches b's anchor, as the offset's does).
-struct SliderRows {
-  AxialRow rows[2];
-  Eigen::Matrix2d k;
-  Eigen::Vector2d error;
-};
+}  // namespace
 
 SliderRows slider_rows(const Joint& joint, const Pose& pose_a, const Pose& pose_b, bool world_b,
                        const SolverBody& a, const SolverBody& b) {
@@ -180,12 +175,14 @@ SliderRows slider_rows(const Joint& joint, const Pose& pose_a, const Pose& pose_
   return s;
 }
 
-double solve_slider_across(JointRow& row, JointBodies& j) {
-  const SliderRows s = slider_rows(row.joint, j.pose_a, j.pose_b, j.world_b(), *j.a, j.body_b());
-  if (!(s.k.determinant() > 0)) return 0;
+namespace {
+
+double solve_slider_across(JointRow& row, JointBodies& j, const JointPoseTerms& terms) {
+  const SliderRows& s = terms.slider;
+  if (!terms.slider_usable) return 0;
   const Eigen::Vector2d rate(row_rate(s.rows[0], *j.a, j.body_b()),
                              row_rate(s.rows[1], *j.a, j.body_b()));
-  const Eigen::Vector2d lambda = -s.k.ldlt().solve(rate);
+  const Eigen::Vector2d lambda = -terms.slider_solver.solve(rate);
   for (int i = 0; i < 2; ++i)
     apply_row(j, s.rows[i], lambda[i]);
   row.joint.linear_impulse += lambda[0] * s.rows[0].linear + lambda[1] * s.rows[1].linear;
@@ -194,11 +191,51 @@ double solve_slider_across(JointRow& row, JointBodies& j) {
 
 }  // namespace
 
+void prepare_joint_terms(const JointRow& row, std::span<const SolverBody> bodies,
+                         std::span<const Pose> poses, bool own_rows, JointPoseTerms* terms) {
+  const Joint& joint = row.joint;
+  const bool world_b = row.b == kWorldAnchor;
+  // (JointBodies writes through its bodies; nothing here does.)
+  SolverBody& a = const_cast<SolverBody&>(bodies[row.a]);
+  SolverBody* b = world_b ? nullptr : const_cast<SolverBody*>(&bodies[row.b]);
+  const JointBodies j{&a, b, poses[row.a], world_b ? Pose{} : poses[row.b]};
+  const SolverBody& body_b = j.body_b();
+  terms->anchors = anchors_of(joint, j.pose_a, j.pose_b, world_b);
+  prepare_axial_terms(joint, j, terms);
+  if (!own_rows) return;
+  switch (joint.kind) {
+    case JointKind::kHinge:
+      terms->hinge =
+          hinge_rows(joint, j.pose_a.orientation, world_b ? nullptr : &j.pose_b.orientation,
+                     a.inverse_inertia + body_b.inverse_inertia);
+      terms->hinge_usable = terms->hinge.k.determinant() > 0;
+      if (terms->hinge_usable) terms->hinge_solver.compute(terms->hinge.k);
+      break;
+    case JointKind::kFixed:
+    case JointKind::kSlider:
+      terms->rotation = a.inverse_inertia + body_b.inverse_inertia;
+      terms->rotation_usable = terms->rotation.determinant() > 0;
+      if (terms->rotation_usable) terms->rotation_solver.compute(terms->rotation);
+      break;
+    case JointKind::kBall:
+    case JointKind::kDistance:
+      break;
+  }
+  if (joint.kind == JointKind::kSlider) {
+    terms->slider = slider_rows(joint, j.pose_a, j.pose_b, world_b, a, body_b);
+    terms->slider_usable = terms->slider.k.determinant() > 0;
+    if (terms->slider_usable) terms->slider_solver.compute(terms->slider.k);
+  } else if (joint.kind != JointKind::kDistance) {
+    terms->point = point_block(a, body_b, terms->anchors);
+    terms->point_solver.compute(terms->point);
+  }
+}
+
 void warm_start_joint(const JointRow& row, std::span<SolverBody> bodies,
-                      std::span<const Pose> poses) {
+                      std::span<const Pose> poses, const JointPoseTerms& terms) {
   JointBodies j = bodies_of(row, bodies, poses);
-  warm_start_axial(row, j);
-  const Anchors anchors = anchors_of(row.joint, j.pose_a, j.pose_b, j.world_b());
+  warm_start_axial(row, j, terms);
+  const Anchors& anchors = terms.anchors;
   switch (row.joint.kind) {
     case JointKind::kDistance: {
       const Vec3 d = anchors.pb - anchors.pa;
@@ -218,30 +255,31 @@ void warm_start_joint(const JointRow& row, std::span<SolverBody> bodies,
 }
 
 double solve_joint(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
-                   const JointTarget& target) {
+                   const JointTarget& target, const JointPoseTerms& terms) {
   JointBodies j = bodies_of(row, bodies, poses);
   // Springs, motors and limits first, so that the rows that must hold have the last word; then
   // the rotation, then the point, whose lever arms the rotation changed last (Box2D v3's
   // revolute joint's order).
-  double change = solve_axial(row, j, target);
+  double change = solve_axial(row, j, target, terms);
   switch (row.joint.kind) {
     case JointKind::kHinge:
-      change = std::max(change, solve_hinge_axes(row, j, target));
+      change = std::max(change, solve_hinge_axes(row, j, target, terms));
       break;
     case JointKind::kFixed:
     case JointKind::kSlider:
-      change = std::max(change, solve_fixed_rotation(row, j));
+      change = std::max(change, solve_fixed_rotation(row, j, terms));
       break;
     case JointKind::kBall:
     case JointKind::kDistance:
       break;
   }
-  if (row.joint.kind == JointKind::kSlider) return std::max(change, solve_slider_across(row, j));
-  const Anchors anchors = anchors_of(row.joint, j.pose_a, j.pose_b, j.world_b());
+  if (row.joint.kind == JointKind::kSlider)
+    return std::max(change, solve_slider_across(row, j, terms));
   if (row.joint.kind == JointKind::kDistance)
-    return rigid_distance(row.joint) ? std::max(change, solve_distance(row, j, anchors, target))
-                                     : change;
-  return std::max(change, solve_point(row, j, anchors, target));
+    return rigid_distance(row.joint)
+               ? std::max(change, solve_distance(row, j, terms.anchors, target))
+               : change;
+  return std::max(change, solve_point(row, j, terms, target));
 }
 
 namespace {
@@ -312,10 +350,7 @@ void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
     if (k > 0) displace_linear(m, anchors.ra, anchors.rb, -(length - joint.length) / k * n);
     return;
   }
-  const Mat3 ra_skew = skew(anchors.ra), rb_skew = skew(anchors.rb);
-  const Mat3 k = (m.a->inverse_mass + b.inverse_mass) * Mat3::Identity() -
-                 ra_skew * m.a->inverse_inertia * ra_skew - rb_skew * b.inverse_inertia * rb_skew;
-  displace_linear(m, anchors.ra, anchors.rb, -k.ldlt().solve(d));
+  displace_linear(m, anchors.ra, anchors.rb, -point_block(*m.a, b, anchors).ldlt().solve(d));
 }
 
 JointReading read_joint(const Joint& joint, const Pose& pose_a, const Pose& pose_b,
@@ -589,9 +624,9 @@ void add_equation_impulses(JointRow& row, const JointEquations& equations,
 }
 
 double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
-                          const JointTarget& target, bool bounds) {
+                          const JointTarget& target, const JointPoseTerms& terms, bool bounds) {
   JointBodies j = bodies_of(row, bodies, poses);
-  return solve_axial(row, j, target, bounds);
+  return solve_axial(row, j, target, terms, bounds);
 }
 
 void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies,

@@ -29,9 +29,11 @@ struct JointRow {
   bool motor_at_bound = false;
 };
 
+struct JointPoseTerms;  // joint_terms.h: what the visits below read of the poses
+
 // Applies the row's impulses to its bodies at their present poses: the warm start.
 void warm_start_joint(const JointRow& row, std::span<SolverBody> bodies,
-                      std::span<const Pose> poses);
+                      std::span<const Pose> poses, const JointPoseTerms& terms);
 
 // What a sweep asks of a joint: with a move of h ahead (h > 0), velocities under which the move
 // opens no error (the turns' curvature included, which the velocities' first order misses; at
@@ -88,13 +90,14 @@ void add_equation_impulses(JointRow& row, const JointEquations& equations,
 // direct solve of the joint's own rows. Without `bounds`, its one-sided limits and cone are left
 // to the exact solver (joint_axial.h, bound_rows).
 double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
-                          const JointTarget& target, bool bounds = true);
+                          const JointTarget& target, const JointPoseTerms& terms,
+                          bool bounds = true);
 // The position pass of the joint's limits and cone alone.
 void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies, std::span<Pose> poses);
 
 // One Gauss-Seidel visit of the joint's rows. Returns the largest velocity change it gave (m/s).
 double solve_joint(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
-                   const JointTarget& target);
+                   const JointTarget& target, const JointPoseTerms& terms);
 
 // One nonlinear Gauss-Seidel visit of the joint's position error after the bodies moved (Catto's
 // position solve, Box2D 2.x): the bodies are moved and turned back onto the joint through their

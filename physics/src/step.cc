@@ -214,12 +214,14 @@ class SerialIsland {
       for (std::uint32_t j : c_.joints)
         correct_joint_position(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
     }
+    joint_terms_current_ = false;
   }
   void refresh_separations() { update_separations(rows_, c_.rows, bodies_, kinematic_time()); }
   // How long the island's bodies have moved in this step, which kinematic bodies' motion in its
   // separations follows (0 where none touches a contact: the separations' arithmetic without it).
   double kinematic_time() const { return c_.scratch.kinematic_contacts ? moved_for_ : 0.0; }
   void warm_start(bool keep_last_substep) {
+    prepare_joint_terms();
     for (std::uint32_t j : c_.joints) {
       JointRow& row = c_.scratch.joint_rows[j];
       // With the direct solve, motors join it each substep until one needs more than its force
@@ -231,7 +233,7 @@ class SerialIsland {
         row.motor_at_bound = false;
         row.joint.motor_impulse = 0;
       }
-      warm_start_joint(row, bodies_, c_.scratch.poses);
+      warm_start_joint(row, bodies_, c_.scratch.poses, c_.scratch.joint_terms[j]);
     }
     tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep, kinematic_time());
   }
@@ -246,12 +248,14 @@ class SerialIsland {
       const JointTarget target{move_ahead ? h : 0.0, c_.settings.solver.max_push_velocity, h};
       // With a tree (joint_tree.h), every joint's own rows at once, exactly, after the drives.
       const bool direct = tree_ != nullptr;
+      prepare_joint_terms();
       for (std::uint32_t j : c_.joints) {
         JointRow& row = c_.scratch.joint_rows[j];
+        const JointPoseTerms& terms = c_.scratch.joint_terms[j];
         row.joint.impulse_time = h;
-        change =
-            std::max(change, direct ? solve_joint_drives(row, bodies_, c_.scratch.poses, target)
-                                    : solve_joint(row, bodies_, c_.scratch.poses, target));
+        change = std::max(change,
+                          direct ? solve_joint_drives(row, bodies_, c_.scratch.poses, target, terms)
+                                 : solve_joint(row, bodies_, c_.scratch.poses, target, terms));
       }
       if (direct)
         change = std::max(change, tree_->solve_velocities(c_.scratch.joint_rows, bodies_,
@@ -282,6 +286,7 @@ class SerialIsland {
     // centre, the tree turned its fall back into a turn about the hinge, and it slid at a steady
     // 0.06 rad/s), so a joint with drives keeps its own rows' warm start too. (Warm-started
     // everywhere, a chain of 20 falling from level opened 5e-5 m at dt 1/30; 2.4e-7 m without.)
+    prepare_joint_terms();
     for (std::uint32_t j : c_.joints) {
       JointRow& row = c_.scratch.joint_rows[j];
       Joint& joint = row.joint;
@@ -299,7 +304,7 @@ class SerialIsland {
         row.motor_at_bound = false;
         joint.motor_impulse = 0;
       }
-      warm_start_joint(row, bodies_, c_.scratch.poses);
+      warm_start_joint(row, bodies_, c_.scratch.poses, c_.scratch.joint_terms[j]);
     }
     // As many visits as a substep's sweeps and relaxation sweeps give them.
     const JointTarget target{h, c_.settings.solver.max_push_velocity, h};
@@ -308,8 +313,9 @@ class SerialIsland {
       ++report_->velocity_iterations;
       double change = 0;
       for (std::uint32_t j : c_.joints)
-        change = std::max(change, solve_joint_drives(c_.scratch.joint_rows[j], bodies_,
-                                                     c_.scratch.poses, target, false));
+        change =
+            std::max(change, solve_joint_drives(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses,
+                                                target, c_.scratch.joint_terms[j], false));
       change = std::max(change, tree_->solve_velocities(c_.scratch.joint_rows, bodies_,
                                                         c_.scratch.poses, target));
       // The first visit's change leaves out the tree's first solve of the substep (its targets'
@@ -361,8 +367,19 @@ class SerialIsland {
   std::span<ContactRow> rows_;
   std::span<ContactRowCold> cold_;
   std::span<SolverBody> bodies_;
+  // What the joints' visits read of the poses (joint_terms.h), worked out once after each move:
+  // the first visit after one finds them out of date.
+  void prepare_joint_terms() {
+    if (joint_terms_current_) return;
+    for (std::uint32_t j : c_.joints)
+      tumble::prepare_joint_terms(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses,
+                                  tree_ == nullptr, &c_.scratch.joint_terms[j]);
+    joint_terms_current_ = true;
+  }
+
   JointTree* tree_ = nullptr;  // the island's joints solved directly (joint_tree.h), if so
   bool one_sweep_solves_ = false;
+  bool joint_terms_current_ = false;
   double moved_for_ = 0;  // s: the moves so far this step
 };
 

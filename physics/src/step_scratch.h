@@ -11,6 +11,7 @@
 #include "continuous.h"
 #include "islands.h"
 #include "joint_solver.h"
+#include "joint_terms.h"
 #include "joint_tree.h"
 #include "tall_stacks.h"
 #include "team_barrier.h"
@@ -79,6 +80,7 @@ struct StepScratch {
   // The joints with a moving body (world_joints.cc), and their links into islands.
   std::vector<JointRow> joint_rows;
   std::vector<IslandLink> joint_links;
+  std::vector<JointPoseTerms> joint_terms;  // beside joint_rows: each island's, after its moves
   std::vector<std::uint8_t> touching;  // per manifold: apart by less than the slop
   // Per manifold: its pair's colour last step and this step's (colouring.h).
   std::vector<std::uint8_t> kept_colours, colours;

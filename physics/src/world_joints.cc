@@ -333,6 +333,7 @@ void World::prepare_joint_rows() {
                             index});
     s.joint_links.push_back({a, b == kWorldAnchor ? a : b});
   }
+  s.joint_terms.resize(s.joint_rows.size());
 }
 
 void World::store_joint_impulses() {
