@@ -194,5 +194,26 @@ TEST(Determinism, PinnedStateHashes) {
   EXPECT_EQ(run_with_threads(pile, 2, 150).hash, 0x08166f42b48d92a5ull) << "pile, no reuse";
 }
 
+// Joint scenes' bits, pinned the same way: the ragdolls (trees of hinges and cone-limited balls
+// lying on the ground and on each other) with every solver, and the chain with a 1000 times
+// heavier end (the direct solve with the joints' geometric stiffness). Their joints' visits,
+// direct solves and position passes must give these bits whatever is reorganised beneath them.
+TEST(Determinism, PinnedJointSceneHashes) {
+  const std::pair<SolverKind, std::uint64_t> ragdolls[] = {
+      {SolverKind::kAuto, 0xb341edbab5f7db75ull},
+      {SolverKind::kSoft, 0x7f97c30e6c0297d2ull},
+      {SolverKind::kPgs, 0xb8628ab56ce5368aull},
+      {SolverKind::kExact, 0xb341edbab5f7db75ull}};
+  for (const auto& [kind, pinned] : ragdolls) {
+    SceneDef scene = ragdolls_scene(4);
+    scene.world.solver.kind = kind;
+    SCOPED_TRACE(std::string(solver_name(kind)));
+    for (int threads : {1, 2})
+      EXPECT_EQ(run_with_threads(scene, threads, 120).hash, pinned) << "ragdolls:4";
+  }
+  EXPECT_EQ(run_with_threads(chain_scene(20, 1000), 1, 120).hash, 0xd1b2fb9a54b489f7ull)
+      << "chain:20:1000";
+}
+
 }  // namespace
 }  // namespace tumble::testing
