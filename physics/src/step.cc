@@ -204,7 +204,8 @@ class SerialIsland {
     for (int pass = 0; pass < kJointPositionPasses; ++pass) {
       if (tree_ != nullptr) {
         for (std::uint32_t j : c_.joints)
-          correct_joint_bounds(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
+          if (has_axial_rows(c_.scratch.joint_rows[j].joint))
+            correct_joint_bounds(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
         // The last refactored pass factors the velocity sweeps' system too (joint_tree.h).
         tree_->solve_positions(c_.scratch.joint_rows, bodies_, c_.scratch.poses,
                                pass < kJointRefactoredPasses,
@@ -253,6 +254,8 @@ class SerialIsland {
         JointRow& row = c_.scratch.joint_rows[j];
         const JointPoseTerms& terms = c_.scratch.joint_terms[j];
         row.joint.impulse_time = h;
+        // (A joint without drives or bounds has nothing to visit besides the direct solve.)
+        if (direct && !has_axial_rows(row.joint)) continue;
         change = std::max(change,
                           direct ? solve_joint_drives(row, bodies_, c_.scratch.poses, target, terms)
                                  : solve_joint(row, bodies_, c_.scratch.poses, target, terms));
