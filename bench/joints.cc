@@ -5,7 +5,8 @@
 // then the standard chain:100 (released level, swinging clear of the ground) and the pile of eight
 // ragdolls (awake, without their joints' friction) for step time alone.
 // Ours with the direct solve of joint trees (auto) and with Gauss-Seidel joints (soft); Bullet 3.24
-// float and double, btPoint2PointConstraint, 10 sequential-impulse iterations. ODE and MuJoCo join
+// float and double, btPoint2PointConstraint, 10 sequential-impulse iterations, and Bullet's
+// btMultiBody (float, generalised coordinates; trees from the world alone). ODE and MuJoCo join
 // in the report's joints section (make report). Usage: bench_joints [seconds] (default 20).
 #include <algorithm>
 #include <chrono>
@@ -84,7 +85,8 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
   PeerOptions options;
   options.sleeping = false;
   for (auto [name, make] :
-       {std::pair{"Bullet float", &make_bullet}, std::pair{"Bullet double", &make_bullet_double}}) {
+       {std::pair{"Bullet float", &make_bullet}, std::pair{"Bullet double", &make_bullet_double},
+        std::pair{"Bullet multibody", &make_bullet_multibody}}) {
     std::string why;
     auto sim = make(peer, options, &why);
     if (!sim) {

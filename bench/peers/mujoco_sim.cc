@@ -17,6 +17,7 @@
 #include <optional>
 #include <sstream>
 
+#include "peers/joint_forest.h"
 #include "peers/simulation.h"
 
 namespace tumble::bench {
@@ -42,8 +43,20 @@ class MujocoSimulation final : public Simulation {
 
   // False once MuJoCo reports full buffers or a non-finite acceleration: on the latter it
   // resets the state to the model's start and would go on as if nothing happened.
+  // A force (world axes, at the centre) on dynamic body i during the next step alone.
+  void kick(std::size_t i, const Vec3& force) {
+    mjtNum* applied = data_->xfrc_applied + 6 * bodies_[i];
+    for (int c = 0; c < 3; ++c)
+      applied[c] = force[c];
+    kicked_ = true;
+  }
+
   bool step() override {
     mj_step(model_, data_);
+    if (kicked_) {
+      mju_zero(data_->xfrc_applied, 6 * model_->nbody);
+      kicked_ = false;
+    }
     current_ = false;
     return data_->warning[mjWARN_CONTACTFULL].number == 0 &&
            data_->warning[mjWARN_CNSTRFULL].number == 0 &&
@@ -80,6 +93,7 @@ class MujocoSimulation final : public Simulation {
   mjData* data_ = nullptr;
   std::vector<int> bodies_;  // MuJoCo's body id of each dynamic body, in scene order
   mutable bool current_ = false;
+  bool kicked_ = false;  // xfrc_applied holds a kick for the next step
 };
 
 void write_vector(std::ostream& out, const Vec3& v) {
@@ -90,59 +104,6 @@ void write_pose(std::ostream& out, const Vec3& position, const Quat& q) {
   out << "pos=\"";
   write_vector(out, position);
   out << "\" quat=\"" << q.w() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << '"';
-}
-
-// Where each dynamic body hangs in MuJoCo's tree: its parent (none: the world) and the joint
-// that holds it there (none: a free body, or the root of a tree of joints).
-struct Placement {
-  std::optional<std::size_t> parent, joint;
-  bool placed = false;  // while the tree grows (place)
-};
-
-// Grows the tree from the world (static bodies are the world) through the joints; a joint whose
-// bodies are both placed already closes a loop. Bodies the world does not reach through joints
-// become free roots, lowest index first, and the growth goes on from them.
-bool place(const SceneDef& scene, std::vector<Placement>* placements, std::string* why_not) {
-  const std::size_t n = scene.bodies.size();
-  for (const BodyDef& def : scene.bodies)
-    if (def.type == BodyType::kKinematic) {
-      *why_not = "kinematic bodies are not mapped to this peer";
-      return false;
-    }
-  std::vector<Placement>& at = *placements;
-  at.assign(n, {});
-  for (std::size_t i = 0; i < n; ++i)
-    at[i].placed = scene.bodies[i].type == BodyType::kStatic;
-  auto placed = [&](std::optional<std::size_t> i) { return !i || at[*i].placed; };
-  std::vector<bool> used(scene.joints.size(), false);
-  for (std::size_t left = scene.joints.size(); left > 0;) {
-    bool grew = false;
-    for (std::size_t j = 0; j < scene.joints.size(); ++j) {
-      if (used[j]) continue;
-      const SceneJoint& joint = scene.joints[j];
-      const std::optional<std::size_t> a = joint.a, b = joint.b;
-      if (placed(a) && placed(b)) {
-        *why_not = "a loop of joints is not a MuJoCo tree";
-        return false;
-      }
-      if (!placed(a) && !placed(b)) continue;
-      const std::size_t child = placed(a) ? *b : *a;
-      const std::optional<std::size_t> parent = placed(a) ? a : b;
-      at[child] = {
-          parent && scene.bodies[*parent].type != BodyType::kStatic ? parent : std::nullopt, j,
-          true};
-      used[j] = true;
-      --left;
-      grew = true;
-    }
-    if (grew || left == 0) continue;
-    for (std::size_t j = 0; j < scene.joints.size() && !grew; ++j)
-      if (!used[j]) {
-        at[scene.joints[j].a].placed = true;  // a free root
-        grew = true;
-      }
-  }
-  return true;
 }
 
 // MuJoCo's coordinate is the child's motion against its parent; ours is b's against a.
@@ -178,10 +139,7 @@ std::unique_ptr<Simulation> make_mujoco(const PeerScene& peer, const PeerOptions
   if (!place(scene, &placements, why_not)) return nullptr;
   // MuJoCo 2.2.2 reads models from XML, and its parser stops at 100 nested elements.
   for (std::size_t i = 0; i < placements.size(); ++i) {
-    int depth = 0;
-    for (std::optional<std::size_t> up = placements[i].parent; up; up = placements[*up].parent)
-      ++depth;
-    if (depth > 90) {
+    if (depth_of(placements, i) > 90) {
       *why_not = "a joint tree over 90 bodies deep (MuJoCo 2.2.2's XML parser stops at 100 levels)";
       return nullptr;
     }
@@ -338,6 +296,16 @@ std::unique_ptr<Simulation> make_mujoco(const PeerScene& peer, const PeerOptions
     }
   }
   mj_forward(simulation->model(), simulation->data());
+  // A body's own velocity that its joint does not carry (the kicked end of a hanging chain) is
+  // its momentum given as a force over the first step: through the joints, the answer our solve
+  // gives the same kick (the velocities projected onto the joints in the bodies' masses).
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    if (scene.bodies[i].type != BodyType::kDynamic) continue;
+    const Vec3 missing = scene.bodies[i].linear_velocity - simulation->body(k).linear_velocity;
+    if (missing.norm() > 1e-9) simulation->kick(k, peer.mass[i] * missing / scene.dt);
+    ++k;
+  }
   return simulation;
 }
 

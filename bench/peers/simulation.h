@@ -69,6 +69,9 @@ std::unique_ptr<Simulation> make_bullet(const PeerScene& scene, const PeerOption
                                         std::string* why_not);
 std::unique_ptr<Simulation> make_bullet_double(const PeerScene& scene, const PeerOptions& options,
                                                std::string* why_not);
+// Bullet's btMultiBody (generalised coordinates: joint trees hanging from the world alone).
+std::unique_ptr<Simulation> make_bullet_multibody(const PeerScene& scene,
+                                                  const PeerOptions& options, std::string* why_not);
 std::unique_ptr<Simulation> make_ode(const PeerScene& scene, const PeerOptions& options,
                                      std::string* why_not);
 std::unique_ptr<Simulation> make_mujoco(const PeerScene& scene, const PeerOptions& options,

@@ -80,6 +80,11 @@ std::unique_ptr<Simulation> make_bullet(const PeerScene&, const PeerOptions&, st
   *why = "not built (Debian's libbullet-dev was not found)";
   return nullptr;
 }
+std::unique_ptr<Simulation> make_bullet_multibody(const PeerScene&, const PeerOptions&,
+                                                  std::string* why) {
+  *why = "not built (Debian's libbullet-dev was not found)";
+  return nullptr;
+}
 std::unique_ptr<Simulation> make_ode(const PeerScene&, const PeerOptions&, std::string* why) {
   *why = "not built (Debian's libode-dev was not found)";
   return nullptr;

@@ -73,6 +73,9 @@ std::vector<Engine> peer_engines() {
   };
   out.push_back(peer("Bullet float", bench::make_bullet));
   out.push_back(peer("Bullet double", bench::make_bullet_double));
+  // Bullet's generalised coordinates (Featherstone): where the joints are trees from the world.
+  out.push_back(peer("Bullet multibody", bench::make_bullet_multibody));
+  out.back().joints_only = true;
   out.push_back(peer("ODE", bench::make_ode));
   // ODE's direct solver is cubic in an island's rows (a pile's contacts): the accurate choice for
   // jointed bodies, where the report measures it.

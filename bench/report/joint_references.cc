@@ -2,8 +2,8 @@
 // against the complete elliptic integral, a hinged double pendulum's energy (conserved exactly),
 // and how far a falling chain's joints come apart (zero by their definition). Hinges and ball
 // joints only, so that every peer maps them (Bullet's btHingeConstraint and
-// btPoint2PointConstraint, ODE's hinge and ball, MuJoCo's hinge and ball in generalised
-// coordinates).
+// btPoint2PointConstraint, Bullet's btMultiBody, ODE's hinge and ball, MuJoCo's hinge and ball in
+// generalised coordinates).
 #include <cmath>
 #include <limits>
 #include <numbers>
