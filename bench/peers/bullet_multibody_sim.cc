@@ -7,7 +7,8 @@
 // stepSimulation(dt, 0) per step; the links' damping off (Bullet's default damps every link by
 // 0.04), their rates clamped at Bullet's default 100 rad/s (unclamped, a chain of 20 falling from
 // level blew up within a second at dt 1/60: its explicit step in generalised coordinates, as
-// MuJoCo's Euler). Links collide with each other but not with the link they are jointed to, as
+// MuJoCo's Euler; with it, a step that leaves a joint's rate at the clamp is reported as the engine
+// unable to go on). Links collide with each other but not with the link they are jointed to, as
 // ours. A hinge's or slider's motor is a btMultiBodyJointMotor (its impulse bounded by the force
 // over a step), its limits a btMultiBodyJointLimitConstraint. Springs, cones, joint friction,
 // distance joints, free bodies beside the trees and trees not hanging from the world are refused.
@@ -23,6 +24,7 @@
 #include <btBulletDynamicsCommon.h>
 #pragma GCC diagnostic pop
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -78,6 +80,15 @@ class MultibodySimulation final : public Simulation {
     kicks_.clear();
     world_.stepSimulation(dt_, 0);
     current_ = false;
+    // A joint rate at Bullet's clamp means the motion has left what the step resolves (a chain
+    // of a hundred released level flails at kilometres a second within seconds, its joints held
+    // by construction): reported as the engine unable to go on, as MuJoCo's warnings are.
+    for (const auto& tree : trees_)
+      for (int link = 0; link < tree->getNumLinks(); ++link) {
+        const btScalar* rates = tree->getJointVelMultiDof(link);
+        for (int d = 0; d < tree->getLink(link).m_dofCount; ++d)
+          if (!(std::abs(rates[d]) < 0.999 * tree->getMaxCoordinateVelocity())) return false;
+      }
     return true;
   }
   std::size_t body_count() const override { return links_.size(); }
