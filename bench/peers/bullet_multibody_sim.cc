@@ -333,20 +333,19 @@ bool MultibodySimulation::build(const PeerScene& peer, const PeerOptions& option
       const std::size_t i = order[k];
       const SceneJoint& joint = scene.joints[*placements[i].joint];
       const double sign = i == joint.a ? -1 : 1;
-      if (joint.def.motor.enabled) {
-        auto motor = std::make_unique<btMultiBodyJointMotor>(
-            tree.get(), static_cast<int>(k), sign * joint.def.motor.speed,
-            joint.def.motor.max_force * scene.dt);
-        world_.addMultiBodyConstraint(motor.get());
-        constraints_.push_back(std::move(motor));
-      }
+      const auto keep = [this](std::unique_ptr<btMultiBodyConstraint> constraint) {
+        world_.addMultiBodyConstraint(constraint.get());
+        constraints_.push_back(std::move(constraint));
+      };
+      if (joint.def.motor.enabled)
+        keep(std::make_unique<btMultiBodyJointMotor>(tree.get(), static_cast<int>(k),
+                                                     sign * joint.def.motor.speed,
+                                                     joint.def.motor.max_force * scene.dt));
       if (joint.def.limit.enabled) {
         const double lower = sign > 0 ? joint.def.limit.lower : -joint.def.limit.upper;
         const double upper = sign > 0 ? joint.def.limit.upper : -joint.def.limit.lower;
-        auto limit = std::make_unique<btMultiBodyJointLimitConstraint>(
-            tree.get(), static_cast<int>(k), lower, upper);
-        world_.addMultiBodyConstraint(limit.get());
-        constraints_.push_back(std::move(limit));
+        keep(std::make_unique<btMultiBodyJointLimitConstraint>(tree.get(), static_cast<int>(k),
+                                                               lower, upper));
       }
     }
     trees_.push_back(std::move(tree));

@@ -92,24 +92,25 @@ double impulse_along(const Joint& joint) {
          (coordinate_friction(joint) ? joint.friction_impulse.x() : 0.0);
 }
 
-void prepare_axial_terms(const Joint& joint, const JointBodies& j, JointPoseTerms* terms) {
-  const SolverBody& b = j.body_b();
+void prepare_axial_terms(const Joint& joint, const SolverBody& a, const SolverBody& b,
+                         const Pose& pose_a, const Pose& pose_b, bool world_b,
+                         JointPoseTerms* terms) {
   terms->coordinate = FreeCoordinate{};
   terms->coordinate_mass = 0;
   if (has_drives(joint) || impulse_along(joint) != 0) {
-    terms->coordinate = free_coordinate(joint, j.pose_a, j.pose_b, j.world_b());
-    if (terms->coordinate.exists) terms->coordinate_mass = row_mass(terms->coordinate.row, *j.a, b);
+    terms->coordinate = free_coordinate(joint, pose_a, pose_b, world_b);
+    if (terms->coordinate.exists) terms->coordinate_mass = row_mass(terms->coordinate.row, a, b);
   }
   terms->swing = Swing{};
   terms->cone_mass = 0;
   if (has_cone(joint)) {
-    terms->swing = swing_of(joint, j.pose_a.orientation, j.pose_b.orientation);
-    if (terms->swing.exists) terms->cone_mass = row_mass(terms->swing.row, *j.a, b);
+    terms->swing = swing_of(joint, pose_a.orientation, pose_b.orientation);
+    if (terms->swing.exists) terms->cone_mass = row_mass(terms->swing.row, a, b);
   }
   terms->mobility_usable = false;
   if (turn_friction(joint)) {
     terms->mobility.setZero();
-    if (j.a->inverse_mass > 0) terms->mobility += j.a->inverse_inertia;
+    if (a.inverse_mass > 0) terms->mobility += a.inverse_inertia;
     if (b.inverse_mass > 0) terms->mobility += b.inverse_inertia;
     terms->mobility_solver.compute(terms->mobility);
     terms->mobility_usable =

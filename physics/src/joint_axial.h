@@ -19,8 +19,10 @@ bool has_axial_rows(const Joint& joint);
 // slider's friction); a rigid rod's, along it.
 double impulse_along(const Joint& joint);
 
-// The terms these rows read (joint_terms.h: the free coordinate, the cone, a ball's friction).
-void prepare_axial_terms(const Joint& joint, const joint_detail::JointBodies& j,
+// The terms these rows read (joint_terms.h: the free coordinate, the cone, a ball's friction), b
+// the world's body (joint_geometry.h, kWorldBody) and pose where world_b.
+void prepare_axial_terms(const Joint& joint, const SolverBody& a, const SolverBody& b,
+                         const Pose& pose_a, const Pose& pose_b, bool world_b,
                          JointPoseTerms* terms);
 
 // Applies the free coordinate's rows' impulses from the last step: the warm start.

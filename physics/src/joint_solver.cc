@@ -195,19 +195,17 @@ void prepare_joint_terms(const JointRow& row, std::span<const SolverBody> bodies
                          std::span<const Pose> poses, bool own_rows, JointPoseTerms* terms) {
   const Joint& joint = row.joint;
   const bool world_b = row.b == kWorldAnchor;
-  // (JointBodies writes through its bodies; nothing here does.)
-  SolverBody& a = const_cast<SolverBody&>(bodies[row.a]);
-  SolverBody* b = world_b ? nullptr : const_cast<SolverBody*>(&bodies[row.b]);
-  const JointBodies j{&a, b, poses[row.a], world_b ? Pose{} : poses[row.b]};
-  const SolverBody& body_b = j.body_b();
-  terms->anchors = anchors_of(joint, j.pose_a, j.pose_b, world_b);
-  prepare_axial_terms(joint, j, terms);
+  const SolverBody& a = bodies[row.a];
+  const SolverBody& body_b = world_b ? kWorldBody : bodies[row.b];
+  const Pose& pose_a = poses[row.a];
+  const Pose pose_b = world_b ? Pose{} : poses[row.b];
+  terms->anchors = anchors_of(joint, pose_a, pose_b, world_b);
+  prepare_axial_terms(joint, a, body_b, pose_a, pose_b, world_b, terms);
   if (!own_rows) return;
   switch (joint.kind) {
     case JointKind::kHinge:
-      terms->hinge =
-          hinge_rows(joint, j.pose_a.orientation, world_b ? nullptr : &j.pose_b.orientation,
-                     a.inverse_inertia + body_b.inverse_inertia);
+      terms->hinge = hinge_rows(joint, pose_a.orientation, world_b ? nullptr : &pose_b.orientation,
+                                a.inverse_inertia + body_b.inverse_inertia);
       terms->hinge_usable = terms->hinge.k.determinant() > 0;
       if (terms->hinge_usable) terms->hinge_solver.compute(terms->hinge.k);
       break;
@@ -222,7 +220,7 @@ void prepare_joint_terms(const JointRow& row, std::span<const SolverBody> bodies
       break;
   }
   if (joint.kind == JointKind::kSlider) {
-    terms->slider = slider_rows(joint, j.pose_a, j.pose_b, world_b, a, body_b);
+    terms->slider = slider_rows(joint, pose_a, pose_b, world_b, a, body_b);
     terms->slider_usable = terms->slider.k.determinant() > 0;
     if (terms->slider_usable) terms->slider_solver.compute(terms->slider.k);
   } else if (joint.kind != JointKind::kDistance) {
