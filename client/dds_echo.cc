@@ -93,6 +93,24 @@ Json body_json(const tumble_msgs_msg_dds__Body_& m) {
   if (m.shape == 1) out["half_height"] = m.half_height;
   if (m.shape == 2) out["half_extents"] = {m.half_extents[0], m.half_extents[1], m.half_extents[2]};
   if (m.shape == 3) out["hull_vertices"] = points(m.hull_vertices);
+  if (m.shape == 7) {
+    Json parts = Json::array();
+    for (std::uint32_t i = 0; i < m.parts._length; ++i) {
+      const tumble_msgs_msg_dds__BodyPart_& part = m.parts._buffer[i];
+      const auto& p = part.pose.position;
+      const auto& q = part.pose.orientation;
+      Json entry = {{"shape", part.shape < 4 ? shapes[part.shape] : "unknown"},
+                    {"p", {p.x, p.y, p.z}},
+                    {"q", {q.w, q.x, q.y, q.z}}};
+      if (part.shape == 0 || part.shape == 1) entry["radius"] = part.radius;
+      if (part.shape == 1) entry["half_height"] = part.half_height;
+      if (part.shape == 2)
+        entry["half_extents"] = {part.half_extents[0], part.half_extents[1], part.half_extents[2]};
+      if (part.shape == 3) entry["hull_vertices"] = points(part.hull_vertices);
+      parts.push_back(entry);
+    }
+    out["parts"] = parts;
+  }
   return out;
 }
 

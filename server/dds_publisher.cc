@@ -27,6 +27,7 @@ using PoseIds = tumble_msgs_msg_dds__BodyIds_;
 using Contacts = tumble_msgs_msg_dds__Contacts_;
 using Stats = tumble_msgs_msg_dds__StepStats_;
 using BodySample = tumble_msgs_msg_dds__Body_;
+using BodyPartSample = tumble_msgs_msg_dds__BodyPart_;
 using Transform = geometry_msgs_msg_dds__TransformStamped_;
 using TfMessage = tf2_msgs_msg_dds__TFMessage_;
 using Clock = rosgraph_msgs_msg_dds__Clock_;
@@ -118,6 +119,27 @@ void add_part_triangles(const Compound::Part& part, std::vector<Point>* out) {
             part.pose.transform(surface->vertices[surface->face_vertices[face.first + corner]]);
         out->push_back({v.x(), v.y(), v.z()});
       }
+}
+
+// A compound's part as the bodies topic gives it: its shape's sizes, a hull's vertices (in
+// `vertices`, which the sample views) and its pose in the body's frame.
+BodyPartSample part_sample(const Compound::Part& part, std::vector<Point>* vertices) {
+  BodyPartSample sample{};
+  const Shape& shape = part.shape;
+  sample.shape = static_cast<std::uint8_t>(shape.type());
+  sample.pose.position = {part.pose.position.x(), part.pose.position.y(), part.pose.position.z()};
+  const Quat& q = part.pose.orientation;
+  sample.pose.orientation = {q.x(), q.y(), q.z(), q.w()};
+  sample.radius = shape.radius();
+  sample.half_height = shape.half_height();
+  for (int k = 0; k < 3; ++k)
+    sample.half_extents[k] = shape.half_extents()[k];
+  vertices->clear();
+  if (shape.type() == ShapeType::kHull)
+    for (const Vec3& v : shape.polyhedron()->vertices)
+      vertices->push_back({v.x(), v.y(), v.z()});
+  sample.hull_vertices = view<dds_sequence_geometry_msgs_msg_dds__Point_>(*vertices);
+  return sample;
 }
 
 }  // namespace
@@ -464,6 +486,8 @@ void DdsPublisher::publish_catalogue(const FrameData& frame) {
   Writers& w = *writers_;
   const Catalogue& now = *frame.catalogue;
   std::vector<Point> vertices;
+  std::vector<BodyPartSample> parts;
+  std::vector<std::vector<Point>> part_vertices;  // each hull part's, viewed by its sample
   BodySample sample{};
   for (auto it = described_.begin(); it != described_.end();) {
     if (now.contains(it->first)) {
@@ -501,6 +525,14 @@ void DdsPublisher::publish_catalogue(const FrameData& frame) {
       for (const Vec3& v : shape.polyhedron()->vertices)
         vertices.push_back({v.x(), v.y(), v.z()});
     sample.hull_vertices = view<dds_sequence_geometry_msgs_msg_dds__Point_>(vertices);
+    parts.clear();
+    if (shape.type() == ShapeType::kCompound) {
+      const std::span<const Compound::Part> compound = shape.compound()->parts();
+      if (part_vertices.size() < compound.size()) part_vertices.resize(compound.size());
+      for (std::size_t i = 0; i < compound.size(); ++i)
+        parts.push_back(part_sample(compound[i], &part_vertices[i]));
+    }
+    sample.parts = view<dds_sequence_tumble_msgs_msg_dds__BodyPart_>(parts);
     sample.mass = look.mass;
     sample.color = look.colour;
     dds_write(w.bodies, &sample);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -314,6 +315,100 @@ TEST_F(DdsTest, ALateSubscriberLearnsEveryLiveBodyAndNoRemovedOne) {
     }
   EXPECT_EQ(described, live);
   EXPECT_FALSE(described.contains(spawned.ids(1)));
+}
+
+// A compound's parts reach the bodies topic as the gRPC stream describes them: each part's shape,
+// sizes, a hull's vertices and its pose in the body's frame (whose origin is the centre of mass,
+// so not the poses spawned), bit for bit.
+TEST_F(DdsTest, ACompoundsPartsReachTheBodiesTopicAsTheStreamDescribesThem) {
+  Server server;
+  server.start({"--paused", "--dds", "--dds-domain", own_domain(), "--standard", "pyramid:2"});
+  auto stub = connect(server);
+  v1::SpawnBodiesRequest spawn;
+  v1::BodySpec* body = spawn.add_bodies();
+  body->mutable_position()->set_z(3);
+  v1::Compound* compound = body->mutable_shape()->mutable_compound();
+  const auto part_at = [&](double x, double y, double z) {
+    v1::CompoundPart* part = compound->add_parts();
+    part->mutable_position()->set_x(x);
+    part->mutable_position()->set_y(y);
+    part->mutable_position()->set_z(z);
+    return part;
+  };
+  v1::CompoundPart* slab = part_at(0, 0, 0.4);
+  slab->mutable_shape()->mutable_box()->mutable_size()->set_x(1.2);
+  slab->mutable_shape()->mutable_box()->mutable_size()->set_y(0.8);
+  slab->mutable_shape()->mutable_box()->mutable_size()->set_z(0.1);
+  slab->mutable_orientation()->set_w(std::sqrt(0.5));
+  slab->mutable_orientation()->set_z(std::sqrt(0.5));
+  part_at(0.5, 0, 0)->mutable_shape()->mutable_sphere()->set_radius(0.2);
+  v1::Capsule* leg = part_at(-0.3, 0.1, 0)->mutable_shape()->mutable_capsule();
+  leg->set_radius(0.05);
+  leg->set_half_height(0.3);
+  v1::Hull* wedge = part_at(0, -0.4, -0.2)->mutable_shape()->mutable_hull();
+  for (double coordinate : {0., 0., 0., 0.3, 0., 0., 0., 0.3, 0., 0., 0., 0.3, 0.2, 0.2, 0.2})
+    wedge->add_points(coordinate);
+
+  grpc::ClientContext stream_context;
+  auto reader = stub->StreamFrames(&stream_context, {});
+  std::mutex mutex;
+  std::map<std::uint64_t, v1::BodyDescription> described;
+  std::thread streaming([&] {
+    v1::Frame frame;
+    while (reader->Read(&frame)) {
+      std::lock_guard lock(mutex);
+      for (const v1::BodyDescription& added : frame.added())
+        described[added.id()] = added;
+    }
+  });
+  v1::SpawnBodiesResponse spawned;
+  {
+    grpc::ClientContext context;
+    ASSERT_TRUE(stub->SpawnBodies(&context, spawn, &spawned).ok());
+  }
+  step_one_at_a_time(*stub, 2);
+  Echo echo("--topics bodies --timeout 3");
+  const std::vector<Json> lines = echo.finish();
+  stream_context.TryCancel();
+  streaming.join();
+
+  const std::uint64_t id = spawned.ids(0);
+  ASSERT_TRUE(described.contains(id));
+  const v1::Compound& parts = described.at(id).shape().compound();
+  ASSERT_EQ(parts.parts_size(), 4);
+  int seen = 0;
+  for (const Json& line : lines) {
+    if (line.contains("removed") || line["id"] != id) continue;
+    ++seen;
+    ASSERT_EQ(line["shape"], "compound");
+    ASSERT_EQ(line["parts"].size(), 4u);
+    const char* kinds[] = {"box", "sphere", "capsule", "hull"};
+    for (int i = 0; i < 4; ++i) {
+      const Json& part = line["parts"][i];
+      const v1::CompoundPart& expected = parts.parts(i);
+      EXPECT_EQ(part["shape"], kinds[i]);
+      EXPECT_EQ(part["p"],
+                Json({expected.position().x(), expected.position().y(), expected.position().z()}));
+      EXPECT_EQ(part["q"], Json({expected.orientation().w(), expected.orientation().x(),
+                                 expected.orientation().y(), expected.orientation().z()}));
+    }
+    const v1::Vec3& size = parts.parts(0).shape().box().size();
+    EXPECT_EQ(line["parts"][0]["half_extents"],
+              Json({0.5 * size.x(), 0.5 * size.y(), 0.5 * size.z()}));
+    EXPECT_EQ(line["parts"][1]["radius"], parts.parts(1).shape().sphere().radius());
+    EXPECT_EQ(line["parts"][2]["radius"], parts.parts(2).shape().capsule().radius());
+    EXPECT_EQ(line["parts"][2]["half_height"], parts.parts(2).shape().capsule().half_height());
+    const auto& points = parts.parts(3).shape().hull().points();
+    Json vertices = Json::array();
+    for (int k = 0; k + 2 < points.size(); k += 3)
+      vertices.push_back({points[k], points[k + 1], points[k + 2]});
+    EXPECT_EQ(line["parts"][3]["hull_vertices"], vertices);
+    EXPECT_EQ(vertices.size(), 5u);
+  }
+  EXPECT_EQ(seen, 1);
+  // The parts are where the body's frame puts them: the centre of mass moved off the spawn's
+  // origin, so the sphere's part is not at the 0.5, 0, 0 it was given.
+  EXPECT_NE(parts.parts(1).position().z(), 0.0);
 }
 
 // A world with joints publishes sensor_msgs/JointState on /joint_states (as robot_state_publisher

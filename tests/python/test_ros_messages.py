@@ -55,7 +55,7 @@ def msg_fields(path):
 
 def test_the_ros_package_defines_the_idl_types_field_for_field():
     structs = idl_structs("tumble_msgs")
-    assert sorted(structs) == ["Body", "BodyIds", "Contacts", "StepStats"]
+    assert sorted(structs) == ["Body", "BodyIds", "BodyPart", "Contacts", "StepStats"]
     directory = os.path.join(SOURCE, "ros", "tumble_msgs", "msg")
     assert sorted(os.listdir(directory)) == sorted(f"{name}.msg" for name in structs)
     for name, members in structs.items():
