@@ -19,6 +19,7 @@
 #include "client.h"
 #include "frame_format.h"
 #include "recording.h"
+#include "scenes/hull_points.h"
 #include "scenes/mesh_file_reader.h"
 #include "tumble/command_line.h"
 
@@ -121,7 +122,7 @@ constexpr int kMaxHeightSamples = 1 << 22;
 constexpr std::size_t kMaxMeshVertices = std::size_t{1} << 21;
 constexpr std::size_t kMaxMeshTriangles = std::size_t{1} << 21;
 // The most points a hull may be given (the engine's kMaxHullPoints: the server refuses more).
-constexpr std::size_t kMaxHullPoints = 1024;
+constexpr std::size_t kMaxHullPoints = mesh_files::kMaxHullInputPoints;
 
 // A heightfield's heights from a text file: one row of samples along x per line, the rows along
 // y from the lowest y up, numbers parted by spaces or commas; blank lines and lines starting with
@@ -226,15 +227,44 @@ Status read_parts(SpawnOptions* options) {
   return Status::ok();
 }
 
-// A hull's --point options into its points; --point belongs to a hull only. The server builds the
-// hull and names what is wrong with it (fewer than four points spanning a volume).
+// A hull of a mesh file's vertices: all of them up to kMaxHullPoints, past that the farthest
+// towards each of kMaxHullPoints directions (mesh_files::hull_point_indices), said on stderr.
+Status read_hull_file(SpawnOptions* options) {
+  mesh_files::Arrays mesh;
+  if (std::string error = mesh_files::read(options->mesh_file, options->mesh_scale,
+                                           kMaxMeshVertices, kMaxMeshTriangles, &mesh);
+      !error.empty())
+    return Status::error("--file: " + error);
+  const std::size_t vertices = mesh.xyz.size() / 3;
+  const std::vector<std::size_t> kept = mesh_files::hull_point_indices(mesh.xyz, kMaxHullPoints);
+  if (kept.size() < vertices)
+    std::fprintf(stderr,
+                 "%s: %zu vertices, more than the %zu a hull may be given: its hull is made of the "
+                 "%zu farthest towards %zu directions spread over the sphere\n",
+                 options->mesh_file.c_str(), vertices, kMaxHullPoints, kept.size(), kMaxHullPoints);
+  for (std::size_t i : kept)
+    for (int k = 0; k < 3; ++k)
+      options->hull.add_points(mesh.xyz[3 * i + k]);
+  return Status::ok();
+}
+
+// A hull's --point options (or --file) into its points; --point belongs to a hull only, --file to
+// a hull or a mesh. The server builds the hull and names what is wrong with it (fewer than four
+// points spanning a volume).
 Status read_points(SpawnOptions* options) {
+  if (!options->mesh_file.empty() && options->shape != "hull" && options->shape != "mesh")
+    return Status::error("--file: only a hull or a mesh comes from a file");
   if (options->shape != "hull") {
     if (!options->points.empty()) return Status::error("--point: only a hull has points");
     return Status::ok();
   }
+  if (!options->mesh_file.empty()) {
+    if (!options->points.empty())
+      return Status::error("--file: a hull comes from --point or from --file, not both");
+    return read_hull_file(options);
+  }
   if (options->points.empty())
-    return Status::error("--point: a hull needs its points (X,Y,Z each, at least four)");
+    return Status::error("--point: a hull needs its points (X,Y,Z each, at least four), or --file");
   if (options->points.size() > kMaxHullPoints)
     return Status::error("--point: " + std::to_string(options->points.size()) +
                          " points, more than the " + std::to_string(kMaxHullPoints) +
@@ -277,14 +307,18 @@ void add_shape_options(CLI::App* command, SpawnOptions* options, bool terrain = 
     command->add_option("--spacing", options->spacing, "heightfield: x,y between samples (m)")
         ->delimiter(',')
         ->expected(2);
-    command
-        ->add_option("--file", options->mesh_file,
-                     "mesh: a mesh file (OBJ, STL, PLY and the others Assimp reads); its "
-                     "triangles face the side their corners run counter-clockwise from")
-        ->check(cli::existing_file);
-    command->add_option("--scale", options->mesh_scale,
-                        "mesh: multiplies every coordinate of the file (0.01 for cm)");
   }
+  command
+      ->add_option("--file", options->mesh_file,
+                   std::string(terrain ? "mesh: a mesh file (OBJ, STL, PLY and the others Assimp "
+                                         "reads); its triangles face the side their corners run "
+                                         "counter-clockwise from. "
+                                       : "") +
+                       "hull: the convex hull of a mesh file's vertices (past 1024 of them, of "
+                       "the farthest towards 1024 directions spread over the sphere)")
+      ->check(cli::existing_file);
+  command->add_option("--scale", options->mesh_scale,
+                      "mesh, hull: multiplies every coordinate of the file (0.01 for cm)");
   command->add_option("--part", options->parts,
                       "compound: one part, KIND:SIZES@X,Y,Z[@W,X,Y,Z] (box:SX,SY,SZ, sphere:R or "
                       "capsule:R,HALF_HEIGHT at X,Y,Z in the body's frame); repeat for each");

@@ -8,11 +8,13 @@
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -393,6 +395,67 @@ TEST(ServerProcess, CliSpawnsAHullOfPoints) {
   EXPECT_NE(misplaced.code, 0);
   EXPECT_NE(misplaced.text.find("--point: only a hull has points"), std::string::npos)
       << misplaced.text;
+}
+
+// A hull of a mesh file's vertices: a ball of radius 0.5 m in cm, 60 rings of 120 vertices
+// (7,082, more than the 1024 a hull may be given): the CLI says it keeps the farthest towards
+// 1024 directions, the server builds the hull, a ray 0.49 m off its axis hits it and one 0.51 m
+// off misses; overlap takes the file too; a file given to a box, or with points, is refused.
+TEST(ServerProcess, CliSpawnsAHullOfAMeshFile) {
+  Server server;
+  ASSERT_NO_FATAL_FAILURE(server.start({"--paused"}));
+  const std::string tumble = cli(server);
+  TempDir dir;
+  {
+    std::ofstream obj(dir / "ball.obj");
+    const int rings = 60, around = 120;
+    obj << "v 0 0 50\n";
+    for (int i = 1; i < rings; ++i)
+      for (int j = 0; j < around; ++j) {
+        const double polar = std::numbers::pi * i / rings,
+                     azimuth = 2 * std::numbers::pi * j / around;
+        obj << "v " << 50 * std::sin(polar) * std::cos(azimuth) << ' '
+            << 50 * std::sin(polar) * std::sin(azimuth) << ' ' << 50 * std::cos(polar) << '\n';
+      }
+    obj << "v 0 0 -50\n";
+    const int last = 2 + (rings - 1) * around;  // the south pole's index (from 1)
+    const auto at = [&](int ring, int j) { return 2 + (ring - 1) * around + j % around; };
+    for (int j = 0; j < around; ++j) {
+      obj << "f 1 " << at(1, j) << ' ' << at(1, j + 1) << '\n';
+      for (int i = 1; i + 1 < rings; ++i)
+        obj << "f " << at(i, j) << ' ' << at(i + 1, j) << ' ' << at(i + 1, j + 1) << ' '
+            << at(i, j + 1) << '\n';
+      obj << "f " << last << ' ' << at(rings - 1, j + 1) << ' ' << at(rings - 1, j) << '\n';
+    }
+  }
+  const std::string ball = "--file " + (dir / "ball.obj") + " --scale 0.01 ";
+  const Output spawned = run(tumble + "spawn hull " + ball + "--pos 100,0,5");
+  ASSERT_EQ(spawned.code, 0) << spawned.text;
+  EXPECT_NE(spawned.text.find("ball.obj: 7082 vertices, more than the 1024 a hull may be given"),
+            std::string::npos)
+      << spawned.text;
+  const std::string id =
+      spawned.text.substr(spawned.text.rfind('\n', spawned.text.size() - 2) + 1, std::string::npos);
+  ASSERT_FALSE(id.empty());
+  const std::string body = id.substr(0, id.find('\n'));
+  const Output hit = run(tumble + "ray --from 100.49,0,8 --dir 0,0,-1");
+  ASSERT_EQ(hit.code, 0) << hit.text;
+  EXPECT_NE(hit.text.find(body), std::string::npos) << hit.text;
+  const Output miss = run(tumble + "ray --from 100.51,0,8 --dir 0,0,-1 --max-distance 5");
+  ASSERT_EQ(miss.code, 0) << miss.text;
+  EXPECT_EQ(miss.text.find(body), std::string::npos) << miss.text;
+  const Output overlapping = run(tumble + "overlap hull " + ball + "--pos 100,0,5.9");
+  ASSERT_EQ(overlapping.code, 0) << overlapping.text;
+  EXPECT_NE(overlapping.text.find(body), std::string::npos) << overlapping.text;
+  const Output boxed = run(tumble + "spawn box " + ball);
+  EXPECT_NE(boxed.code, 0);
+  EXPECT_NE(boxed.text.find("--file: only a hull or a mesh comes from a file"), std::string::npos)
+      << boxed.text;
+  const Output both = run(tumble + "spawn hull " + ball + "--point 0,0,0");
+  EXPECT_NE(both.code, 0);
+  EXPECT_NE(both.text.find("--file: a hull comes from --point or from --file, not both"),
+            std::string::npos)
+      << both.text;
 }
 
 TEST(ServerProcess, OversizedRequestsAreRefusedAndChangeNothing) {

@@ -1,8 +1,12 @@
 #include "scenes/mesh_file.h"
 
+#include "scenes/hull_points.h"
 #include "scenes/mesh_file_reader.h"
 
 namespace tumble {
+
+static_assert(mesh_files::kMaxHullInputPoints == kMaxHullPoints,
+              "the hull reduction keeps as many points as the engine takes");
 
 Result<TriangleMeshDef> read_mesh_file(const std::string& path, double scale) {
   mesh_files::Arrays arrays;
@@ -19,6 +23,18 @@ Result<TriangleMeshDef> read_mesh_file(const std::string& path, double scale) {
     mesh.triangles.push_back(
         {arrays.triangles[k], arrays.triangles[k + 1], arrays.triangles[k + 2]});
   return mesh;
+}
+
+Result<HullDef> read_hull_file(const std::string& path, double scale) {
+  mesh_files::Arrays arrays;
+  if (std::string error =
+          mesh_files::read(path, scale, kMaxMeshVertices, kMaxMeshTriangles, &arrays);
+      !error.empty())
+    return Status::error(error);
+  HullDef hull;
+  for (std::size_t i : mesh_files::hull_point_indices(arrays.xyz, kMaxHullPoints))
+    hull.points.emplace_back(arrays.xyz[3 * i], arrays.xyz[3 * i + 1], arrays.xyz[3 * i + 2]);
+  return hull;
 }
 
 }  // namespace tumble

@@ -270,6 +270,20 @@ ShapeDef read_shape(ObjectReader& r) {
   if (type == "hull") {
     const Json* points = r.find("points");
     const std::string path = r.child("points");
+    if (const Json* file = r.find("file")) {
+      // As a mesh's file: read only from scene files on disk, relative to the scene's folder.
+      if (points != nullptr)
+        fail(r.child("file"), "a hull comes from a file or from points, not both");
+      if (!file->is_string() || file->get<std::string>().empty())
+        fail(r.child("file"), "must be the path of a mesh file (OBJ, STL, PLY, ...)");
+      if (mesh_folder == nullptr)
+        fail(r.child("file"), "mesh files are read only from scene files on disk; send points");
+      const double scale = positive(r, "scale", 1);
+      Result<HullDef> hull =
+          read_hull_file((*mesh_folder / file->get<std::string>()).string(), scale);
+      if (!hull) fail(r.child("file"), hull.status().message());
+      return std::move(hull).value();
+    }
     if (points == nullptr || !points->is_array() || points->size() < 4)
       fail(path, "must be an array of at least 4 points [x, y, z]");
     HullDef hull;
