@@ -6,6 +6,8 @@
 #include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
@@ -50,9 +52,12 @@ class BulletSimulation final : public Simulation {
   }
 
   // False (with the reason) for a shape this adapter does not map.
-  bool add(const BodyDef& def, double mass, const Vec3& inertia, const PeerOptions& options,
-           std::string* why_not) {
+  bool add(const BodyDef& def, double mass, Vec3 inertia, const Vec3& centre_of_mass,
+           const Mat3& inertia_tensor, const PeerOptions& options, std::string* why_not) {
     std::unique_ptr<btCollisionShape> shape;
+    // Bullet's body frame is its centre of mass on its principal axes: the shape's frame turned
+    // by `principal` and moved to the centre of mass (the identity but for compounds).
+    Quat principal = Quat::Identity();
     btTransform pose(btQuaternion(def.orientation.x(), def.orientation.y(), def.orientation.z(),
                                   def.orientation.w()),
                      to_bt(def.position));
@@ -67,26 +72,22 @@ class BulletSimulation final : public Simulation {
     } else if (const auto* capsule = std::get_if<CapsuleDef>(&def.shape)) {
       shape = std::make_unique<btCapsuleShapeZ>(capsule->radius, 2 * capsule->half_height);
     } else if (const auto* compound = std::get_if<CompoundDef>(&def.shape)) {
-      // A btCompoundShape of the parts at their poses. Bullet takes a body's frame as its centre
-      // of mass and principal axes, so only compounds whose centre of mass is their frame's
-      // origin are mapped (the caller's inertia is about it).
-      // (This module is built apart from the engine: the volumes are worked out here.)
-      Vec3 moment = Vec3::Zero();
-      double volume = 0;
-      for (const CompoundPart& part : compound->parts) {
-        double v = 0;
-        if (const auto* box = std::get_if<BoxDef>(&part.shape)) v = 8 * box->half_extents.prod();
-        if (const auto* ball = std::get_if<SphereDef>(&part.shape))
-          v = 4.0 / 3.0 * M_PI * std::pow(ball->radius, 3);
-        if (const auto* rod = std::get_if<CapsuleDef>(&part.shape))
-          v = M_PI * rod->radius * rod->radius * (2 * rod->half_height + 4.0 / 3.0 * rod->radius);
-        moment += v * part.pose.position;
-        volume += v;
+      // A btCompoundShape of the parts at their poses in Bullet's body frame: from the shape's
+      // frame, moved to the centre of mass and turned onto the principal axes of the inertia
+      // tensor (its eigenvectors; the shape's own axes where the tensor is diagonal already, as
+      // for a compound symmetric about them). The body is placed there, and body() turns its
+      // orientation back to the shape's, as ours reports it.
+      const bool diagonal =
+          (inertia_tensor - Mat3(inertia_tensor.diagonal().asDiagonal())).cwiseAbs().maxCoeff() ==
+          0;
+      if (!diagonal) {
+        const Eigen::SelfAdjointEigenSolver<Mat3> axes(inertia_tensor);
+        Mat3 turn = axes.eigenvectors();
+        if (turn.determinant() < 0) turn.col(2) = -turn.col(2);
+        principal = Quat(turn).normalized();
+        inertia = axes.eigenvalues();
       }
-      if ((moment / volume).norm() > 1e-9) {
-        *why_not = "compounds with their centre of mass off their frame's origin are not mapped";
-        return false;
-      }
+      const Quat to_principal = principal.conjugate();
       auto parts = std::make_unique<btCompoundShape>();
       for (const CompoundPart& part : compound->parts) {
         std::unique_ptr<btCollisionShape> child;
@@ -100,13 +101,17 @@ class BulletSimulation final : public Simulation {
           *why_not = "hull parts of compounds are not mapped to Bullet";
           return false;
         }
-        const Quat& q = part.pose.orientation;
+        const Quat q = to_principal * part.pose.orientation;
         parts->addChildShape(
-            btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), to_bt(part.pose.position)),
+            btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()),
+                        to_bt(to_principal * (part.pose.position - centre_of_mass))),
             child.get());
         shapes_.push_back(std::move(child));
       }
       shape = std::move(parts);
+      const Quat placed = def.orientation * principal;
+      pose = btTransform(btQuaternion(placed.x(), placed.y(), placed.z(), placed.w()),
+                         to_bt(def.position + def.orientation * centre_of_mass));
     } else if (const auto* mesh = std::get_if<TriangleMeshDef>(&def.shape)) {
       // A btBvhTriangleMeshShape as a user makes one, without btAdjustInternalEdgeContacts (an
       // optional contact callback): its inner edges are what the mesh scenes measure.
@@ -163,7 +168,10 @@ class BulletSimulation final : public Simulation {
       kinematic_.push_back({states_.back().get(), def.linear_velocity, def.angular_velocity});
     }
     world_.addRigidBody(body);
-    if (!is_static) dynamic_.push_back(body);
+    if (!is_static) {
+      dynamic_.push_back(body);
+      principal_.push_back(principal);
+    }
     return true;
   }
 
@@ -261,7 +269,7 @@ class BulletSimulation final : public Simulation {
     const btRigidBody* b = dynamic_[i];
     const btTransform& t = b->getCenterOfMassTransform();
     const btQuaternion r = t.getRotation();
-    return {from_bt(t.getOrigin()), Quat(r.w(), r.x(), r.y(), r.z()),
+    return {from_bt(t.getOrigin()), Quat(r.w(), r.x(), r.y(), r.z()) * principal_[i].conjugate(),
             from_bt(b->getLinearVelocity()), from_bt(b->getAngularVelocity())};
   }
 
@@ -280,6 +288,7 @@ class BulletSimulation final : public Simulation {
   std::vector<std::unique_ptr<btDefaultMotionState>> states_;
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
   std::vector<btRigidBody*> dynamic_;
+  std::vector<Quat> principal_;  // dynamic_[i]'s principal axes in its shape's frame
   struct Kinematic {
     btDefaultMotionState* state;
     Vec3 linear_velocity, angular_velocity;
@@ -291,7 +300,8 @@ class BulletSimulation final : public Simulation {
 Simulation* build(const PeerScene& peer, const PeerOptions& options, std::string* why_not) {
   auto simulation = std::make_unique<BulletSimulation>(*peer.scene, options);
   for (std::size_t i = 0; i < peer.scene->bodies.size(); ++i)
-    if (!simulation->add(peer.scene->bodies[i], peer.mass[i], peer.inertia[i], options, why_not))
+    if (!simulation->add(peer.scene->bodies[i], peer.mass[i], peer.inertia[i],
+                         peer.centre_of_mass[i], peer.inertia_tensor[i], options, why_not))
       return nullptr;
   for (const SceneJoint& joint : peer.scene->joints)
     if (!simulation->join(joint, why_not)) return nullptr;

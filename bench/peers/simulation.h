@@ -47,7 +47,11 @@ class Simulation {
 struct PeerScene {
   const SceneDef* scene = nullptr;
   std::vector<double> mass;
-  std::vector<Vec3> inertia;
+  std::vector<Vec3> inertia;  // the diagonal of inertia_tensor: the principal moments but for
+                              // hulls and compounds, whose axes need not be principal
+  std::vector<Vec3> centre_of_mass;  // m, in the shape's frame (off its origin for hulls and
+                                     // compounds)
+  std::vector<Mat3> inertia_tensor;  // kg m^2, about the centre of mass, in the shape's axes
 };
 PeerScene peer_scene(const SceneDef& scene);
 

@@ -71,6 +71,8 @@ PeerScene peer_scene(const SceneDef& scene) {
     Result<MassProperties> body = body_mass_properties(def);
     peer.mass.push_back(body ? body.value().mass : 0);
     peer.inertia.push_back(body ? Vec3(body.value().inertia.diagonal()) : Vec3::Zero());
+    peer.centre_of_mass.push_back(body ? body.value().center_of_mass : Vec3::Zero());
+    peer.inertia_tensor.push_back(body ? body.value().inertia : Mat3::Zero());
   }
   return peer;
 }
