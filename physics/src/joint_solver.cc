@@ -19,7 +19,8 @@ using namespace joint_detail;
 // How far an anchor r (from the centre of mass) moves over a move of h: the body's translation
 // and its exact turn, as the move makes them.
 Vec3 anchor_move(const SolverBody& body, const Vec3& r, double h) {
-  return h * body.v + (rotation_quaternion(h * body.w) * r - r);
+  const Vec3 theta = h * body.w;
+  return h * body.v + (theta.cross(r) + turn_curvature(theta, r));
 }
 // The same with the body's turn over the move, rotation_quaternion(h w), known.
 Vec3 anchor_move(const SolverBody& body, const Quat& turn, const Vec3& r, double h) {
@@ -53,10 +54,8 @@ double solve_point(JointRow& row, JointBodies& j, const JointPoseTerms& terms,
   // The move's drift beyond the velocities' first order (the turns' curvature), which the
   // velocities must cancel to end the move on the joint.
   Vec3 drift = Vec3::Zero();
-  if (t.h > 0) {
-    drift = anchor_move(b, anchors.rb, t.h) - anchor_move(*j.a, anchors.ra, t.h) -
-            t.h * anchor_velocity(j, anchors);
-  }
+  if (t.h > 0)
+    drift = turn_curvature(t.h * b.w, anchors.rb) - turn_curvature(t.h * j.a->w, anchors.ra);
   const Vec3 impulse = -terms.point_solver.solve(anchor_velocity(j, anchors) +
                                                  drift_velocity(drift, t.h, t.most_speed));
   row.joint.linear_impulse += impulse;
@@ -93,9 +92,12 @@ double solve_hinge_axes(JointRow& row, JointBodies& j, const JointTarget& t,
   Eigen::Vector2d velocity(relative_w.dot(g1), relative_w.dot(g2));
   if (t.h > 0) {
     // The turns' curvature over the move, beyond the velocities' first order.
-    const Quat turn_a = rotation_quaternion(t.h * j.a->w);
-    const Quat turn_b = rotation_quaternion(t.h * b.w);
-    const Vec3 a_next = turn_a * axis_a, b2_next = turn_b * b2, c2_next = turn_b * c2;
+    const Vec3 turn_a = t.h * j.a->w, turn_b = t.h * b.w;
+    const auto turned = [](const Vec3& theta, const Vec3& r) {
+      return Vec3(r + theta.cross(r) + turn_curvature(theta, r));
+    };
+    const Vec3 a_next = turned(turn_a, axis_a), b2_next = turned(turn_b, b2),
+               c2_next = turned(turn_b, c2);
     const Vec3 drift(a_next.dot(b2_next) - axis_a.dot(b2) - t.h * velocity.x(),
                      a_next.dot(c2_next) - axis_a.dot(c2) - t.h * velocity.y(), 0);
     const Vec3 extra = drift_velocity(drift, t.h, t.most_speed);

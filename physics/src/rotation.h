@@ -21,6 +21,31 @@ inline Quat rotation_quaternion(const Vec3& theta) {
   return Quat(std::cos(half), axis.x(), axis.y(), axis.z());
 }
 
+// Where the rotation by `theta` takes r, less r and less the first-order theta x r: the turn's
+// curvature, (sin t / t - 1) theta x r + ((1 - cos t) / t^2) theta x (theta x r) with t = |theta|
+// (Rodrigues' formula). Below t = 0.25 rad both factors are their Taylor series to the t^10
+// terms (the next ones below 1e-15 of the sums), with no square root, sine or cosine: the
+// joints' velocity rows ask this of both bodies at every visit.
+inline Vec3 turn_curvature(const Vec3& theta, const Vec3& r) {
+  const double t2 = theta.squaredNorm();
+  const Vec3 across = theta.cross(r);
+  double first, second;
+  if (t2 < 0.0625) {
+    // -1/3!, 1/5!, ... and 1/2!, -1/4!, ...: Horner's rule in t^2.
+    constexpr double s1 = -1.0 / 6, s2 = 1.0 / 120, s3 = -1.0 / 5040, s4 = 1.0 / 362880,
+                     s5 = -1.0 / 39916800;
+    constexpr double c0 = 1.0 / 2, c1 = -1.0 / 24, c2 = 1.0 / 720, c3 = -1.0 / 40320,
+                     c4 = 1.0 / 3628800, c5 = -1.0 / 479001600;
+    first = t2 * (s1 + t2 * (s2 + t2 * (s3 + t2 * (s4 + t2 * s5))));
+    second = c0 + t2 * (c1 + t2 * (c2 + t2 * (c3 + t2 * (c4 + t2 * c5))));
+  } else {
+    const double t = std::sqrt(t2);
+    first = std::sin(t) / t - 1;
+    second = (1 - std::cos(t)) / t2;
+  }
+  return first * across + second * theta.cross(across);
+}
+
 // `q` turned by `theta` given in world axes, renormalised against drift.
 inline Quat rotated(const Quat& q, const Vec3& theta) {
   return (rotation_quaternion(theta) * q).normalized();
