@@ -13,7 +13,8 @@ Built from proto/tumble/v1/world.proto by `make python` into build/python (docs/
 from tumble.bodies import Body, BodySpec, Description
 from tumble.errors import ArgumentError, Error
 from tumble.frames import Contacts, Frame, FrameStream, JointStates
-from tumble.shapes import Box, Capsule, Compound, HeightField, Hull, Mesh, Part, Plane, Sphere
+from tumble.shapes import (Box, Capsule, Compound, HeightField, Hull, Mesh, Part, Plane, Sphere,
+                           hull_points)
 from tumble.local import World
 from tumble.world import Info, LoadedScene, RemoteWorld, Settings, Snapshot, States, connect
 
@@ -22,5 +23,5 @@ __all__ = [
     "Frame", "FrameStream", "HeightField", "Hull", "Info", "JointStates", "LoadedScene", "Mesh", "Part", "Plane",
     "Settings",
     "Snapshot",
-    "RemoteWorld", "Sphere", "States", "World", "connect",
+    "RemoteWorld", "Sphere", "States", "World", "connect", "hull_points",
 ]

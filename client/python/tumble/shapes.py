@@ -58,6 +58,36 @@ class Hull:
         return shape
 
 
+def hull_points(points, max_points=1024):
+    """The points of an (N, 3) cloud to give a hull (which takes at most 1024): all of them when
+    they are at most `max_points`; else, for each of `max_points` directions spread evenly over
+    the sphere (a Fibonacci lattice, half a step off the axes' planes), the point farthest along
+    it, each once, in the cloud's order. The CLI's `spawn hull --file` and scene files' hulls from
+    mesh files keep the same points: a box keeps its 8 corners, a finely tessellated ball of radius
+    r keeps max_points vertices whose hull lies within about 0.0034 r of it (docs/SCENES.md)."""
+    cloud = convert.points(points, "points")
+    if not (isinstance(max_points, int) and max_points >= 4):
+        raise ArgumentError("max_points: must be an int of at least 4")
+    if len(cloud) <= max_points:
+        return cloud
+    k = np.arange(max_points, dtype=float)
+    z = 1 - (2 * k + 1) / max_points
+    ring = np.sqrt(np.maximum(0.0, 1 - z * z))
+    longitude = np.pi * (3 - np.sqrt(5.0)) * (k + 0.5)
+    directions = np.stack([ring * np.cos(longitude), ring * np.sin(longitude), z], axis=1)
+    # In slices of the cloud, so that a million points do not take directions x points of memory.
+    best = np.zeros(max_points, dtype=np.int64)
+    farthest = np.full(max_points, -np.inf)
+    for start in range(0, len(cloud), 8192):
+        along = directions @ cloud[start:start + 8192].T
+        here = np.argmax(along, axis=1)
+        value = along[np.arange(max_points), here]
+        better = value > farthest
+        best[better] = start + here[better]
+        farthest[better] = value[better]
+    return cloud[np.unique(best)]
+
+
 @dataclass(frozen=True)
 class Plane:
     """The half-space z <= 0 of the body's frame: a ground (static bodies only)."""
