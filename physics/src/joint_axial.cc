@@ -28,10 +28,6 @@ double stretch(const Joint& joint, double position) {
   return is_angle(joint.kind) ? wrapped(d) : d;
 }
 
-bool has_cone(const Joint& joint) {
-  return joint.kind == JointKind::kBall && joint.max_swing < kPi;
-}
-
 AxialRow negated(const AxialRow& row) {
   return {-row.linear, -row.angular_a, -row.angular_b};
 }
@@ -80,6 +76,10 @@ bool has_drives(const Joint& joint) {
 }
 
 }  // namespace
+
+bool has_cone(const Joint& joint) {
+  return joint.kind == JointKind::kBall && joint.max_swing < kPi;
+}
 
 bool has_axial_rows(const Joint& joint) {
   return joint.spring.enabled || joint.motor.enabled || joint.limit.enabled || has_cone(joint) ||

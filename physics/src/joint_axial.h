@@ -14,6 +14,8 @@ namespace tumble {
 
 // Whether the joint has any of these rows (a spring, motor, limit or cone).
 bool has_axial_rows(const Joint& joint);
+// Whether it is a ball with a swing cone.
+bool has_cone(const Joint& joint);
 
 // The impulse the rows above gave along the free coordinate (limit, motor, spring, a hinge's or
 // slider's friction); a rigid rod's, along it.

@@ -591,16 +591,66 @@ bool motor_row(const JointRow& row, const JointEquations& equations) {
          (row.joint.kind == JointKind::kHinge || row.joint.kind == JointKind::kSlider);
 }
 
+namespace {
+
+// The joint's bounds as rows after its own, targets minus how far the poses are past them: the
+// ones past now (and a locked limit) where `choose`, setting *which; else those in *which, past
+// or not (the rows of the factoring their targets are solved with).
+template <class Out>
+void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses, bool choose,
+                       std::uint8_t* which) {
+  const Joint& joint = row.joint;
+  const bool world_b = row.b == kWorldAnchor;
+  const Pose& pose_a = poses[row.a];
+  const Pose pose_b = world_b ? Pose{} : poses[row.b];
+  const auto add = [&](const AxialRow& axial, double past) {
+    const int i = e.rows++;
+    if constexpr (std::is_same_v<Out, JointEquations>) {
+      e.on_a.template block<1, 3>(i, 0) = -axial.linear.transpose();
+      e.on_a.template block<1, 3>(i, 3) = axial.angular_a.transpose();
+      e.on_b.template block<1, 3>(i, 0) = axial.linear.transpose();
+      e.on_b.template block<1, 3>(i, 3) = axial.angular_b.transpose();
+    }
+    e.target[i] = -past;
+  };
+  if (choose) *which = 0;
+  if (has_cone(joint) && (choose || (*which & kConeRow))) {
+    const Swing swing = swing_of(joint, pose_a.orientation, pose_b.orientation);
+    const double over = swing.exists ? swing.angle - joint.max_swing : 0.0;
+    if (!choose || (swing.exists && over > 0 && e.rows < 6)) {
+      add(swing.row, over);
+      if (choose) *which |= kConeRow;
+    }
+  }
+  if (joint.limit.enabled && (choose || (*which & kLimitRow))) {
+    const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
+    const bool locked = joint.limit.lower == joint.limit.upper;
+    double past = 0;  // signed as the coordinate
+    if (c.exists && (c.position < joint.limit.lower || locked))
+      past = c.position - joint.limit.lower;
+    else if (c.exists && c.position > joint.limit.upper)
+      past = c.position - joint.limit.upper;
+    if (!choose || (c.exists && (past != 0 || locked) && e.rows < 6)) {
+      add(c.row, past);
+      if (choose) *which |= kLimitRow;
+    }
+  }
+}
+
+}  // namespace
+
 void position_equations(JointEquations* e, const JointRow& row, std::span<const SolverBody> bodies,
-                        std::span<const Pose> poses) {
+                        std::span<const Pose> poses, std::uint8_t* bounds) {
   clear_equations(e);
   equations_of(*e, row, bodies, poses, nullptr);
+  if (bounds != nullptr) append_bound_rows(*e, row, poses, true, bounds);
 }
 
 JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,
-                                        std::span<const Pose> poses) {
+                                        std::span<const Pose> poses, std::uint8_t bounds) {
   JointTargets e;
   equations_of(e, row, bodies, poses, nullptr);
+  if (bounds != 0) append_bound_rows(e, row, poses, false, &bounds);
   return e.target;
 }
 
@@ -627,13 +677,6 @@ double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span
                           const JointTarget& target, const JointPoseTerms& terms, bool bounds) {
   JointBodies j = bodies_of(row, bodies, poses);
   return solve_axial(row, j, target, terms, bounds);
-}
-
-void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies,
-                          std::span<Pose> poses) {
-  const bool world_b = row.b == kWorldAnchor;
-  correct_axial(row.joint, &bodies[row.a], world_b ? nullptr : &bodies[row.b], &poses[row.a],
-                world_b ? nullptr : &poses[row.b]);
 }
 
 }  // namespace tumble

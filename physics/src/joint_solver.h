@@ -75,12 +75,19 @@ JointEquations::Vector velocity_targets(const JointRow& row, std::span<const Sol
                                         const Quat* turns = nullptr);
 // Whether the equations' last row is the joint's motor (JointRow::motor_in_tree).
 bool motor_row(const JointRow& row, const JointEquations& equations);
-// For positions: target = minus the error.
+// For positions: target = minus the error. With `bounds`, the joint's cone and limit that the
+// poses are past (or a locked limit) follow as rows of their own, held where they are met for the
+// pass, and *bounds says which (kConeRow, kLimitRow): a position pass of the direct solve then
+// corrects the bounds and the joint's own rows at once, where a separate pass of the bounds and
+// one of the rows each undid part of the other.
+inline constexpr std::uint8_t kConeRow = 1, kLimitRow = 2;
 void position_equations(JointEquations* equations, const JointRow& row,
-                        std::span<const SolverBody> bodies, std::span<const Pose> poses);
-// Their targets alone (position_equations' target).
+                        std::span<const SolverBody> bodies, std::span<const Pose> poses,
+                        std::uint8_t* bounds = nullptr);
+// Their targets alone (position_equations' target), with the bound rows `bounds` (as
+// position_equations chose them for the factoring these targets are solved with).
 JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,
-                                        std::span<const Pose> poses);
+                                        std::span<const Pose> poses, std::uint8_t bounds = 0);
 // Adds the equations' impulses (one per row, on b; a takes the opposite) to the joint's warm
 // start, in the same terms as the Gauss-Seidel rows keep them.
 void add_equation_impulses(JointRow& row, const JointEquations& equations,
@@ -92,8 +99,6 @@ void add_equation_impulses(JointRow& row, const JointEquations& equations,
 double solve_joint_drives(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,
                           const JointTarget& target, const JointPoseTerms& terms,
                           bool bounds = true);
-// The position pass of the joint's limits and cone alone.
-void correct_joint_bounds(const JointRow& row, std::span<SolverBody> bodies, std::span<Pose> poses);
 
 // One Gauss-Seidel visit of the joint's rows. Returns the largest velocity change it gave (m/s).
 double solve_joint(JointRow& row, std::span<SolverBody> bodies, std::span<const Pose> poses,

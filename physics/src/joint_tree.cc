@@ -695,7 +695,8 @@ bool JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
 }
 
 void JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                                std::span<Pose> poses, bool refactor, double velocity_substep) {
+                                std::span<Pose> poses, bool refactor, double velocity_substep,
+                                bool bounds) {
   if (joints_.empty()) return;
   // A move came before: the next sweeps take their targets afresh, and factor again unless this
   // pass or one before it since the move factored for them.
@@ -706,15 +707,21 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
     // times heavier end tore.
     const bool for_velocities = velocity_substep > 0 && !has_motors_ &&
                                 !set_geometric_stiffness(rows, bodies, poses, velocity_substep);
-    velocities_factored_ = for_velocities;
-    if (for_velocities) stiffened_ = false;
+    bool bound_rows = false;
     factor(bodies, false, [&](std::size_t k, JointEquations* equations) {
-      position_equations(equations, rows[joints_[k].row], bodies, poses);
+      joints_[k].bounds = 0;
+      position_equations(equations, rows[joints_[k].row], bodies, poses,
+                         bounds ? &joints_[k].bounds : nullptr);
+      bound_rows = bound_rows || joints_[k].bounds != 0;
     });
+    // The velocity sweeps hold no bound as an equality: a factoring with bound rows is not theirs.
+    velocities_factored_ = for_velocities && !bound_rows;
+    if (velocities_factored_) stiffened_ = false;
     solve(false, [&](std::size_t k) { return equations_[k].target; });
   } else {
-    solve(false,
-          [&](std::size_t k) { return position_targets(rows[joints_[k].row], bodies, poses); });
+    solve(false, [&](std::size_t k) {
+      return position_targets(rows[joints_[k].row], bodies, poses, joints_[k].bounds);
+    });
   }
   if (!solution_finite()) return;
   for (const TreeBody& body : tree_bodies_)

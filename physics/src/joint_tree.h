@@ -52,7 +52,8 @@ class JointTree {
   // the same: the same rows and masses; the passes after it move the bodies by a millionth of
   // this one's correction).
   void solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                       std::span<Pose> poses, bool refactor, double velocity_substep = 0);
+                       std::span<Pose> poses, bool refactor, double velocity_substep = 0,
+                       bool bounds = true);
 
   // The exact solver's use of the tree (exact_joints.h), with the velocity factors of the last
   // solve_velocities: whether a body is one of the tree's;
@@ -113,6 +114,7 @@ class JointTree {
     std::uint32_t row = 0;                         // index into the rows
     std::uint32_t body_a = kNone, body_b = kNone;  // tree bodies; kNone: static or the world
     int width = 3;
+    std::uint8_t bounds = 0;  // the bound rows of the last position factoring (joint_solver.h)
     // Where its later neighbours are: the hub of its parent body, and its place there (kNone:
     // it has none).
     std::uint32_t hub = kNone, place = 0;

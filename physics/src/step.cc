@@ -118,7 +118,8 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
 // corrections along one link a pass, which the next moves' passes carry on. Solved directly
 // (joint_tree.h), the first two passes are Newton steps and the last reuses the second's rows (on
 // a chain of 20 dropped from the horizontal: 7e-6 m at worst, 1.8e-7 m refactoring every pass,
-// for a fifth less time).
+// for a fifth less time); the first also holds the limits and cones the poses are past (the later
+// ones' rows are the velocity sweeps' too, which hold no bound).
 constexpr int kJointPositionPasses = 3;
 constexpr int kJointRefactoredPasses = 2;
 static_assert(kJointRefactoredPasses >= 1, "the first pass after a move refactors");
@@ -203,13 +204,10 @@ class SerialIsland {
     }
     for (int pass = 0; pass < kJointPositionPasses; ++pass) {
       if (tree_ != nullptr) {
-        for (std::uint32_t j : c_.joints)
-          if (has_axial_rows(c_.scratch.joint_rows[j].joint))
-            correct_joint_bounds(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
         // The last refactored pass factors the velocity sweeps' system too (joint_tree.h).
         tree_->solve_positions(c_.scratch.joint_rows, bodies_, c_.scratch.poses,
                                pass < kJointRefactoredPasses,
-                               pass == kJointRefactoredPasses - 1 ? h : 0.0);
+                               pass == kJointRefactoredPasses - 1 ? h : 0.0, pass == 0);
         continue;
       }
       for (std::uint32_t j : c_.joints)
