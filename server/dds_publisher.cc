@@ -121,6 +121,14 @@ void add_part_triangles(const Compound::Part& part, std::vector<Point>* out) {
       }
 }
 
+// A hull's vertices into `out` (emptied first; nothing for another shape), for a sample to view.
+void hull_vertices(const Shape& shape, std::vector<Point>* out) {
+  out->clear();
+  if (shape.type() == ShapeType::kHull)
+    for (const Vec3& v : shape.polyhedron()->vertices)
+      out->push_back({v.x(), v.y(), v.z()});
+}
+
 // A compound's part as the bodies topic gives it: its shape's sizes, a hull's vertices (in
 // `vertices`, which the sample views) and its pose in the body's frame.
 BodyPartSample part_sample(const Compound::Part& part, std::vector<Point>* vertices) {
@@ -134,10 +142,7 @@ BodyPartSample part_sample(const Compound::Part& part, std::vector<Point>* verti
   sample.half_height = shape.half_height();
   for (int k = 0; k < 3; ++k)
     sample.half_extents[k] = shape.half_extents()[k];
-  vertices->clear();
-  if (shape.type() == ShapeType::kHull)
-    for (const Vec3& v : shape.polyhedron()->vertices)
-      vertices->push_back({v.x(), v.y(), v.z()});
+  hull_vertices(shape, vertices);
   sample.hull_vertices = view<dds_sequence_geometry_msgs_msg_dds__Point_>(*vertices);
   return sample;
 }
@@ -520,10 +525,7 @@ void DdsPublisher::publish_catalogue(const FrameData& frame) {
     sample.half_height = shape.half_height();
     for (int k = 0; k < 3; ++k)
       sample.half_extents[k] = shape.half_extents()[k];
-    vertices.clear();
-    if (shape.type() == ShapeType::kHull)
-      for (const Vec3& v : shape.polyhedron()->vertices)
-        vertices.push_back({v.x(), v.y(), v.z()});
+    hull_vertices(shape, &vertices);
     sample.hull_vertices = view<dds_sequence_geometry_msgs_msg_dds__Point_>(vertices);
     parts.clear();
     if (shape.type() == ShapeType::kCompound) {

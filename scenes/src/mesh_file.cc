@@ -8,12 +8,19 @@ namespace tumble {
 static_assert(mesh_files::kMaxHullInputPoints == kMaxHullPoints,
               "the hull reduction keeps as many points as the engine takes");
 
+namespace {
+
+// The file's arrays within the engine's mesh limits, or the error naming the file.
+Status read_arrays(const std::string& path, double scale, mesh_files::Arrays* arrays) {
+  std::string error = mesh_files::read(path, scale, kMaxMeshVertices, kMaxMeshTriangles, arrays);
+  return error.empty() ? Status::ok() : Status::error(error);
+}
+
+}  // namespace
+
 Result<TriangleMeshDef> read_mesh_file(const std::string& path, double scale) {
   mesh_files::Arrays arrays;
-  if (std::string error =
-          mesh_files::read(path, scale, kMaxMeshVertices, kMaxMeshTriangles, &arrays);
-      !error.empty())
-    return Status::error(error);
+  if (Status s = read_arrays(path, scale, &arrays); !s) return s;
   TriangleMeshDef mesh;
   mesh.vertices.reserve(arrays.xyz.size() / 3);
   for (std::size_t k = 0; k < arrays.xyz.size(); k += 3)
@@ -27,10 +34,7 @@ Result<TriangleMeshDef> read_mesh_file(const std::string& path, double scale) {
 
 Result<HullDef> read_hull_file(const std::string& path, double scale) {
   mesh_files::Arrays arrays;
-  if (std::string error =
-          mesh_files::read(path, scale, kMaxMeshVertices, kMaxMeshTriangles, &arrays);
-      !error.empty())
-    return Status::error(error);
+  if (Status s = read_arrays(path, scale, &arrays); !s) return s;
   HullDef hull;
   for (std::size_t i : mesh_files::hull_point_indices(arrays.xyz, kMaxHullPoints))
     hull.points.emplace_back(arrays.xyz[3 * i], arrays.xyz[3 * i + 1], arrays.xyz[3 * i + 2]);
