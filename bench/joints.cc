@@ -4,7 +4,8 @@
 // every step, read from the bodies' poses the same way for every engine) and the median step time;
 // then the standard chain:100 (released level, swinging clear of the ground) and the pile of eight
 // ragdolls (awake, without their joints' friction) for step time alone.
-// Ours with the direct solve of joint trees (auto) and with Gauss-Seidel joints (soft); Bullet 3.24
+// Ours with the direct solve of joint trees (auto, with the default four substeps and with one)
+// and with Gauss-Seidel joints (soft, pgs); Bullet 3.24
 // float and double, btPoint2PointConstraint, 10 sequential-impulse iterations, and Bullet's
 // btMultiBody (float, generalised coordinates; trees from the world alone). ODE and MuJoCo join
 // in the report's joints section (make report). Usage: bench_joints [seconds] (default 20).
@@ -68,16 +69,29 @@ Run run(Simulation* sim, int steps, Measure measure) {
   return r;
 }
 
-// Every engine on `scene` (ours with each of `solvers`).
+// Ours as configured: the solver, and the substeps (0: the settings' default).
+struct Ours {
+  const char* label;
+  SolverKind solver;
+  int substeps;
+};
+// auto with one substep takes one step of dt, as the peers do: a pendulum's period error at dt
+// 1/60 is then theirs (docs/PERFORMANCE.md), where the default four substeps cut it sixteenfold.
+constexpr Ours kOurs[] = {{"Tumble auto (direct)", SolverKind::kAuto, 0},
+                          {"Tumble auto, 1 substep", SolverKind::kAuto, 1},
+                          {"Tumble soft (GS)", SolverKind::kSoft, 0},
+                          {"Tumble pgs (GS)", SolverKind::kPgs, 0}};
+
+// Every engine on `scene` (ours in each configuration of kOurs).
 template <class Make, class Measure>
 void each_engine(Make make_scene, int steps, Measure measure, const char* label) {
-  for (SolverKind solver : {SolverKind::kAuto, SolverKind::kSoft}) {
-    const SceneDef scene = make_scene(solver);
+  for (const Ours& ours : kOurs) {
+    SceneDef scene = make_scene(ours.solver);
+    if (ours.substeps > 0) scene.world.solver.substeps = ours.substeps;
     std::string why;
     auto sim = make_tumble(scene, &why);
     const Run r = sim ? run(sim.get(), steps, measure) : Run{};
-    std::printf("  %-8s %-22s gap %11.3e m  median %8.4f ms%s\n", label,
-                solver == SolverKind::kAuto ? "Tumble auto (direct)" : "Tumble soft (GS)", r.gap,
+    std::printf("  %-8s %-24s gap %11.3e m  median %8.4f ms%s\n", label, ours.label, r.gap,
                 r.median_ms, sim ? "" : (" -- " + why).c_str());
   }
   const SceneDef scene = make_scene(SolverKind::kSoft);
@@ -90,11 +104,11 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
     std::string why;
     auto sim = make(peer, options, &why);
     if (!sim) {
-      std::printf("  %-8s %-22s not run: %s\n", label, name, why.c_str());
+      std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
       continue;
     }
     const Run r = run(sim.get(), steps, measure);
-    std::printf("  %-8s %-22s gap %11.3e m  median %8.4f ms\n", label, name, r.gap, r.median_ms);
+    std::printf("  %-8s %-24s gap %11.3e m  median %8.4f ms\n", label, name, r.gap, r.median_ms);
   }
 }
 

@@ -10,7 +10,8 @@
 //   STEPS    steps per round from that state (default 10)
 //   ROUNDS   rounds (default 5)
 //   THREADS  step threads (default 1)
-// TUMBLE_SOLVER=exact|pgs|soft|auto in the environment replaces the scene's solver.
+// TUMBLE_SOLVER=exact|pgs|soft|auto in the environment replaces the scene's solver, and
+// TUMBLE_SUBSTEPS=N (1 to 32) its substeps.
 // Sleeping is off, so the whole scene is awake. Each round restores the state, takes two untimed
 // steps (the restored world's buffers warm up) and times STEPS more. Prints the mean time per step
 // of each stage per round, then each stage's minimum and median over the rounds, and the state's
@@ -89,6 +90,14 @@ int main(int argc, char** argv) {
       return 2;
     }
     scene.value().world.solver.kind = *kind;
+  }
+  if (const char* substeps = std::getenv("TUMBLE_SUBSTEPS")) {
+    const int count = std::atoi(substeps);
+    if (count < 1 || count > 32) {
+      std::fprintf(stderr, "bench_replay: TUMBLE_SUBSTEPS=%s is not 1 to 32\n", substeps);
+      return 2;
+    }
+    scene.value().world.solver.substeps = count;
   }
   scene.value().world.solver.sleeping = false;
   const double dt = scene.value().dt;

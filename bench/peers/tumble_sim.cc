@@ -24,7 +24,8 @@ class TumbleSimulation final : public Simulation {
         break;
       case SolverKind::kAuto:
         settings_ =
-            "soft; exact where soft would differ (<= " + std::to_string(s.exact_max_points) +
+            "soft, " + std::to_string(s.substeps) +
+            " substeps; exact where soft would differ (<= " + std::to_string(s.exact_max_points) +
             " points, a mass ratio > 4 or a body under 100 soft sags)";
         break;
       case SolverKind::kExact:
