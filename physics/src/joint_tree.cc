@@ -415,7 +415,19 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
               body.inverse_mass * rows_on_body.template leftCols<3>().transpose();
         response.template bottomLeftCorner<3, W>().noalias() =
             body.angular_inverse.lazyProduct(rows_on_body.template rightCols<3>().transpose());
-        pivot.noalias() += rows_on_body.lazyProduct(response.template leftCols<W>());
+        if constexpr (W == 3) {
+          pivot.noalias() += rows_on_body.lazyProduct(response.template leftCols<W>());
+        } else {
+          // Written out: Eigen's general 6 x 6 product here was a call of its own, a tenth of a
+          // ragdoll pile's factoring.
+          for (int j = 0; j < W; ++j)
+            for (int i = 0; i < W; ++i) {
+              double sum = rows_on_body(i, 0) * response(0, j);
+              for (int c = 1; c < 6; ++c)
+                sum += rows_on_body(i, c) * response(c, j);
+              pivot(i, j) += sum;
+            }
+        }
       }
       for (int r = equations_[k].rows; r < W; ++r)
         pivot(r, r) = 1;
