@@ -23,10 +23,10 @@ class TumbleSimulation final : public Simulation {
         settings_ = "pgs, " + std::to_string(s.iterations) + " iterations";
         break;
       case SolverKind::kAuto:
-        settings_ =
-            "soft, " + std::to_string(s.substeps) +
-            " substeps; exact where soft would differ (<= " + std::to_string(s.exact_max_points) +
-            " points, a mass ratio > 4 or a body under 100 soft sags)";
+        settings_ = "soft, " + std::to_string(s.substeps) +
+                    (s.substeps == 1 ? " substep" : " substeps") +
+                    "; exact where soft would differ (<= " + std::to_string(s.exact_max_points) +
+                    " points, a mass ratio > 4 or a body under 100 soft sags)";
         break;
       case SolverKind::kExact:
         settings_ = "Lemke, " + std::to_string(s.friction_directions) + "-sided friction pyramid";
