@@ -7,6 +7,11 @@
 // time, its first 5 s alone (every box still awake on either ground: the piles' costs step for
 // step before the plane's towers sleep while some of the hills' topple).
 //
+// With the peers built (make bench), Bullet 3.24 (float, its deactivation on as our sleeping is)
+// takes the same three scenes each round, its heightfield a btHeightfieldTerrainShape and its mesh
+// a btBvhTriangleMeshShape (bench/peers/bullet_sim.cc): the hills' cost over the plane's in an
+// engine the goal did not shape, and ours beside it.
+//
 // Usage: bench_terrain [BOXES [ROUNDS [THREADS [FLAT]]]]   (defaults 1000, 3, 1, 0)
 //   FLAT 1: the hills levelled (every height 0), as a heightfield and as a mesh: the pile lands on
 //   them as on the plane (the face rule gives a flat terrain the plane's contacts), so the ratios
@@ -22,6 +27,9 @@
 #include "physics/world.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
+#ifdef TUMBLE_HAVE_PEERS
+#include "peers/simulation.h"
+#endif
 
 namespace {
 
@@ -54,6 +62,31 @@ double under(const HeightField* field, const Pose& pose, const Vec3& p) {
   return field->height_at(local.x(), local.y()) - local.z();
 }
 
+// The boxes' depth under the ground (`field`: the hills, or null for the plane), into the run's
+// marks: a box's centre under it, a vertex more than 1 cm under it, the deepest vertex.
+template <class BoxAt>
+void sample_depths(const HeightField* field, const Pose& ground, std::size_t boxes, BoxAt box_at,
+                   std::vector<std::uint8_t>* through, std::vector<std::uint8_t>* dipped,
+                   double* deepest) {
+  for (std::size_t k = 0; k < boxes; ++k) {
+    const auto [position, orientation, h] = box_at(k);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 local((corner & 1 ? 1 : -1) * h.x(), (corner & 2 ? 1 : -1) * h.y(),
+                       (corner & 4 ? 1 : -1) * h.z());
+      const double depth = under(field, ground, position + orientation * local);
+      *deepest = std::max(*deepest, depth);
+      if (depth > 0.01) (*dipped)[k] = 1;
+    }
+    if (under(field, ground, position) > 0) (*through)[k] = 1;
+  }
+}
+
+struct BoxPose {
+  Vec3 position;
+  Quat orientation;
+  Vec3 half_extents;
+};
+
 // hills: the hills' surface (the mesh's triangles are the heightfield's).
 Run run(SceneDef scene, int threads, const HeightField& hills) {
   scene.world.threads = threads;
@@ -81,20 +114,13 @@ Run run(SceneDef scene, int threads, const HeightField& hills) {
     if (step + 1 == first_steps) first_seconds = seconds;
     if (step % 10 != 9) continue;  // sampled, untimed
     const BodyView ground = world.body(ground_id);
-    const HeightField* field = terrain ? &hills : nullptr;
-    const Pose pose{ground.position(), ground.orientation()};
-    for (std::size_t k = 0; k < ids.size(); ++k) {
-      const BodyView body = world.body(ids[k]);
-      const Vec3 h = body.shape().half_extents();
-      for (int corner = 0; corner < 8; ++corner) {
-        const Vec3 local((corner & 1 ? 1 : -1) * h.x(), (corner & 2 ? 1 : -1) * h.y(),
-                         (corner & 4 ? 1 : -1) * h.z());
-        const double depth = under(field, pose, body.position() + body.orientation() * local);
-        out.deepest = std::max(out.deepest, depth);
-        if (depth > 0.01) dipped[k] = 1;
-      }
-      if (under(field, pose, body.position()) > 0) through[k] = 1;
-    }
+    sample_depths(
+        terrain ? &hills : nullptr, Pose{ground.position(), ground.orientation()}, ids.size(),
+        [&](std::size_t k) {
+          const BodyView body = world.body(ids[k]);
+          return BoxPose{body.position(), body.orientation(), body.shape().half_extents()};
+        },
+        &through, &dipped, &out.deepest);
   }
   for (std::size_t k = 0; k < ids.size(); ++k) {
     out.through += through[k];
@@ -106,6 +132,56 @@ Run run(SceneDef scene, int threads, const HeightField& hills) {
   out.first_ms_per_step = 1e3 * first_seconds / first_steps;
   return out;
 }
+
+#ifdef TUMBLE_HAVE_PEERS
+// The same run in Bullet (float): its time a step and the same marks (no contact count).
+Run run_bullet(const SceneDef& scene, const HeightField& hills) {
+  std::string why_not;
+  const std::unique_ptr<bench::Simulation> sim =
+      bench::make_bullet(bench::peer_scene(scene), bench::PeerOptions{}, &why_not);
+  if (!sim) {
+    std::fprintf(stderr, "bench_terrain: Bullet: %s\n", why_not.c_str());
+    std::exit(1);
+  }
+  const BodyDef* ground = nullptr;
+  std::vector<Vec3> half_extents;  // the dynamic bodies', in the scene's order (the adapter's)
+  for (const BodyDef& body : scene.bodies) {
+    if (body.type == BodyType::kStatic)
+      ground = &body;
+    else
+      half_extents.push_back(std::get<BoxDef>(body.shape).half_extents);
+  }
+  const bool terrain = !std::holds_alternative<HalfSpaceDef>(ground->shape);
+  const Pose ground_pose{ground->position, ground->orientation};
+  const int steps = static_cast<int>(scene.duration / scene.dt + 0.5);
+  const int first_steps = std::min(steps, static_cast<int>(5 / scene.dt + 0.5));
+  std::vector<std::uint8_t> through(half_extents.size(), 0), dipped(half_extents.size(), 0);
+  Run out;
+  double seconds = 0, first_seconds = 0;
+  for (int step = 0; step < steps; ++step) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!sim->step()) break;
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (step + 1 == first_steps) first_seconds = seconds;
+    if (step % 10 != 9) continue;  // sampled, untimed
+    sample_depths(
+        terrain ? &hills : nullptr, ground_pose, half_extents.size(),
+        [&](std::size_t k) {
+          const bench::BodyState state = sim->body(k);
+          return BoxPose{state.position, state.orientation, half_extents[k]};
+        },
+        &through, &dipped, &out.deepest);
+  }
+  for (std::size_t k = 0; k < half_extents.size(); ++k) {
+    out.through += through[k];
+    out.dipped += dipped[k];
+    out.fastest = std::max(out.fastest, sim->body(k).linear_velocity.norm());
+  }
+  out.ms_per_step = 1e3 * seconds / steps;
+  out.first_ms_per_step = 1e3 * first_seconds / first_steps;
+  return out;
+}
+#endif
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -136,7 +212,7 @@ int main(int argc, char** argv) {
   std::printf(
       "round  scene                    ms/step  first 5 s  through  dipped  deepest(m)  "
       "fastest(m/s)  points\n");
-  std::vector<double> times[3], first[3];
+  std::vector<double> times[3], first[3], bullet_times[3], bullet_first[3];
   for (int round = 0; round < rounds; ++round) {
     for (int k = 0; k < 3; ++k) {
       const Run r = run(scenes[k], threads, hills);
@@ -146,6 +222,16 @@ int main(int argc, char** argv) {
                   names[k].c_str(), r.ms_per_step, r.first_ms_per_step, r.through, r.dipped,
                   r.deepest, r.fastest, r.points);
     }
+#ifdef TUMBLE_HAVE_PEERS
+    for (int k = 0; k < 3; ++k) {
+      const Run r = run_bullet(scenes[k], hills);
+      bullet_times[k].push_back(r.ms_per_step);
+      bullet_first[k].push_back(r.first_ms_per_step);
+      std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %12.4f       -\n", round,
+                  ("Bullet " + names[k]).c_str(), r.ms_per_step, r.first_ms_per_step, r.through,
+                  r.dipped, r.deepest, r.fastest);
+    }
+#endif
   }
   const double a = median(times[0]), b = median(times[1]), c = median(times[2]);
   std::printf(
@@ -157,5 +243,25 @@ int main(int argc, char** argv) {
       "first 5 s, median ms/step: plane %.3f, heightfield %.3f, mesh %.3f; heightfield / plane "
       "%.2f, mesh / plane %.2f\n",
       fa, fb, fc, fb / fa, fc / fa);
+#ifdef TUMBLE_HAVE_PEERS
+  if (threads == 1) {
+    const double ba = median(bullet_times[0]), bb = median(bullet_times[1]),
+                 bc = median(bullet_times[2]);
+    std::printf(
+        "Bullet, median ms/step: plane %.3f, heightfield %.3f, mesh %.3f; heightfield / plane "
+        "%.2f, mesh / plane %.2f\n",
+        ba, bb, bc, bb / ba, bc / ba);
+    const double bfa = median(bullet_first[0]), bfb = median(bullet_first[1]),
+                 bfc = median(bullet_first[2]);
+    std::printf(
+        "Bullet, first 5 s: plane %.3f, heightfield %.3f, mesh %.3f; heightfield / plane %.2f, "
+        "mesh / plane %.2f\n",
+        bfa, bfb, bfc, bfb / bfa, bfc / bfa);
+    std::printf(
+        "ours / Bullet's step, whole run: plane %.2f, heightfield %.2f, mesh %.2f; first 5 s: "
+        "%.2f, %.2f, %.2f\n",
+        a / ba, b / bb, c / bc, fa / bfa, fb / bfb, fc / bfc);
+  }
+#endif
   return 0;
 }
