@@ -50,16 +50,17 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
                                                 (moves(bodies, row.a) ? 2 : 0) |
                                                 (moves(bodies, row.b) ? 4 : 0))});
   }
-  if (built_ && shape_ == built_shape_ && node_of_body_.size() >= body_count) {
+  std::vector<std::uint32_t>& node_of_body = index_->node_of_body;
+  if (node_of_body.size() < body_count) node_of_body.resize(body_count, kNone);
+  if (built_ && shape_ == built_shape_) {
+    for (std::size_t k = 0; k < tree_bodies_.size(); ++k)
+      node_of_body[tree_bodies_[k].index] = static_cast<std::uint32_t>(k);
     finish_build(rows, bodies);
     return true;
   }
   built_ = false;
   built_shape_ = shape_;
-  for (std::uint32_t body : bodies_used_)
-    node_of_body_[body] = kNone;
   bodies_used_.clear();
-  if (node_of_body_.size() < body_count) node_of_body_.resize(body_count, kNone);
   nodes_.clear();
   first_edge_.clear();
   next_edge_.clear();
@@ -85,12 +86,12 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
     const std::uint32_t joint_node = add_node(true, j);
     for (const auto& [body, moving] : {std::pair{row.a, moves_a}, std::pair{row.b, moves_b}}) {
       if (!moving) continue;
-      if (node_of_body_[body] == kNone) {
-        node_of_body_[body] = add_node(false, body);
+      if (node_of_body[body] == kNone) {
+        node_of_body[body] = add_node(false, body);
         bodies_used_.push_back(body);
       }
-      add_edge(joint_node, node_of_body_[body]);
-      add_edge(node_of_body_[body], joint_node);
+      add_edge(joint_node, node_of_body[body]);
+      add_edge(node_of_body[body], joint_node);
     }
   }
   // Each tree rooted at its one joint to a static body or the world, if it has one (a joint's
@@ -137,6 +138,8 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
   for (std::uint32_t node = 0; forest && node < n; ++node)
     if (!visited_[node]) forest = visit_tree(node);
   auto give_up = [&] {
+    detach();
+    bodies_used_.clear();
     nodes_.clear();
     joints_.clear();
     tree_bodies_.clear();
@@ -164,6 +167,13 @@ bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const Joi
   return true;
 }
 
+void JointTree::detach() {
+  if (index_ == nullptr) return;
+  for (std::uint32_t body : bodies_used_)
+    index_->node_of_body[body] = kNone;
+  index_ = nullptr;
+}
+
 bool JointTree::number_forest(std::span<const JointRow> rows, std::span<const SolverBody> bodies) {
   const std::size_t n = nodes_.size();
   // Joints and bodies numbered in the nodes' order (children before parents).
@@ -179,15 +189,15 @@ bool JointTree::number_forest(std::span<const JointRow> rows, std::span<const So
       joints_.back().row = node.index;
     } else {
       numbered[k] = static_cast<std::uint32_t>(tree_bodies_.size());
-      node_of_body_[node.index] = numbered[k];
+      index_->node_of_body[node.index] = numbered[k];
       tree_bodies_.push_back({});
       tree_bodies_.back().index = node.index;
     }
   }
   for (TreeJoint& joint : joints_) {
     const JointRow& row = rows[joint.row];
-    if (moves(bodies, row.a)) joint.body_a = node_of_body_[row.a];
-    if (moves(bodies, row.b)) joint.body_b = node_of_body_[row.b];
+    if (moves(bodies, row.a)) joint.body_a = index_->node_of_body[row.a];
+    if (moves(bodies, row.b)) joint.body_b = index_->node_of_body[row.b];
   }
   // Each body's hub: the joints below it in order, then the joint above it.
   std::vector<std::uint32_t>& child_count = child_count_;
@@ -224,7 +234,7 @@ bool JointTree::number_forest(std::span<const JointRow> rows, std::span<const So
     hub_members_[hub.first_member + place] = joint;
     const JointRow& row = rows[joints_[joint].row];
     member_side_b_[hub.first_member + place] =
-        moves(bodies, row.b) && node_of_body_[row.b] == hub.body ? 1 : 0;
+        moves(bodies, row.b) && index_->node_of_body[row.b] == hub.body ? 1 : 0;
   };
   for (std::size_t k = 0; k < n; ++k) {
     const Node& node = nodes_[k];
@@ -315,8 +325,8 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     }
     for (const auto& [body, r, force] : {std::tuple{row.a, anchors.ra, Vec3(-force_on_b)},
                                          std::tuple{row.b, anchors.rb, force_on_b}}) {
-      if (body == kWorldAnchor || node_of_body_[body] == kNone) continue;
-      TreeBody& body_node = tree_bodies_[node_of_body_[body]];
+      if (body == kWorldAnchor || index_->node_of_body[body] == kNone) continue;
+      TreeBody& body_node = tree_bodies_[index_->node_of_body[body]];
       body_node.linear_stiffness += linear;
       const double arm = r.norm();
       if (arm > body_node.longest_lever.norm()) body_node.longest_lever = r;
@@ -619,7 +629,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     set_turns(rows, bodies, target.h);
     for (std::size_t k = 0; k < joints_.size(); ++k)
       kept_targets_[k] =
-          velocity_targets(rows[joints_[k].row], bodies, poses, target, turns_.data());
+          velocity_targets(rows[joints_[k].row], bodies, poses, target, index_->turns.data());
     // Where the second iterate is not taken, its solve (from the same velocities, to the same
     // targets) is this sweep's.
     solved = !take_second_targets(rows, bodies, poses, target, rates_of);
@@ -691,7 +701,7 @@ bool JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
   double first = 0, change = 0;
   for (std::size_t k = 0; k < joints; ++k) {
     second_targets_[k] =
-        velocity_targets(rows[joints_[k].row], bodies, poses, target, turns_.data());
+        velocity_targets(rows[joints_[k].row], bodies, poses, target, index_->turns.data());
     first = std::max(first, kept_targets_[k].lpNorm<Eigen::Infinity>());
     change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
   }
@@ -745,14 +755,15 @@ void JointTree::set_turns(std::span<const JointRow> rows, std::span<const Solver
                           double h) {
   // Every joint's bodies: the tree's turn with their velocities; a static body or the world
   // (kWorldAnchor: none stored) not at all.
-  if (turns_.size() < node_of_body_.size()) turns_.resize(node_of_body_.size());
+  std::vector<Quat>& turns = index_->turns;
+  if (turns.size() < index_->node_of_body.size()) turns.resize(index_->node_of_body.size());
   for (const TreeJoint& joint : joints_) {
     const JointRow& row = rows[joint.row];
-    turns_[row.a] = Quat::Identity();
-    if (row.b != kWorldAnchor) turns_[row.b] = Quat::Identity();
+    turns[row.a] = Quat::Identity();
+    if (row.b != kWorldAnchor) turns[row.b] = Quat::Identity();
   }
   for (const TreeBody& body : tree_bodies_)
-    turns_[body.index] = rotation_quaternion(h * bodies[body.index].w);
+    turns[body.index] = rotation_quaternion(h * bodies[body.index].w);
 }
 
 bool JointTree::solution_finite() const {
@@ -769,7 +780,7 @@ bool JointTree::respond(std::span<const BodyImpulse> impulses) {
   for (TreeBody& body : tree_bodies_)
     body.base.setZero();
   for (const BodyImpulse& push : impulses) {
-    TreeBody& body = tree_bodies_[node_of_body_[push.body]];
+    TreeBody& body = tree_bodies_[index_->node_of_body[push.body]];
     body.base.head<3>() += push.impulse.head<3>();
     body.base.tail<3>() += push.impulse.tail<3>();
   }

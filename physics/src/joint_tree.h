@@ -25,11 +25,27 @@
 
 namespace tumble {
 
+// What a forest looks up by the step's solver index (each body's place in it, each body's turn
+// over a move): as long as the step's bodies, so one per thread, lent to the forest of the island
+// the thread solves (JointTree::attach) rather than one per forest.
+struct JointTreeIndex {
+  std::vector<std::uint32_t> node_of_body;  // its tree body in the attached forest, or UINT32_MAX
+  std::vector<Quat> turns;                  // JointTree::set_turns
+};
+
 class JointTree {
  public:
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+
+  // The thread's index, for one island's solve: build() and everything after it use it, and
+  // detach() leaves it as it found it (every entry kNone) for the thread's next island.
+  void attach(JointTreeIndex* index) { index_ = index; }
+  void detach();
+
   // The forest of the island's joints (indices into `rows`); false when the joints close a loop
   // or a body holds more than 16 of them (JointTree::Hub; the island keeps Gauss-Seidel).
-  // `body_count`: the step's solver bodies. Keeps its memory from one island to the next.
+  // `body_count`: the step's solver bodies. Keeps its memory, and the same joints between the
+  // same bodies keep the forest, from one step to the next.
   bool build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
              std::span<const SolverBody> bodies, std::size_t body_count);
 
@@ -58,7 +74,7 @@ class JointTree {
   // The exact solver's use of the tree (exact_joints.h), with the velocity factors of the last
   // solve_velocities: whether a body is one of the tree's;
   bool holds(std::uint32_t body) const {
-    return body < node_of_body_.size() && node_of_body_[body] != kNone;
+    return body < index_->node_of_body.size() && index_->node_of_body[body] != kNone;
   }
   // the change of the tree's bodies' velocities when the impulses act on some of them (linear,
   // then angular; world axes) while every joint's rows keep their rates: the response the LCP's
@@ -70,7 +86,7 @@ class JointTree {
   bool respond(std::span<const BodyImpulse> impulses);
   // After respond: a body's velocity change (linear, angular);
   Eigen::Matrix<double, 6, 1> change_of(std::uint32_t body) const {
-    return tree_bodies_[node_of_body_[body]].result;
+    return tree_bodies_[index_->node_of_body[body]].result;
   }
   // and the response given to the bodies (as velocities, or as the push-out's pseudo-velocities)
   // with, for velocities, the joints' impulses added to their rows.
@@ -79,7 +95,6 @@ class JointTree {
  private:
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
-  static constexpr std::uint32_t kNone = UINT32_MAX;
   // Past it a hub's blocks (half its joints squared, 576 bytes each) would outgrow the rest of
   // the tree's memory several times over, and their elimination grow with the cube.
   static constexpr std::uint32_t kMostHubJoints = 16;
@@ -156,8 +171,8 @@ class JointTree {
   void substitute();
   bool solution_finite() const;
   // Each of the joints' bodies' turn over a move of h at its velocity (rotation_quaternion(h w);
-  // identity for a static body) in turns_, by solver index: the targets' arithmetic, once a
-  // body rather than once a joint end.
+  // identity for a static body) in the index's turns, by solver index: the targets' arithmetic,
+  // once a body rather than once a joint end.
   void set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies, double h);
   // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
   void set_velocity_base(std::span<const SolverBody> bodies);
@@ -196,10 +211,9 @@ class JointTree {
   std::vector<std::uint32_t> hub_members_;   // joints
   std::vector<std::uint8_t> member_side_b_;  // whether the hub's body is the member's b
   std::vector<HubPair> pairs_;
-  std::vector<std::uint32_t> node_of_body_;  // by solver index: its tree body, kNone if none
-  std::vector<std::uint32_t> bodies_used_;   // solver indices whose node_of_body_ is set
-  std::vector<JointEquations> equations_;    // by joint
-  std::vector<Quat> turns_;                  // set_turns
+  JointTreeIndex* index_ = nullptr;         // attach()
+  std::vector<std::uint32_t> bodies_used_;  // solver indices the forest's bodies are
+  std::vector<JointEquations> equations_;   // by joint
   // A substep's targets for its sweeps before the move (solve_velocities).
   std::vector<Eigen::Matrix<double, 6, 1>> kept_targets_;
   // The targets of SHAKE's second iterate, and the bodies' velocities it starts from.

@@ -29,6 +29,7 @@ namespace {
 
 // Everything one island needs to advance, independent of every other island.
 struct IslandContext {
+  std::size_t island;
   std::span<const std::uint32_t> bodies;
   std::span<const std::uint32_t> rows;
   std::span<const std::uint32_t> joints;  // indices into scratch.joint_rows
@@ -146,7 +147,8 @@ class SerialIsland {
       }
     }
     if (report->joint_tree && !c.joints.empty()) {
-      tree_ = &c.scratch.joint_trees[omp_get_thread_num()];
+      tree_ = &c.scratch.joint_trees[c.scratch.tree_of_island[c.island]];
+      tree_->attach(&c.scratch.joint_tree_index[omp_get_thread_num()]);
       if (!tree_->build(c.joints, c.scratch.joint_rows, bodies_, bodies_.size())) {
         tree_ = nullptr;
         report->joint_tree = false;
@@ -172,6 +174,12 @@ class SerialIsland {
                           return has_axial_rows(c.scratch.joint_rows[j].joint);
                         });
   }
+
+  ~SerialIsland() {
+    if (tree_ != nullptr) tree_->detach();
+  }
+  SerialIsland(const SerialIsland&) = delete;
+  SerialIsland& operator=(const SerialIsland&) = delete;
 
   bool has_rows() const { return !c_.rows.empty() || !c_.joints.empty(); }
   void pass_impacts(double reach) {
@@ -386,6 +394,7 @@ class SerialIsland {
 
 IslandContext island_context(StepScratch& s, const WorldSettings& settings, std::size_t i) {
   return {
+      i,
       std::span(s.islands.bodies)
           .subspan(s.islands.body_begin[i], s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
       std::span(s.island_rows)
@@ -878,7 +887,13 @@ void World::solve_islands(double dt) {
   for (const StepScratch::PackedManifolds& pack : s.pack_manifolds)
     stats_.packed_manifolds += pack.count;
   const bool parallel = threads > 1 && (work > 1 || !s.team_islands.empty());
-  if (s.joint_trees.size() < static_cast<std::size_t>(threads)) s.joint_trees.resize(threads);
+  s.tree_of_island.assign(s.reports.size(), StepScratch::kNoTree);
+  std::uint32_t trees = 0;
+  for (std::size_t i = 0; i < s.reports.size(); ++i)
+    if (s.islands.joint_begin[i + 1] > s.islands.joint_begin[i]) s.tree_of_island[i] = trees++;
+  if (s.joint_trees.size() < trees) s.joint_trees.resize(trees);
+  if (s.joint_tree_index.size() < static_cast<std::size_t>(threads))
+    s.joint_tree_index.resize(threads);
   // Large islands one after the other with the whole team, then the rest one island per thread:
   // islands share no body and no row, and colours share no moving body, so any thread count gives
   // the same bits.

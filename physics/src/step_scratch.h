@@ -128,7 +128,14 @@ struct StepScratch {
   std::vector<double> first_impact;
   std::vector<std::uint32_t> support_level;               // for tall_stacks.h
   std::vector<std::vector<LevelSums>> thread_level_sums;  // for tall_stacks.h, one per thread
-  std::vector<JointTree> joint_trees;                     // for joint_tree.h, one per thread
+  // For joint_tree.h: a forest per island with joints (their order among the islands: the
+  // islands' order is the same from step to step while nothing joins or parts, so each keeps its
+  // forest), each island's (kNoTree: it has no joints), and the index a forest looks bodies up
+  // in, one per thread (it is as long as the step's bodies).
+  std::vector<JointTree> joint_trees;
+  std::vector<std::uint32_t> tree_of_island;
+  static constexpr std::uint32_t kNoTree = UINT32_MAX;
+  std::vector<JointTreeIndex> joint_tree_index;
   // The touching pairs as the last step left them, with their impulses (contact_pairs.h), sorted
   // by body pair; and this step's, contact for contact, with the index of each one's record in
   // `pairs` (kNoRecord: none) and whether its manifold was taken from there.
