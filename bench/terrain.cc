@@ -87,49 +87,61 @@ struct BoxPose {
   Vec3 half_extents;
 };
 
-// hills: the hills' surface (the mesh's triangles are the heightfield's).
+// The scene's whole run timed step by step (`step` returns false to stop), its boxes' depths
+// under the ground sampled every tenth step untimed, and their speeds (`speed_of`) at the end.
+// `hills`: the hills' surface (the mesh's triangles are the heightfield's); the static ground is
+// the scene's.
+template <class Step, class BoxAt, class SpeedOf>
+Run timed_run(const SceneDef& scene, const HeightField& hills, std::size_t boxes, Step step,
+              BoxAt box_at, SpeedOf speed_of) {
+  const BodyDef* ground = nullptr;
+  for (const BodyDef& body : scene.bodies)
+    if (body.type == BodyType::kStatic) ground = &body;
+  const HeightField* field = std::holds_alternative<HalfSpaceDef>(ground->shape) ? nullptr : &hills;
+  const Pose ground_pose{ground->position, ground->orientation};
+  const int steps = static_cast<int>(scene.duration / scene.dt + 0.5);
+  const int first_steps = std::min(steps, static_cast<int>(5 / scene.dt + 0.5));
+  std::vector<std::uint8_t> through(boxes, 0), dipped(boxes, 0);
+  Run out;
+  double seconds = 0, first_seconds = 0;
+  for (int k = 0; k < steps; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!step()) break;
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (k + 1 == first_steps) first_seconds = seconds;
+    if (k % 10 != 9) continue;  // sampled, untimed
+    sample_depths(field, ground_pose, boxes, box_at, &through, &dipped, &out.deepest);
+  }
+  for (std::size_t k = 0; k < boxes; ++k) {
+    out.through += through[k];
+    out.dipped += dipped[k];
+    out.fastest = std::max(out.fastest, speed_of(k));
+  }
+  out.ms_per_step = 1e3 * seconds / steps;
+  out.first_ms_per_step = 1e3 * first_seconds / first_steps;
+  return out;
+}
+
 Run run(SceneDef scene, int threads, const HeightField& hills) {
   scene.world.threads = threads;
   World world = make_world(scene).value();
-  const int steps = static_cast<int>(scene.duration / scene.dt + 0.5);
   std::vector<BodyId> ids;
-  BodyId ground_id;
   for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
     const BodyId id = world.id_at(slot);
-    if (!id.is_valid()) continue;
-    if (world.body(id).is_static())
-      ground_id = id;
-    else
-      ids.push_back(id);
+    if (id.is_valid() && !world.body(id).is_static()) ids.push_back(id);
   }
-  const bool terrain = is_terrain(world.body(ground_id).shape().type());
-  std::vector<std::uint8_t> through(ids.size(), 0), dipped(ids.size(), 0);
-  Run out;
-  double seconds = 0, first_seconds = 0;
-  const int first_steps = std::min(steps, static_cast<int>(5 / scene.dt + 0.5));
-  for (int step = 0; step < steps; ++step) {
-    const auto start = std::chrono::steady_clock::now();
-    (void)world.step(scene.dt);
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (step + 1 == first_steps) first_seconds = seconds;
-    if (step % 10 != 9) continue;  // sampled, untimed
-    const BodyView ground = world.body(ground_id);
-    sample_depths(
-        terrain ? &hills : nullptr, Pose{ground.position(), ground.orientation()}, ids.size(),
-        [&](std::size_t k) {
-          const BodyView body = world.body(ids[k]);
-          return BoxPose{body.position(), body.orientation(), body.shape().half_extents()};
-        },
-        &through, &dipped, &out.deepest);
-  }
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    out.through += through[k];
-    out.dipped += dipped[k];
-    out.fastest = std::max(out.fastest, world.body(ids[k]).linear_velocity().norm());
-  }
+  Run out = timed_run(
+      scene, hills, ids.size(),
+      [&] {
+        (void)world.step(scene.dt);
+        return true;
+      },
+      [&](std::size_t k) {
+        const BodyView body = world.body(ids[k]);
+        return BoxPose{body.position(), body.orientation(), body.shape().half_extents()};
+      },
+      [&](std::size_t k) { return world.body(ids[k]).linear_velocity().norm(); });
   out.points = world.last_step().contact_points;
-  out.ms_per_step = 1e3 * seconds / steps;
-  out.first_ms_per_step = 1e3 * first_seconds / first_steps;
   return out;
 }
 
@@ -143,43 +155,17 @@ Run run_bullet(const SceneDef& scene, const HeightField& hills) {
     std::fprintf(stderr, "bench_terrain: Bullet: %s\n", why_not.c_str());
     std::exit(1);
   }
-  const BodyDef* ground = nullptr;
   std::vector<Vec3> half_extents;  // the dynamic bodies', in the scene's order (the adapter's)
-  for (const BodyDef& body : scene.bodies) {
-    if (body.type == BodyType::kStatic)
-      ground = &body;
-    else
+  for (const BodyDef& body : scene.bodies)
+    if (body.type != BodyType::kStatic)
       half_extents.push_back(std::get<BoxDef>(body.shape).half_extents);
-  }
-  const bool terrain = !std::holds_alternative<HalfSpaceDef>(ground->shape);
-  const Pose ground_pose{ground->position, ground->orientation};
-  const int steps = static_cast<int>(scene.duration / scene.dt + 0.5);
-  const int first_steps = std::min(steps, static_cast<int>(5 / scene.dt + 0.5));
-  std::vector<std::uint8_t> through(half_extents.size(), 0), dipped(half_extents.size(), 0);
-  Run out;
-  double seconds = 0, first_seconds = 0;
-  for (int step = 0; step < steps; ++step) {
-    const auto start = std::chrono::steady_clock::now();
-    if (!sim->step()) break;
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (step + 1 == first_steps) first_seconds = seconds;
-    if (step % 10 != 9) continue;  // sampled, untimed
-    sample_depths(
-        terrain ? &hills : nullptr, ground_pose, half_extents.size(),
-        [&](std::size_t k) {
-          const bench::BodyState state = sim->body(k);
-          return BoxPose{state.position, state.orientation, half_extents[k]};
-        },
-        &through, &dipped, &out.deepest);
-  }
-  for (std::size_t k = 0; k < half_extents.size(); ++k) {
-    out.through += through[k];
-    out.dipped += dipped[k];
-    out.fastest = std::max(out.fastest, sim->body(k).linear_velocity.norm());
-  }
-  out.ms_per_step = 1e3 * seconds / steps;
-  out.first_ms_per_step = 1e3 * first_seconds / first_steps;
-  return out;
+  return timed_run(
+      scene, hills, half_extents.size(), [&] { return sim->step(); },
+      [&](std::size_t k) {
+        const bench::BodyState state = sim->body(k);
+        return BoxPose{state.position, state.orientation, half_extents[k]};
+      },
+      [&](std::size_t k) { return sim->body(k).linear_velocity.norm(); });
 }
 #endif
 
