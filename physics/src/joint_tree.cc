@@ -342,10 +342,21 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
   // body's stiffest turn or shift (and rho0 = kResolvedTurn^2); continuous in the load.
   const double resolved = kResolvedTurn * kResolvedTurn;
   bool any = false;
-  // rho: the largest eigenvalue of W^1/2 K W^1/2 (W the inverse mass or inertia).
-  auto keep_excess = [&](Mat3& stiffness, const Mat3& inverse_mass) {
-    // The trace of K W bounds rho from above (both are positive semidefinite): most bodies
-    // (every body of a pendulum or of a chain of like links) end here, without the eigenvalues.
+  // rho: the largest eigenvalue of W^1/2 K W^1/2 (W the inverse mass or inertia, M its inverse).
+  // rho < r exactly when r M - K is positive definite (the same congruence): three leading minors,
+  // a few dozen operations, where the eigenvalues cost a hundred times that. Tested with r a
+  // millionth short, so that a body it passes is one whose rho the eigenvalues would find below
+  // r too (their error is near rounding): the same stiffness, zero, and the same bits.
+  const double surely_resolved = resolved * (1 - 1e-6);
+  auto keep_excess = [&](Mat3& stiffness, const Mat3& mass, auto inverse_of_mass) {
+    const Mat3 margin = surely_resolved * mass - stiffness;
+    const double minor2 = margin(0, 0) * margin(1, 1) - margin(0, 1) * margin(1, 0);
+    if (margin(0, 0) > 0 && minor2 > 0 && margin.determinant() > 0) {
+      stiffness.setZero();
+      return;
+    }
+    const Mat3 inverse_mass = inverse_of_mass();
+    // The trace of K W bounds rho from above (both are positive semidefinite).
     if ((stiffness * inverse_mass).trace() <= resolved) {
       stiffness.setZero();
       return;
@@ -359,14 +370,15 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
   };
   for (TreeBody& node : tree_bodies_) {
     const SolverBody& body = bodies[node.index];
-    keep_excess(node.linear_stiffness, body.inverse_mass * Mat3::Identity());
+    keep_excess(node.linear_stiffness, Mat3(Mat3::Identity() / body.inverse_mass),
+                [&] { return Mat3(body.inverse_mass * Mat3::Identity()); });
     // A turn moves the anchors, and the joints move the body with them: against its longest
     // lever r the turn's inertia is at least I + m (|r|^2 - r r^T) (a pendulum's bob turns about
     // its pivot, not its centre).
     const Vec3& r = node.longest_lever;
     const Mat3 turning =
         node.inertia + (r.squaredNorm() * Mat3::Identity() - r * r.transpose()) / body.inverse_mass;
-    keep_excess(node.angular_stiffness, turning.inverse());
+    keep_excess(node.angular_stiffness, turning, [&] { return Mat3(turning.inverse()); });
   }
   return any;
 }
