@@ -268,6 +268,8 @@ void JointTree::finish_build(std::span<const JointRow> rows, std::span<const Sol
   for (TreeBody& body : tree_bodies_)
     body.inertia = bodies[body.index].inverse_inertia.inverse();
   velocities_factored_ = false;
+  share_pending_ = false;
+  stiffness_kept_ = false;
   targets_taken_ = false;
 }
 
@@ -606,7 +608,8 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   if (joints_.empty()) return 0;
   // The poses stay put between moves: one factoring serves every sweep until the next.
   if (!velocities_factored_) {
-    stiffened_ = set_geometric_stiffness(rows, bodies, poses, target.substep);
+    stiffened_ = stiffness_kept_ || set_geometric_stiffness(rows, bodies, poses, target.substep);
+    stiffness_kept_ = false;
     factor(bodies, true, [&](std::size_t k, JointEquations* equations) {
       JointTarget plain = target;
       plain.h = 0;
@@ -735,12 +738,8 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
   // A move came before: the next sweeps take their targets afresh, and factor again unless this
   // pass or one before it since the move factored for them.
   targets_taken_ = false;
+  stiffness_kept_ = false;
   if (refactor) {
-    // Shared only where no body takes stiffness: a light link's stiffness as mass in the position
-    // passes shifted its corrections onto the heavy end, and a chain of beads under a million
-    // times heavier end tore.
-    const bool for_velocities = velocity_substep > 0 && !has_motors_ &&
-                                !set_geometric_stiffness(rows, bodies, poses, velocity_substep);
     bool bound_rows = false;
     factor(bodies, false, [&](std::size_t k, JointEquations* equations) {
       joints_[k].bounds = 0;
@@ -748,9 +747,11 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
                          bounds ? &joints_[k].bounds : nullptr);
       bound_rows = bound_rows || joints_[k].bounds != 0;
     });
-    // The velocity sweeps hold no bound as an equality: a factoring with bound rows is not theirs.
-    velocities_factored_ = for_velocities && !bound_rows;
-    if (velocities_factored_) stiffened_ = false;
+    // The velocity sweeps hold no bound as an equality: a factoring with bound rows is not theirs;
+    // nor one where a body takes stiffness (settle_velocity_factors decides after the passes).
+    velocities_factored_ = false;
+    share_pending_ = velocity_substep > 0 && !has_motors_ && !bound_rows;
+    shared_substep_ = velocity_substep;
     solve(false, [&](std::size_t k) { return equations_[k].target; });
   } else {
     solve(false, [&](std::size_t k) {
@@ -761,6 +762,23 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
   for (const TreeBody& body : tree_bodies_)
     joint_detail::move_body(&bodies[body.index], &poses[body.index], body.result.head<3>(),
                             body.result.tail<3>());
+}
+
+void JointTree::settle_velocity_factors(std::span<const JointRow> rows,
+                                        std::span<const SolverBody> bodies,
+                                        std::span<const Pose> poses, bool keep_stiffness) {
+  if (!share_pending_) return;
+  share_pending_ = false;
+  // Shared only where no body takes stiffness: a light link's stiffness as mass in the position
+  // passes shifted its corrections onto the heavy end, and a chain of beads under a million times
+  // heavier end tore. Worked out where the sweeps' own factoring would work it out (the poses
+  // after the last pass, the impulses of the sweeps before), so that it can keep it.
+  if (!set_geometric_stiffness(rows, bodies, poses, shared_substep_)) {
+    velocities_factored_ = true;
+    stiffened_ = false;
+    return;
+  }
+  stiffness_kept_ = keep_stiffness;
 }
 
 void JointTree::set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies,

@@ -63,13 +63,20 @@ class JointTree {
   // untouched): a position pass. Without `refactor`, with the rows of the pass before (a chord
   // step: the passes after the first correct errors a million times smaller, through rows that
   // barely turned); the first pass after a move must refactor. With `velocity_substep` > 0 (and
-  // no motor in the tree: its row is a velocity row alone), the pass's factors serve the velocity
-  // sweeps too where no body takes stiffness for a substep of that length (their systems are then
-  // the same: the same rows and masses; the passes after it move the bodies by a millionth of
-  // this one's correction).
+  // no motor in the tree: its row is a velocity row alone), the pass's factors may serve the
+  // velocity sweeps too, where no body takes stiffness for a substep of that length (their
+  // systems are then the same: the same rows and masses; the passes after it move the bodies by a
+  // millionth of this one's correction): settle_velocity_factors says after the last pass.
   void solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                        std::span<Pose> poses, bool refactor, double velocity_substep = 0,
                        bool bounds = true);
+  // After a move's position passes: whether the factors of the pass given a velocity_substep serve
+  // the velocity sweeps (no body takes stiffness at the poses the passes left). Where some body
+  // does, and `keep_stiffness`, the stiffness worked out here is the next velocity factoring's
+  // (the sweeps that follow meet these poses and impulses; the exact solver's substep clears the
+  // impulses first, and does not keep it).
+  void settle_velocity_factors(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
+                               std::span<const Pose> poses, bool keep_stiffness);
 
   // The exact solver's use of the tree (exact_joints.h), with the velocity factors of the last
   // solve_velocities: whether a body is one of the tree's;
@@ -220,6 +227,10 @@ class JointTree {
   std::vector<Eigen::Matrix<double, 6, 1>> second_targets_, held_velocities_;
   bool velocities_factored_ = false;  // since the last move
   bool stiffened_ = false;
+  // settle_velocity_factors: a pass's factors that may serve the sweeps, for a substep of
+  // shared_substep_; and the bodies' stiffness worked out for the next velocity factoring.
+  bool share_pending_ = false, stiffness_kept_ = false;
+  double shared_substep_ = 0;
   bool has_motors_ = false;     // a joint with a motor: its row joins the velocity system
   bool targets_taken_ = false;  // since the last move
   // For building: each node's neighbours and the visit.

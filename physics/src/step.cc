@@ -221,6 +221,9 @@ class SerialIsland {
       for (std::uint32_t j : c_.joints)
         correct_joint_position(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
     }
+    if (tree_ != nullptr)
+      tree_->settle_velocity_factors(c_.scratch.joint_rows, bodies_, c_.scratch.poses,
+                                     !report_->exact_joints);
     joint_terms_current_ = false;
   }
   void refresh_separations() { update_separations(rows_, c_.rows, bodies_, kinematic_time()); }
