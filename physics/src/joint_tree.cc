@@ -751,7 +751,6 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
     // nor one where a body takes stiffness (settle_velocity_factors decides after the passes).
     velocities_factored_ = false;
     share_pending_ = velocity_substep > 0 && !has_motors_ && !bound_rows;
-    shared_substep_ = velocity_substep;
     solve(false, [&](std::size_t k) { return equations_[k].target; });
   } else {
     solve(false, [&](std::size_t k) {
@@ -766,14 +765,15 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
 
 void JointTree::settle_velocity_factors(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
-                                        std::span<const Pose> poses, bool keep_stiffness) {
+                                        std::span<const Pose> poses, double h,
+                                        bool keep_stiffness) {
   if (!share_pending_) return;
   share_pending_ = false;
   // Shared only where no body takes stiffness: a light link's stiffness as mass in the position
   // passes shifted its corrections onto the heavy end, and a chain of beads under a million times
   // heavier end tore. Worked out where the sweeps' own factoring would work it out (the poses
   // after the last pass, the impulses of the sweeps before), so that it can keep it.
-  if (!set_geometric_stiffness(rows, bodies, poses, shared_substep_)) {
+  if (!set_geometric_stiffness(rows, bodies, poses, h)) {
     velocities_factored_ = true;
     stiffened_ = false;
     return;

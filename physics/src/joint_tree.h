@@ -70,13 +70,13 @@ class JointTree {
   void solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                        std::span<Pose> poses, bool refactor, double velocity_substep = 0,
                        bool bounds = true);
-  // After a move's position passes: whether the factors of the pass given a velocity_substep serve
+  // After a move's position passes: whether the factors of the pass given velocity_substep h serve
   // the velocity sweeps (no body takes stiffness at the poses the passes left). Where some body
   // does, and `keep_stiffness`, the stiffness worked out here is the next velocity factoring's
   // (the sweeps that follow meet these poses and impulses; the exact solver's substep clears the
   // impulses first, and does not keep it).
   void settle_velocity_factors(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
-                               std::span<const Pose> poses, bool keep_stiffness);
+                               std::span<const Pose> poses, double h, bool keep_stiffness);
 
   // The exact solver's use of the tree (exact_joints.h), with the velocity factors of the last
   // solve_velocities: whether a body is one of the tree's;
@@ -227,10 +227,9 @@ class JointTree {
   std::vector<Eigen::Matrix<double, 6, 1>> second_targets_, held_velocities_;
   bool velocities_factored_ = false;  // since the last move
   bool stiffened_ = false;
-  // settle_velocity_factors: a pass's factors that may serve the sweeps, for a substep of
-  // shared_substep_; and the bodies' stiffness worked out for the next velocity factoring.
+  // settle_velocity_factors: a pass's factors that may serve the sweeps, and the bodies'
+  // stiffness worked out for the next velocity factoring.
   bool share_pending_ = false, stiffness_kept_ = false;
-  double shared_substep_ = 0;
   bool has_motors_ = false;     // a joint with a motor: its row joins the velocity system
   bool targets_taken_ = false;  // since the last move
   // For building: each node's neighbours and the visit.

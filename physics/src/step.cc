@@ -222,7 +222,7 @@ class SerialIsland {
         correct_joint_position(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
     }
     if (tree_ != nullptr)
-      tree_->settle_velocity_factors(c_.scratch.joint_rows, bodies_, c_.scratch.poses,
+      tree_->settle_velocity_factors(c_.scratch.joint_rows, bodies_, c_.scratch.poses, h,
                                      !report_->exact_joints);
     joint_terms_current_ = false;
   }
