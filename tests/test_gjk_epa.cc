@@ -5,6 +5,7 @@
 #include "epa.h"
 #include "gjk.h"
 #include "physics/collision.h"
+#include "segment.h"
 #include "test_support.h"
 
 namespace tumble {
@@ -152,6 +153,41 @@ TEST(Epa, RandomHullsAgreeWithSatAndSeparateAlongTheirNormal) {
   }
   EXPECT_GT(overlapping, 1000);
   EXPECT_GT(separated, 300);
+}
+
+// The closed form against a convex search: the squared distance from the box is convex along the
+// segment, so a ternary search over the parameter converges on its least value.
+TEST(SegmentBox, ClosestMatchesAConvexSearch) {
+  Random rng(11);
+  int apart = 0, meeting = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 half = rng.vector(0.05, 1.5);
+    Vec3 p = rng.vector(-3, 3), q = rng.vector(-3, 3);
+    // A segment parallel to a face (or two), and one with an end on a face's plane.
+    if (i % 4 == 1) q[rng.integer(0, 2)] = p[0];
+    if (i % 4 == 1) q[i % 3] = p[i % 3];
+    if (i % 4 == 2) p[rng.integer(0, 2)] = (i % 8 == 2 ? 1 : -1) * half[0];
+    auto squared_at = [&](double t) {
+      const Vec3 x = p + t * (q - p);
+      return (x - x.cwiseMax(-half).cwiseMin(half)).squaredNorm();
+    };
+    double lo = 0, hi = 1;
+    for (int k = 0; k < 200; ++k) {
+      const double a = lo + (hi - lo) / 3, b = hi - (hi - lo) / 3;
+      (squared_at(a) <= squared_at(b) ? hi : lo) = squared_at(a) <= squared_at(b) ? b : a;
+    }
+    const double reference = std::min({squared_at(0), squared_at(1), squared_at(0.5 * (lo + hi))});
+    const SegmentBoxClosest closest = closest_segment_box(p, q, half);
+    ASSERT_GE(closest.t, 0.0) << i;
+    ASSERT_LE(closest.t, 1.0) << i;
+    ASSERT_EQ(closest.squared_distance, squared_at(closest.t)) << i;
+    ASSERT_NEAR(closest.squared_distance, reference, 1e-12 * (1 + reference)) << i;
+    ASSERT_LE(closest.squared_distance, reference + 1e-14 * (1 + reference)) << i;
+    (reference > 1e-12 ? apart : meeting) += 1;
+  }
+  // Both kinds were met.
+  EXPECT_GT(apart, 5000);
+  EXPECT_GT(meeting, 1000);
 }
 
 }  // namespace

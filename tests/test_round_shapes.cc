@@ -87,6 +87,37 @@ TEST(RoundShapes, CapsuleLyingOnBoxGivesTwoPoints) {
   EXPECT_NEAR(std::abs(m.points[0].point_a.x() - m.points[1].point_a.x()), 2.0, 1e-12);
 }
 
+// A capsule against a box (the closed form) and against the same box as a hull (GJK): one answer.
+TEST(RoundShapes, CapsuleAgainstHullMatchesCapsuleAgainstEqualBox) {
+  std::vector<Vec3> corners;
+  const Vec3 half(0.6, 0.3, 0.2);
+  for (int i = 0; i < 8; ++i)
+    corners.emplace_back((i & 1) ? half.x() : -half.x(), (i & 2) ? half.y() : -half.y(),
+                         (i & 4) ? half.z() : -half.z());
+  const Shape hull = make(HullDef{corners});
+  const Shape box = make(BoxDef{half});
+  const Shape capsule = make(CapsuleDef{0.1, 0.25});
+  CollisionSettings settings;
+  settings.margin = 0.05;
+  testing::Random rng(5);
+  int touching = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Pose capsule_pose = at(rng.vector(-1.1, 1.1), rng.rotation());
+    const Pose body = at(Vec3::Zero(), i % 2 == 0 ? Quat::Identity() : rng.rotation());
+    ContactManifold mh, mb;
+    collide(capsule, capsule_pose, hull, body, settings, &mh);
+    collide(capsule, capsule_pose, box, body, settings, &mb);
+    ASSERT_EQ(mh.count, mb.count) << i;
+    if (mb.count == 0) continue;
+    ++touching;
+    ASSERT_NEAR(mh.depth, mb.depth, 1e-9) << i;
+    ASSERT_TRUE(mh.normal.isApprox(mb.normal, 1e-6)) << i;
+    for (int k = 0; k < mb.count; ++k)
+      ASSERT_TRUE(mh.points[k].point_a.isApprox(mb.points[k].point_a, 1e-6)) << i;
+  }
+  EXPECT_GT(touching, 400);
+}
+
 TEST(RoundShapes, CapsuleCoreInsideBoxUsesEpa) {
   const Shape capsule = make(CapsuleDef{0.1, 0.5});
   const Shape box = make(BoxDef{Vec3(1, 1, 1)});

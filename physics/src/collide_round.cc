@@ -1,6 +1,7 @@
 // Spheres and capsules: a point or a segment (the core) swept by a radius. Against each other the
 // answer is closed-form (closest points of the cores); against a polytope the core's distance comes
-// from GJK, and a core that has entered the polytope from EPA (segment) or the face planes (point).
+// from GJK (closed-form against a box), and a core that has entered the polytope from EPA (segment)
+// or the face planes (point).
 #include "epa.h"
 #include "manifold.h"
 #include "narrow_phase.h"
@@ -130,6 +131,15 @@ std::uint32_t collide_round_polyhedron(const Vec3& p, const Vec3& q, double radi
       normal[axis] = p[axis] >= 0 ? -1.0 : 1.0;
     }
     core_point = p;
+  } else if (const SegmentBoxClosest closest = box_half_extents != nullptr
+                                                   ? closest_segment_box(p, q, *box_half_extents)
+                                                   : SegmentBoxClosest{0, 0};
+             closest.squared_distance > tolerance * tolerance) {
+    // Apart from a box: its closest points in closed form (segment.h).
+    core_point = p + closest.t * (q - p);
+    const Vec3 on_box = core_point.cwiseMax(-*box_half_extents).cwiseMin(*box_half_extents);
+    normal = direction_or(core_point, on_box, Vec3::UnitZ(), &core_depth);
+    core_depth = -core_depth;
   } else {
     const SegmentSupport core{p, q};
     const PolyhedronSupport support_b{&poly};

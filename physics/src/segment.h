@@ -49,6 +49,61 @@ inline double closest_on_segment(const Vec3& p, const Vec3& q, const Vec3& x) {
   return length2 > 0 ? std::clamp((x - p).dot(d) / length2, 0.0, 1.0) : 0.0;
 }
 
+// The point of segment p..q nearest to the box |x_i| <= half_i (in the box's frame), as a
+// parameter in [0, 1], and its squared distance from the box. That distance, the sum over the
+// axes of (|x_i| - half_i)^2 where positive, is convex along the segment and one quadratic
+// between the parameters where the segment crosses a face's plane (at most six of them): the
+// least of the pieces' minima is the exact answer, a few dozen operations where GJK iterates
+// over the box's corners. Where the segment meets the box the distance is 0 (rounding aside).
+struct SegmentBoxClosest {
+  double t = 0, squared_distance = 0;
+};
+inline SegmentBoxClosest closest_segment_box(const Vec3& p, const Vec3& q, const Vec3& half) {
+  const Vec3 u = q - p;
+  double breaks[8];
+  int count = 0;
+  breaks[count++] = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (u[i] == 0) continue;
+    for (const double plane : {-half[i], half[i]}) {
+      const double t = (plane - p[i]) / u[i];
+      if (t > 0 && t < 1) {
+        int k = count++;  // sorted as they come: at most six
+        for (; k > 1 && breaks[k - 1] > t; --k)
+          breaks[k] = breaks[k - 1];
+        breaks[k] = t;
+      }
+    }
+  }
+  breaks[count++] = 1;
+  auto squared_distance_at = [&](double t) {
+    const Vec3 x = p + t * u;
+    return (x - x.cwiseMax(-half).cwiseMin(half)).squaredNorm();
+  };
+  SegmentBoxClosest best{0, squared_distance_at(0)};
+  for (int k = 0; k + 1 < count; ++k) {
+    const double lo = breaks[k], hi = breaks[k + 1];
+    // Which planes the piece lies beyond, from its middle (its ends may sit on a plane).
+    const Vec3 middle = p + (0.5 * (lo + hi)) * u;
+    double uu = 0, uc = 0;
+    for (int i = 0; i < 3; ++i) {
+      double plane;
+      if (middle[i] > half[i])
+        plane = half[i];
+      else if (middle[i] < -half[i])
+        plane = -half[i];
+      else
+        continue;
+      uu += u[i] * u[i];
+      uc += u[i] * (p[i] - plane);
+    }
+    const double t = uu > 0 ? std::clamp(-uc / uu, lo, hi) : lo;
+    const double squared = squared_distance_at(t);
+    if (squared < best.squared_distance) best = {t, squared};
+  }
+  return best;
+}
+
 // A unit vector orthogonal to `v` (which need not be unit).
 inline Vec3 any_orthogonal(const Vec3& v) {
   int least = 0;
