@@ -425,6 +425,7 @@ void set_row(JointEquations& e, int i, const AxialRow& row) {
 // Three rows at once: the point (rate: b's anchor's velocity less a's), or the rotation
 // (w_b - w_a).
 void set_point_rows(JointEquations& e, int first, const Anchors& anchors) {
+  e.point_rows = first == 0;
   e.on_a.block<3, 3>(first, 0) = -Mat3::Identity();
   e.on_a.block<3, 3>(first, 3) = skew(anchors.ra);
   e.on_b.block<3, 3>(first, 0) = Mat3::Identity();
@@ -437,6 +438,7 @@ void set_rotation_rows(JointEquations& e, int first) {
 
 void clear_equations(JointEquations* e) {
   e->rows = 0;
+  e->point_rows = false;
   e->on_a.setZero();
   e->on_b.setZero();
   e->target.setZero();

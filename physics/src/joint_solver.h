@@ -59,6 +59,9 @@ struct JointTarget {
 struct JointEquations {
   using Vector = Eigen::Matrix<double, 6, 1>;
   int rows = 0;
+  // Whether the first three rows are a point's (a ball's, a hinge's, a fixed joint's): on a,
+  // [-I, [r_a]x]; on b, [I, -[r_b]x] (JointTree's products take that shape).
+  bool point_rows = false;
   Eigen::Matrix<double, 6, 6> on_a = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 6> on_b = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> target = Eigen::Matrix<double, 6, 1>::Zero();

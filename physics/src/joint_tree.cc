@@ -6,6 +6,7 @@
 
 #include "joint_geometry.h"
 #include "rotation.h"
+#include "wide.h"
 
 namespace tumble {
 namespace {
@@ -401,6 +402,36 @@ void with_widths(int first, int second, F&& f) {
              [&]<int A>() { with_width(second, [&]<int B>() { f.template operator()<A, B>(); }); });
 }
 
+// A joint's rows on one of its bodies times x (6 x n): the first A rows of J x. Where the first
+// three are a point's (JointEquations::point_rows: on a, [-I, [r_a]x]; on b, [I, -[r_b]x]), they
+// are plus or minus x's linear half and a cross product with its angular half, half the
+// dense rows' arithmetic; the rest are written out (Eigen's general product of these shapes was
+// a call of its own, a tenth of a ragdoll pile's factoring).
+template <int A, class X>
+TUMBLE_INLINE Eigen::Matrix<double, A, X::ColsAtCompileTime> rows_times(
+    const JointEquations& equations, bool side_b, const X& x) {
+  const Eigen::Matrix<double, 6, 6>& rows = side_b ? equations.on_b : equations.on_a;
+  Eigen::Matrix<double, A, X::ColsAtCompileTime> out;
+  int first = 0;
+  if (equations.point_rows) {
+    // The cross block [c]x holds c: ([c]x)(2,1) = c_x, (0,2) = c_y, (1,0) = c_z.
+    const Vec3 c(rows(2, 4), rows(0, 5), rows(1, 3));
+    for (int col = 0; col < x.cols(); ++col) {
+      const Vec3 linear = x.col(col).template head<3>(), angular = x.col(col).template tail<3>();
+      out.col(col).template head<3>() = (side_b ? linear : Vec3(-linear)) + c.cross(angular);
+    }
+    first = 3;
+  }
+  for (int col = 0; col < x.cols(); ++col)
+    for (int i = first; i < A; ++i) {
+      double sum = rows(i, 0) * x(0, col);
+      for (int k = 1; k < 6; ++k)
+        sum += rows(i, k) * x(k, col);
+      out(i, col) = sum;
+    }
+  return out;
+}
+
 }  // namespace
 
 template <class Equations>
@@ -439,19 +470,7 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
               body.inverse_mass * rows_on_body.template leftCols<3>().transpose();
         response.template bottomLeftCorner<3, W>().noalias() =
             body.angular_inverse.lazyProduct(rows_on_body.template rightCols<3>().transpose());
-        if constexpr (W == 3) {
-          pivot.noalias() += rows_on_body.lazyProduct(response.template leftCols<W>());
-        } else {
-          // Written out: Eigen's general 6 x 6 product here was a call of its own, a tenth of a
-          // ragdoll pile's factoring.
-          for (int j = 0; j < W; ++j)
-            for (int i = 0; i < W; ++i) {
-              double sum = rows_on_body(i, 0) * response(0, j);
-              for (int c = 1; c < 6; ++c)
-                sum += rows_on_body(i, c) * response(c, j);
-              pivot(i, j) += sum;
-            }
-        }
+        pivot += rows_times<W>(equations_[k], side_b, response.template leftCols<W>());
       }
       for (int r = equations_[k].rows; r < W; ++r)
         pivot(r, r) = 1;
@@ -468,10 +487,8 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
         const bool second_b = member_side_b_[hub.first_member + j] != 0;
         const Mat6& response = second_b ? joints_[second].response_b : joints_[second].response_a;
         with_widths(joints_[first].width, joints_[second].width, [&]<int A, int B>() {
-          pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>().noalias() =
-              jacobian(first, first_b)
-                  .template topRows<A>()
-                  .lazyProduct(response.template leftCols<B>());
+          pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>() =
+              rows_times<A>(equations_[first], first_b, response.template leftCols<B>());
         });
       }
     }
@@ -543,8 +560,7 @@ void JointTree::solve(bool from_base, Targets targets) {
       for (const bool side_b : {false, true}) {
         const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
         if (b == kNone) continue;
-        joint.rhs.template head<W>().noalias() +=
-            jacobian(k, side_b).template topRows<W>().lazyProduct(tree_bodies_[b].base);
+        joint.rhs.template head<W>() += rows_times<W>(equations_[k], side_b, tree_bodies_[b].base);
       }
     });
   }
