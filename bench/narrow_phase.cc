@@ -159,7 +159,8 @@ void report(const char* title, const std::vector<PairSpec>& pairs,
 // Capsule-box pairs where the capsule's core stays outside the box (a capsule resting on or
 // against a box; a core inside it goes to EPA either way): the closed form (segment.h) against
 // GJK on the same box as a hull. Reference: the core's squared distance from the box is convex
-// along the core, so a ternary search over the core's parameter finds it to rounding.
+// along the core, so a ternary search over the core's parameter finds it to rounding
+// (test_support.h).
 void report_capsule_box(int count, Random& rng) {
   struct CapsulePair {
     double radius, half_height;
@@ -180,19 +181,8 @@ void report_capsule_box(int count, Random& rng) {
     const Vec3 axis = p.capsule.orientation * Vec3(0, 0, p.half_height);
     const Vec3 core_p = to_box * (p.capsule.position - axis),
                core_q = to_box * (p.capsule.position + axis);
-    auto squared_at = [&](double t) {
-      const Vec3 x = core_p + t * (core_q - core_p);
-      return (x - x.cwiseMax(-p.half).cwiseMin(p.half)).squaredNorm();
-    };
-    double lo = 0, hi = 1;
-    for (int k = 0; k < 200; ++k) {
-      const double a = lo + (hi - lo) / 3, b = hi - (hi - lo) / 3;
-      if (squared_at(a) <= squared_at(b))
-        hi = b;
-      else
-        lo = a;
-    }
-    const double distance = std::sqrt(std::min({squared_at(0), squared_at(1), squared_at(lo)}));
+    const double distance =
+        std::sqrt(testing::segment_box_squared_distance_by_search(core_p, core_q, p.half));
     if (distance < 1e-3 || distance >= p.radius) continue;  // core inside, or not touching
     p.depth = p.radius - distance;
     pairs.push_back(p);
@@ -201,11 +191,7 @@ void report_capsule_box(int count, Random& rng) {
   for (const CapsulePair& p : pairs) {
     capsules.push_back(Shape::create(CapsuleDef{p.radius, p.half_height}).value());
     boxes.push_back(Shape::create(BoxDef{p.half}).value());
-    std::vector<Vec3> corners;
-    for (int i = 0; i < 8; ++i)
-      corners.emplace_back((i & 1) ? p.half.x() : -p.half.x(), (i & 2) ? p.half.y() : -p.half.y(),
-                           (i & 4) ? p.half.z() : -p.half.z());
-    hulls.push_back(Shape::create(HullDef{corners}).value());
+    hulls.push_back(Shape::create(HullDef{testing::box_corners(p.half)}).value());
   }
   std::printf("\nCapsule-box (core outside the box): %zu touching pairs, one thread\n",
               pairs.size());

@@ -155,8 +155,8 @@ TEST(Epa, RandomHullsAgreeWithSatAndSeparateAlongTheirNormal) {
   EXPECT_GT(separated, 300);
 }
 
-// The closed form against a convex search: the squared distance from the box is convex along the
-// segment, so a ternary search over the parameter converges on its least value.
+// The closed form against a convex search (test_support.h): the squared distance from the box is
+// convex along the segment, so a ternary search over the parameter converges on its least value.
 TEST(SegmentBox, ClosestMatchesAConvexSearch) {
   Random rng(11);
   int apart = 0, meeting = 0;
@@ -171,12 +171,7 @@ TEST(SegmentBox, ClosestMatchesAConvexSearch) {
       const Vec3 x = p + t * (q - p);
       return (x - x.cwiseMax(-half).cwiseMin(half)).squaredNorm();
     };
-    double lo = 0, hi = 1;
-    for (int k = 0; k < 200; ++k) {
-      const double a = lo + (hi - lo) / 3, b = hi - (hi - lo) / 3;
-      (squared_at(a) <= squared_at(b) ? hi : lo) = squared_at(a) <= squared_at(b) ? b : a;
-    }
-    const double reference = std::min({squared_at(0), squared_at(1), squared_at(0.5 * (lo + hi))});
+    const double reference = testing::segment_box_squared_distance_by_search(p, q, half);
     const SegmentBoxClosest closest = closest_segment_box(p, q, half);
     ASSERT_GE(closest.t, 0.0) << i;
     ASSERT_LE(closest.t, 1.0) << i;

@@ -89,12 +89,8 @@ TEST(RoundShapes, CapsuleLyingOnBoxGivesTwoPoints) {
 
 // A capsule against a box (the closed form) and against the same box as a hull (GJK): one answer.
 TEST(RoundShapes, CapsuleAgainstHullMatchesCapsuleAgainstEqualBox) {
-  std::vector<Vec3> corners;
   const Vec3 half(0.6, 0.3, 0.2);
-  for (int i = 0; i < 8; ++i)
-    corners.emplace_back((i & 1) ? half.x() : -half.x(), (i & 2) ? half.y() : -half.y(),
-                         (i & 4) ? half.z() : -half.z());
-  const Shape hull = make(HullDef{corners});
+  const Shape hull = make(HullDef{testing::box_corners(half)});
   const Shape box = make(BoxDef{half});
   const Shape capsule = make(CapsuleDef{0.1, 0.25});
   CollisionSettings settings;

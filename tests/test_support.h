@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 #include "physics/math.h"
 
@@ -103,6 +104,35 @@ inline double box_signed_distance(const Vec3& h, const Pose& pose, const Vec3& w
   const Vec3 q = p.cwiseAbs() - h;
   const double outside = q.cwiseMax(0.0).norm();
   return outside > 0 ? outside : q.maxCoeff();
+}
+
+// The eight corners of the box |x_i| <= half_i (to build the same box as a hull).
+inline std::vector<Vec3> box_corners(const Vec3& half) {
+  std::vector<Vec3> corners;
+  for (int i = 0; i < 8; ++i)
+    corners.emplace_back((i & 1) ? half.x() : -half.x(), (i & 2) ? half.y() : -half.y(),
+                         (i & 4) ? half.z() : -half.z());
+  return corners;
+}
+
+// The squared distance of segment p..q from the box |x_i| <= half_i, by a ternary search over
+// the segment's parameter: that distance is convex along the segment. Shares no code with the
+// engine's closed form (segment.h).
+inline double segment_box_squared_distance_by_search(const Vec3& p, const Vec3& q,
+                                                     const Vec3& half) {
+  auto squared_at = [&](double t) {
+    const Vec3 x = p + t * (q - p);
+    return (x - x.cwiseMax(-half).cwiseMin(half)).squaredNorm();
+  };
+  double lo = 0, hi = 1;
+  for (int k = 0; k < 200; ++k) {
+    const double a = lo + (hi - lo) / 3, b = hi - (hi - lo) / 3;
+    if (squared_at(a) <= squared_at(b))
+      hi = b;
+    else
+      lo = a;
+  }
+  return std::min({squared_at(0), squared_at(1), squared_at(0.5 * (lo + hi))});
 }
 
 }  // namespace tumble::testing
