@@ -161,7 +161,7 @@ void HashGrid::list_cells(std::span<const Aabb> bounds, std::span<const std::uin
   // Emptied here too, for a team smaller than asked for (find_pairs).
   for (std::vector<Entry>& run : thread_entries_)
     run.clear();
-  run_region(threads, count > 256, [&] {
+  run_region(threads, worth_a_team(count, 60), [&] {
     const int t = omp_get_thread_num();
     auto& mine = thread_entries_[t];
     mine.clear();

@@ -75,6 +75,18 @@ class RegionTimer {
 
 }  // namespace detail
 
+// Whether `items` of a loop, each about `nanoseconds_each` on one thread, are worth a team.
+// Under OMP_WAIT_POLICY=passive (our programs' default) a team's threads sleep between regions,
+// and waking them costs tens of microseconds, more on a virtual machine whose idle cores halt
+// (measured 2026-11-29 on a 2-core one: a region of 20 us of work took 60-200 us on two
+// threads). A region pays when its work is several wake-ups: about 50 us on one thread. The
+// per-item costs at the call sites are one thread's, measured by a region's time over its items
+// in the landed pile of 4000 (bench_threads with a timing probe).
+inline constexpr double kRegionWorthNanoseconds = 50'000;
+constexpr bool worth_a_team(std::int64_t items, double nanoseconds_each) {
+  return static_cast<double>(items) * nanoseconds_each >= kRegionWorthNanoseconds;
+}
+
 // Runs `region()` on a team of `threads` when `parallel` and threads > 1, else on this thread.
 template <class Region>
 void run_region(int threads, bool parallel, Region&& region) {

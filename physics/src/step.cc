@@ -1053,7 +1053,8 @@ void World::update_sleep(double dt) {
   // Each body's timer over the team (each its own), then each island's shortest.
   const std::int64_t island_bodies = static_cast<std::int64_t>(s.islands.bodies.size());
   for_indices(
-      team_size(settings_.threads), island_bodies > 1024, island_bodies, [&](std::int64_t k) {
+      team_size(settings_.threads), worth_a_team(island_bodies, 34), island_bodies,
+      [&](std::int64_t k) {
         Body& body = bodies_[s.solver_slot[s.islands.bodies[k]]].body;
         const auto anchor_here = [&body] {
           body.sleep_anchor_position = body.position;
@@ -1109,7 +1110,7 @@ void World::finish_step(double dt) {
   TUMBLE_ASSERT(s.next_pairs.size() == contacts_.size());
   impulses_.resize(s.rows.size());
   std::uint32_t non_finite = 0, slowed = 0, stopped = 0;
-  run_region(threads, std::max(moving, manifolds) > 256, [&] {
+  run_region(threads, worth_a_team(moving + manifolds, 33), [&] {
     std::uint32_t my_non_finite = 0, my_slowed = 0, my_stopped = 0;
 #pragma omp for schedule(static) nowait
     for (std::int64_t k = 0; k < moving; ++k) {

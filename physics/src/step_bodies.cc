@@ -64,7 +64,7 @@ void World::load_solver_bodies() {
   s.dynamic.resize(solver_bodies);
   s.body_of.resize(solver_bodies);
   const int threads = team_size(settings_.threads);
-  for_indices(threads, solver_bodies > 256, solver_bodies, [&](std::int64_t k) {
+  for_indices(threads, worth_a_team(solver_bodies, 20), solver_bodies, [&](std::int64_t k) {
     const Body& body = bodies_[s.solver_slot[k]].body;
     SolverBody& sb = s.bodies[k];
     sb = SolverBody{};

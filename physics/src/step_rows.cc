@@ -32,7 +32,7 @@ void World::prepare_contact_rows() {
   const std::int64_t count = static_cast<std::int64_t>(manifolds);
   // What each manifold says of itself, read over the team (the contacts are large and each is
   // read once); then the places of the rows, a count on one thread over a word per manifold.
-  for_indices(threads, count > 256, count, [&](std::int64_t m) {
+  for_indices(threads, worth_a_team(count, 7), count, [&](std::int64_t m) {
     const Contact& contact = contacts_[m];
     s.row_begin[m + 1] = static_cast<std::uint32_t>(contact.manifold.count);
     s.links[m] = {s.solver_of_slot[contact.a.index], s.solver_of_slot[contact.b.index]};
@@ -59,7 +59,7 @@ void World::prepare_contact_rows() {
     for (std::size_t r = from; r < s.row_ids.size(); ++r)
       s.row_ids[r] = static_cast<std::uint32_t>(r);
   }
-  for_indices(threads, count > 64, count, [&](std::int64_t m) {
+  for_indices(threads, worth_a_team(count, 190), count, [&](std::int64_t m) {
     s.next_pairs[m].colour = s.colours[m];
     const Contact& contact = contacts_[m];
     const std::uint32_t previous = s.previous_pair[m];

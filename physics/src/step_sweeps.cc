@@ -97,7 +97,9 @@ void World::group_for_sweeps() {
     // Colours are grouped independently, over the team (a thread's own scratch).
     s.thread_grouped.resize(threads);
     for_indices(
-        threads, colours > 1 && s.colouring.manifolds.size() > 1024, colours,
+        threads,
+        colours > 1 && worth_a_team(static_cast<std::int64_t>(s.colouring.manifolds.size()), 50),
+        colours,
         [&](std::int64_t c) {
           if (s.colouring.serial[c]) return;
           const std::uint32_t begin = s.colouring.colour_begin[c],
@@ -123,7 +125,7 @@ void World::group_for_sweeps() {
   }
   s.packs.resize(s.pack_manifolds.size());
   const std::int64_t packs = static_cast<std::int64_t>(s.packs.size());
-  for_indices(threads, packs > 16, packs, [&](std::int64_t k) {
+  for_indices(threads, worth_a_team(packs, 225), packs, [&](std::int64_t k) {
     std::uint32_t lanes[kWideLanes];
     for (std::uint32_t lane = 0; lane < kWideLanes; ++lane)
       lanes[lane] = lane < s.pack_manifolds[k].count

@@ -695,13 +695,14 @@ void World::compute_bounds(double dt) {
   const std::span<const std::uint32_t> awake = awake_slots();
   if (all) {
     const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
-    for_indices(threads, n > 256, n, [&](std::int64_t i) { bound(static_cast<std::uint32_t>(i)); });
+    for_indices(threads, worth_a_team(n, 40), n,
+                [&](std::int64_t i) { bound(static_cast<std::uint32_t>(i)); });
   } else {
     if (changed)
       for (std::uint32_t slot : resting_log_)
         bound(slot);
     const std::int64_t n = static_cast<std::int64_t>(awake.size());
-    for_indices(threads, n > 256, n, [&](std::int64_t k) { bound(awake[k]); });
+    for_indices(threads, worth_a_team(n, 40), n, [&](std::int64_t k) { bound(awake[k]); });
     for (std::uint32_t slot : kinematic_)
       if (bodies_[slot].body.carries()) bound(slot);
   }
@@ -949,7 +950,7 @@ void World::find_contacts(double dt) {
   resize_reusing(s.next_pairs, kept);
   resize_reusing(s.previous_pair, kept);
   resize_reusing(s.reused, kept);
-  for_indices(threads, n > 512, n, [&](std::int64_t i) {
+  for_indices(threads, worth_a_team(n, 20), n, [&](std::int64_t i) {
     if ((s.found_flags[i] & StepScratch::kPairTouches) == 0) return;
     const std::uint32_t k = s.kept_index[i];
     contacts_[k] = s.found_contacts[i];
