@@ -2,6 +2,7 @@
 // islands share nothing, pairs write their own slots, and every ordering is fixed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "contact_packs.h"
@@ -15,15 +16,19 @@ struct Run {
   std::uint32_t coloured_islands = 0;  // in the last step
   double residual = 0;                 // the last step's
   std::uint32_t coloured_islands_alone = 0;
+  std::uint32_t team_joint_islands = 0;  // the most in any step
 };
 
 Run run_with_threads(const SceneDef& base, int threads, long steps) {
   SceneDef scene = base;
   scene.world.threads = threads;
   World world = build(scene);
-  run(world, scene.dt, steps);
+  std::uint32_t team_joint_islands = 0;
+  run(world, scene.dt, steps, [&](long) {
+    team_joint_islands = std::max(team_joint_islands, world.last_step().team_joint_islands);
+  });
   return {state_hash(world), world.last_step().coloured_islands, world.last_step().residual,
-          world.last_step().coloured_islands_alone};
+          world.last_step().coloured_islands_alone, team_joint_islands};
 }
 
 void expect_same_bits(const SceneDef& scene, long steps) {
@@ -192,6 +197,29 @@ TEST(Determinism, PinnedStateHashes) {
   EXPECT_EQ(run_with_threads(default_scene, 2, 300).hash, 0x80e77b561e45a108ull)
       << "default scene, no reuse";
   EXPECT_EQ(run_with_threads(pile, 2, 150).hash, 0x08166f42b48d92a5ull) << "pile, no reuse";
+}
+
+// Ragdolls in a heap are one island (their contacts join them) of several joint trees, which a
+// team solves side by side, each thread its share of the trees, the contacts on one: the same
+// bits as one thread, whatever the share.
+TEST(Determinism, RagdollHeapOnTheTeamSameBitsForAnyThreadCount) {
+  for (SolverKind kind : {SolverKind::kAuto, SolverKind::kSoft}) {
+    SCOPED_TRACE(std::string(solver_name(kind)));
+    SceneDef scene = ragdolls_scene(8);
+    scene.world.solver.kind = kind;
+    scene.world.solver.sleeping = false;
+    const auto one = run_with_threads(scene, 1, 150);
+    EXPECT_EQ(one.team_joint_islands, 0u);
+    for (int threads : {2, 3}) {
+      SCOPED_TRACE(std::to_string(threads) + " threads");
+      const auto team = run_with_threads(scene, threads, 150);
+      EXPECT_EQ(team.hash, one.hash);
+      EXPECT_GE(team.team_joint_islands, 1u);
+    }
+    // Under eight joints a thread the island is one thread's, as before.
+    const int too_many = static_cast<int>(scene.joints.size() / 8) + 1;
+    EXPECT_EQ(run_with_threads(scene, too_many, 150).team_joint_islands, 0u);
+  }
 }
 
 // Joint scenes' bits, pinned the same way: the ragdolls (trees of hinges and cone-limited balls

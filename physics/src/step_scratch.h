@@ -128,13 +128,23 @@ struct StepScratch {
   std::vector<double> first_impact;
   std::vector<std::uint32_t> support_level;               // for tall_stacks.h
   std::vector<std::vector<LevelSums>> thread_level_sums;  // for tall_stacks.h, one per thread
-  // For joint_tree.h: a forest per island with joints (their order among the islands: the
-  // islands' order is the same from step to step while nothing joins or parts, so each keeps its
-  // forest), each island's (kNoTree: it has no joints), and the index a forest looks bodies up
-  // in, one per thread (it is as long as the step's bodies).
+  // An island's joints in components: joints joined through bodies that move (statics, kinematic
+  // bodies and the world join nothing: the joints push them not). Components share no moving
+  // body, so a team can solve them side by side (SerialIsland). Island i's components are
+  // first_component[i] .. first_component[i + 1]; component c's joints (indices into
+  // joint_rows, in the island's order) component_joints[component_begin[c] ..
+  // component_begin[c + 1]]. An island the exact solver takes with its joints is one component.
+  std::vector<std::uint32_t> first_component, component_begin, component_joints;
+  // By solver index: the union-find over moving bodies, and each root's component.
+  std::vector<std::uint32_t> component_root, component_number;
+  std::vector<std::uint32_t> component_cursor;  // by component: where its next joint goes
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> joint_component;  // (component, joint)
+  // Islands with joints solved by the whole team, component by component (SerialIsland).
+  std::vector<std::uint32_t> team_joint_islands;
+  // For joint_tree.h: a forest per component (their order among the islands: the islands' order
+  // is the same from step to step while nothing joins or parts, so each keeps its forest), and
+  // the index a forest looks bodies up in, one per thread (it is as long as the step's bodies).
   std::vector<JointTree> joint_trees;
-  std::vector<std::uint32_t> tree_of_island;
-  static constexpr std::uint32_t kNoTree = UINT32_MAX;
   std::vector<JointTreeIndex> joint_tree_index;
   // The touching pairs as the last step left them, with their impulses (contact_pairs.h), sorted
   // by body pair; and this step's, contact for contact, with the index of each one's record in

@@ -135,6 +135,9 @@ struct StepStats {
   // asked for it but whose joints close a loop (solved by Gauss-Seidel sweeps instead).
   std::uint32_t joint_tree_islands = 0;
   std::uint32_t joint_loop_islands = 0;
+  // Islands of several joint components (ragdolls in a heap: joints join each ragdoll, contacts
+  // join them all) solved by the whole team, each thread its share of the components.
+  std::uint32_t team_joint_islands = 0;
   double joint_error = 0;
   std::uint32_t collision_flags = 0;
   // Bodies whose implicit gyroscopic step hit its Newton iteration bound or spun too fast for
