@@ -203,14 +203,17 @@ TEST(Determinism, PinnedStateHashes) {
 // team solves side by side, each thread its share of the trees, the contacts on one: the same
 // bits as one thread, whatever the share.
 TEST(Determinism, RagdollHeapOnTheTeamSameBitsForAnyThreadCount) {
-  for (SolverKind kind : {SolverKind::kAuto, SolverKind::kSoft}) {
+  for (SolverKind kind :
+       {SolverKind::kAuto, SolverKind::kSoft, SolverKind::kPgs, SolverKind::kExact}) {
     SCOPED_TRACE(std::string(solver_name(kind)));
     SceneDef scene = ragdolls_scene(8);
     scene.world.solver.kind = kind;
     scene.world.solver.sleeping = false;
     const auto one = run_with_threads(scene, 1, 150);
     EXPECT_EQ(one.team_joint_islands, 0u);
+    // (Three threads on a 2-core machine wait at every barrier for a core: auto alone.)
     for (int threads : {2, 3}) {
+      if (threads == 3 && kind != SolverKind::kAuto) continue;
       SCOPED_TRACE(std::to_string(threads) + " threads");
       const auto team = run_with_threads(scene, threads, 150);
       EXPECT_EQ(team.hash, one.hash);
