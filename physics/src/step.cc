@@ -29,7 +29,6 @@ namespace {
 
 // Everything one island needs to advance, independent of every other island.
 struct IslandContext {
-  std::size_t island;
   std::span<const std::uint32_t> bodies;
   std::span<const std::uint32_t> rows;
   std::span<const std::uint32_t> joints;  // indices into scratch.joint_rows
@@ -549,7 +548,6 @@ class SerialIsland {
 
 IslandContext island_context(StepScratch& s, const WorldSettings& settings, std::size_t i) {
   return {
-      i,
       std::span(s.islands.bodies)
           .subspan(s.islands.body_begin[i], s.islands.body_begin[i + 1] - s.islands.body_begin[i]),
       std::span(s.island_rows)
