@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "joint_geometry.h"
 #include "rotation.h"
@@ -747,14 +748,19 @@ bool JointTree::take_second_targets(std::span<const JointRow> rows, std::span<So
   return true;
 }
 
-void JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                                std::span<Pose> poses, bool refactor, double velocity_substep,
-                                bool bounds) {
-  if (joints_.empty()) return;
+double JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
+                                  std::span<Pose> poses, bool refactor, double velocity_substep,
+                                  bool bounds) {
+  if (joints_.empty()) return 0;
   // A move came before: the next sweeps take their targets afresh, and factor again unless this
   // pass or one before it since the move factored for them.
   targets_taken_ = false;
   stiffness_kept_ = false;
+  double largest = 0;
+  const auto corrected = [&](const JointEquations::Vector& target) {
+    largest = std::max(largest, target.lpNorm<Eigen::Infinity>());
+    return target;
+  };
   if (refactor) {
     bool bound_rows = false;
     factor(bodies, false, [&](std::size_t k, JointEquations* equations) {
@@ -767,16 +773,17 @@ void JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solver
     // nor one where a body takes stiffness (settle_velocity_factors decides after the passes).
     velocities_factored_ = false;
     share_pending_ = velocity_substep > 0 && !has_motors_ && !bound_rows;
-    solve(false, [&](std::size_t k) { return equations_[k].target; });
+    solve(false, [&](std::size_t k) { return corrected(equations_[k].target); });
   } else {
     solve(false, [&](std::size_t k) {
-      return position_targets(rows[joints_[k].row], bodies, poses, joints_[k].bounds);
+      return corrected(position_targets(rows[joints_[k].row], bodies, poses, joints_[k].bounds));
     });
   }
-  if (!solution_finite()) return;
+  if (!solution_finite()) return std::numeric_limits<double>::infinity();
   for (const TreeBody& body : tree_bodies_)
     joint_detail::move_body(&bodies[body.index], &poses[body.index], body.result.head<3>(),
                             body.result.tail<3>());
+  return largest;
 }
 
 void JointTree::settle_velocity_factors(std::span<const JointRow> rows,
