@@ -531,15 +531,19 @@ TEST(StandardScenes, PendulumAndChainSwingOnTheirJoints) {
 }
 
 // The double pendulum's energy (solved directly) swings about its start by up to 0.55% of 3 m g
-// (the step's own O(h^2) error, chaotic motion) but does not grow: over two minutes the mean of
-// each 10 s stays within 3e-4 of the first ten seconds' or below it (measured: -1.8e-4 then
-// +2.0e-5, -3.2e-4, ... falling to -1.5e-3), and no swing above the start passes 0.6%.
-TEST(StandardScenes, DoublePendulumEnergyHasNoUpwardDrift) {
+// (the step's own O(h^2) error, chaotic motion) but neither grows nor drains: over two minutes no
+// 10 s window's mean passes 3e-4 above the start, the second minute's mean is not 1e-4 above the
+// first's (a third of a window's swing), and it stays within 1e-3 of the start (measured: window
+// means from -1.8e-4 to +1.3e-4, the minutes' -1.1e-4 and -2.5e-4). Before an island of joints
+// alone took its curvature targets until they settled (joint_tree.cc), the position passes'
+// projection of what two takes left drained it: -1.6e-3 over the second minute, -4.8e-3 by the
+// third.
+TEST(StandardScenes, DoublePendulumEnergyNeitherGrowsNorDrains) {
   SceneDef scene = standard_scene("double-pendulum").value();
   World world = build(scene);
   const double start = total_energy(world);
   const double scale = 3 * 9.81;  // 3 m g, as the report's
-  double first_mean = 0, highest = 0;
+  double minute_means[2] = {0, 0}, highest = 0;
   for (int window = 0; window < 12; ++window) {
     double mean = 0;
     const int steps = static_cast<int>(10 / scene.dt);
@@ -549,9 +553,11 @@ TEST(StandardScenes, DoublePendulumEnergyHasNoUpwardDrift) {
       mean += departure / steps;
       highest = std::max(highest, departure);
     }
-    if (window == 0) first_mean = mean;
-    EXPECT_LT(mean, first_mean + 3e-4) << "seconds " << 10 * window << " to " << 10 * window + 10;
+    minute_means[window / 6] += mean / 6;
+    EXPECT_LT(mean, 3e-4) << "seconds " << 10 * window << " to " << 10 * window + 10;
   }
+  EXPECT_LT(minute_means[1], minute_means[0] + 1e-4);
+  EXPECT_LT(std::abs(minute_means[1]), 1e-3);
   EXPECT_LT(highest, 6e-3);
 }
 

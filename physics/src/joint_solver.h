@@ -49,6 +49,9 @@ struct JointTarget {
   double h = 0;
   double most_speed = 0;
   double substep = 0;
+  // The island's energy is its joints' alone (no contacts, drives or bounds to take any): the
+  // direct solve's curvature targets are iterated until they settle (joint_tree.cc).
+  bool conserving = false;
 };
 
 // The rows a joint must hold exactly (its point, axes, rotation, a rod's length, a slider's line;

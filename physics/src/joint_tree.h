@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "contact_solver.h"
@@ -53,6 +54,9 @@ class JointTree {
   // modes a little (the stiffness is in the masses, not in the velocities' right side), so a
   // second sweep changes the velocities.
   bool stiffened() const { return stiffened_; }
+  // Substeps whose takes of a conserving island's curvature targets (JointTarget::conserving)
+  // stopped at kMostTakes or stopped contracting before they settled, since the last call.
+  std::uint32_t take_limit_hits() { return std::exchange(take_limit_hits_, 0); }
   // The rows changed (a motor joins the solve again): the next sweep factors afresh.
   void forget_velocity_factors() { velocities_factored_ = false; }
   // Velocities that hold every joint's rows at the sweep's targets (JointTarget); the impulses
@@ -185,12 +189,16 @@ class JointTree {
   void set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies, double h);
   // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
   void set_velocity_base(std::span<const SolverBody> bodies);
-  // SHAKE's second iterate of the curvature targets in kept_targets_, where it converges
-  // (solve_velocities); the bodies' velocities are left as they were. Whether it was taken (if
-  // not, the solution of the kept targets is left in the joints' and bodies' results).
+  // SHAKE's next iterate of the curvature targets in kept_targets_ (solve_velocities), into
+  // second_targets_: the kept targets solved (the solution left in the joints' and bodies'
+  // results; the bodies' velocities as they were) and the targets taken again from the
+  // velocities found. How far they moved: relative to the kept ones, and times the substep.
+  struct Retake {
+    double ratio = 0, move = 0;
+  };
   template <class Rates>
-  bool take_second_targets(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                           std::span<const Pose> poses, const JointTarget& target, Rates rates_of);
+  Retake take_targets_again(std::span<const JointRow> rows, std::span<SolverBody> bodies,
+                            std::span<const Pose> poses, const JointTarget& target, Rates rates_of);
   // Sets each body's stiffness (TreeBody) for a substep of h (joint_tree.cc: why and how much);
   // whether any body has some.
   bool set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
@@ -234,6 +242,7 @@ class JointTree {
   bool share_pending_ = false, stiffness_kept_ = false;
   bool has_motors_ = false;     // a joint with a motor: its row joins the velocity system
   bool targets_taken_ = false;  // since the last move
+  std::uint32_t take_limit_hits_ = 0;
   // For building: each node's neighbours and the visit.
   std::vector<std::uint32_t> first_edge_, next_edge_, edge_to_, pending_, parent_of_, order_;
   std::vector<std::uint32_t> numbered_, child_count_;

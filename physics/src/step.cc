@@ -212,6 +212,14 @@ class SerialIsland {
   }
 
   ~SerialIsland() {
+    std::uint32_t take_limit_hits = 0;
+    for (std::uint32_t component = mine_.first; component < mine_.second && !trees_.empty();
+         ++component)
+      take_limit_hits += trees_[component].take_limit_hits();
+    if (take_limit_hits > 0) {
+#pragma omp atomic
+      report_->joint_take_limit_hits += take_limit_hits;
+    }
     if (team_) c_.scratch.barrier.wait();  // every thread is done with the trees
     if (team_ && thread_ != 0) return;
     for (JointTree& tree : trees_)
@@ -308,7 +316,8 @@ class SerialIsland {
     if (!c_.joints.empty()) {
       // Before a move: the soft solver's sweeps with bias, and every pgs sweep (its move follows).
       const bool move_ahead = soft != nullptr || report_->solver == IslandSolver::kPgs;
-      const JointTarget target{move_ahead ? h : 0.0, c_.settings.solver.max_push_velocity, h};
+      const JointTarget target{move_ahead ? h : 0.0, c_.settings.solver.max_push_velocity, h,
+                               one_sweep_solves_};
       // With trees (joint_tree.h), every joint's own rows at once, exactly, after the drives.
       const bool direct = !trees_.empty();
       prepare_joint_terms();
@@ -387,7 +396,7 @@ class SerialIsland {
       warm_start_joint(row, bodies_, c_.scratch.poses, c_.scratch.joint_terms[j]);
     }
     // As many visits as a substep's sweeps and relaxation sweeps give them.
-    const JointTarget target{h, c_.settings.solver.max_push_velocity, h};
+    const JointTarget target{h, c_.settings.solver.max_push_velocity, h, one_sweep_solves_};
     const int visits = c_.settings.solver.soft_iterations + c_.settings.solver.relax_iterations;
     for (int i = 0; i < visits; ++i) {
       ++report_->velocity_iterations;
@@ -1177,6 +1186,7 @@ void World::solve_islands(double dt) {
     stats_.lemke_pivots += report.lemke_pivots;
     stats_.velocity_iterations += report.velocity_iterations;
     stats_.gyroscopic_limit_hits += report.gyroscopic_limit_hits;
+    stats_.joint_take_limit_hits += report.joint_take_limit_hits;
     stats_.impact_limit_hits += report.impact_limit_hits;
     stats_.residual = std::max(stats_.residual, report.residual);
   }

@@ -27,6 +27,7 @@ struct IslandReport {
   bool needs_position_correction = false;  // exact, but its push-out LCP failed
   std::uint32_t gyroscopic_limit_hits = 0;
   std::uint32_t impact_limit_hits = 0;  // 1 when pass_impacts hit its bound
+  std::uint32_t joint_take_limit_hits = 0;  // StepStats::joint_take_limit_hits
   std::uint64_t lemke_pivots = 0, velocity_iterations = 0;
   double residual = 0;
   // Soft islands tall enough to buckle (tall_stacks.h): their substeps and spring; 0 for the

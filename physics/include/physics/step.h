@@ -143,6 +143,10 @@ struct StepStats {
   // Bodies whose implicit gyroscopic step hit its Newton iteration bound or spun too fast for
   // kGyroscopicMaxPieces; they kept their body-frame spin for the step.
   std::uint32_t gyroscopic_limit_hits = 0;
+  // Substeps of islands of joints alone (no contacts, drives or bounds) whose direct solve's
+  // curvature targets (SHAKE's iteration, docs/DYNAMICS.md) stopped at their bound of takes or
+  // stopped converging before they settled; the position passes corrected what they left.
+  std::uint32_t joint_take_limit_hits = 0;
   // 1 when the broad phase found more pairs than World::max_pairs and kept the first ones (bodies
   // heaped inside one another).
   std::uint32_t pair_limit_hits = 0;
