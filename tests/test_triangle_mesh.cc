@@ -149,6 +149,38 @@ TEST(TriangleMesh, SphereAndBoxRestInAValleyAndOnARidgeAsOnTheHeightfield) {
   EXPECT_NEAR(rest_height(ridge, BoxDef{Vec3(0.2, 0.2, 0.1)}, Vec3(0.1, 0, 1)), 0.1, 1e-4);
 }
 
+// Over a convex edge too gentle to be active (3.4°, under kSmoothEdgeAngle), a vertex within the
+// margin can lie beyond the feet of both triangles' normals: here 8 cm up and 2 mm past the edge,
+// in the 4.8 mm wedge between them. The heightfield holds it by the triangle under it; the mesh
+// must too (by where the line from the box's centre through it meets the surface): a box landing
+// fast with such a vertex once sank 10 cm into the hills as a mesh and not as a heightfield.
+TEST(TriangleMesh, AVertexOverAGentleConvexEdgeMeetsTheSurfaceAsOnTheHeightfield) {
+  const HeightFieldDef field =
+      field_of(9, 9, 0.5, [](double x, double) { return x <= 0 ? 0.0 : -0.06 * x; });
+  for (const bool as_mesh : {false, true}) {
+    WorldSettings settings;
+    settings.collision.margin = 0.1;
+    World world(settings);
+    if (as_mesh)
+      add_static(&world, mesh_of(field));
+    else
+      add_static(&world, field);
+    // The bottom face 8 cm up: its two corners at x = 0.002 in the wedge, the two at x = 1.002
+    // 14 cm over the slope, beyond the margin.
+    add_dynamic(&world, BoxDef{Vec3(0.5, 0.5, 0.5)}, Vec3(0.502, 0, 0.58));
+    int points = 0;
+    for (const Contact& contact : world.find_contacts()) {
+      for (int p = 0; p < contact.manifold.count; ++p) {
+        const ContactPoint& point = contact.manifold.points[p];
+        EXPECT_NEAR(std::abs(point.point_a.x() + point.point_b.x()) / 2, 0.002, 0.01) << as_mesh;
+        EXPECT_NEAR(point.depth, -0.08, 1e-3) << as_mesh;
+        ++points;
+      }
+    }
+    EXPECT_EQ(points, 2) << (as_mesh ? "mesh" : "heightfield");
+  }
+}
+
 TEST(TriangleMesh, TrianglesHoldBodiesOnTheirFrontOnly) {
   // On a closed cube (facing out): a box rests on its top.
   EXPECT_NEAR(rest_height(cube_mesh(Vec3(1, 1, 0.5), false), BoxDef{Vec3(0.2, 0.2, 0.2)},
