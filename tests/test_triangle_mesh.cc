@@ -181,6 +181,29 @@ TEST(TriangleMesh, AVertexOverAGentleConvexEdgeMeetsTheSurfaceAsOnTheHeightfield
   }
 }
 
+// The same wedge under a ball or a capsule's core: over the apex of a ridge turning by 4.6°
+// (inactive) the core's feet fall beyond both slopes, and the ball fell through the mesh (and sank
+// 2 cm into the heightfield). The edge holds it there, at its radius above the apex, on both.
+TEST(TriangleMesh, BallsAndCapsulesRestOnTheApexOfAGentleRidge) {
+  const HeightFieldDef ridge =
+      field_of(9, 9, 0.5, [](double, double y) { return -0.04 * std::abs(y); });
+  const TriangleMeshDef mesh = mesh_of(ridge);
+  for (const ShapeDef& ground : {ShapeDef{ridge}, ShapeDef{mesh}}) {
+    EXPECT_NEAR(rest_height(ground, SphereDef{0.3}, Vec3(0.1, 0, 1)), 0.3, 1e-4);
+    // A capsule lying along the ridge (its axis turned onto x), both core ends over the apex.
+    World world;
+    add_static(&world, ground);
+    BodyDef capsule;
+    capsule.shape = CapsuleDef{0.2, 0.5};
+    capsule.mass = 1;
+    capsule.position = Vec3(0.1, 0, 1);
+    capsule.orientation = Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()));
+    const BodyId id = world.create_body(capsule).value();
+    run(&world, 120);
+    EXPECT_NEAR(world.body(id)->position().z(), 0.2, 1e-4);
+  }
+}
+
 TEST(TriangleMesh, TrianglesHoldBodiesOnTheirFrontOnly) {
   // On a closed cube (facing out): a box rests on its top.
   EXPECT_NEAR(rest_height(cube_mesh(Vec3(1, 1, 0.5), false), BoxDef{Vec3(0.2, 0.2, 0.2)},

@@ -45,9 +45,15 @@ std::uint32_t collide_height_field(const Shape& a, const Mat3& rotation, const V
         for (int e = 0; e < 3; ++e) {
           // Each edge once: from the lower of its two triangles.
           const std::int64_t other = field.neighbour(t, e);
-          if ((active & (1u << e)) == 0 || (other >= 0 && static_cast<std::size_t>(other) < t))
-            continue;
+          if (other >= 0 && static_cast<std::size_t>(other) < t) continue;
           if (std::max(v[e].z(), v[(e + 1) % 3].z()) < box.min.z()) continue;
+          if ((active & (1u << e)) == 0) {
+            // A round core over a gentle ridge can lie beyond both triangles' feet.
+            if (!body.round || other < 0) continue;
+            const std::array<Vec3, 3> w = field.triangle(static_cast<std::size_t>(other));
+            if (convex_edge(v, n, w)) contacts.gentle_edge(body, v, n, e, normal_of(w), 3 * t + e);
+            continue;
+          }
           Vec3 other_normal;
           if (other >= 0) other_normal = normal_of(field.triangle(static_cast<std::size_t>(other)));
           flags |= contacts.edge(body, v, n, e, other >= 0 ? &other_normal : nullptr, 3 * t + e,

@@ -115,8 +115,16 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
     const std::uint8_t active = mesh.active_edges(t);
     for (int e = 0; e < 3; ++e) {
       const std::int64_t other = mesh.neighbour(t, e);
-      if ((active & (1u << e)) == 0 || (other >= 0 && static_cast<std::uint32_t>(other) < t))
+      if (other >= 0 && static_cast<std::uint32_t>(other) < t) continue;
+      if ((active & (1u << e)) == 0) {
+        // A round core over a gentle ridge can lie beyond both triangles' feet.
+        if (!body.round || other < 0) continue;
+        const auto o = static_cast<std::size_t>(other);
+        const std::array<Vec3, 3> w = mesh.triangle(o);
+        if ((front || in_front(w, mesh.normal(o))) && convex_edge(v, n, w))
+          contacts.gentle_edge(body, v, n, e, mesh.normal(o), 3 * std::uint64_t{t} + e);
         continue;
+      }
       Vec3 other_normal;
       if (other >= 0) {
         const auto o = static_cast<std::size_t>(other);

@@ -11,7 +11,9 @@
 // Each such edge is met as a segment (a capsule of radius 0: the narrow phase's round routines),
 // and its normal kept only where the surface can push that way: turned about the edge from one
 // triangle's normal no farther than the other's (any way outwards over a boundary edge). Flat
-// and concave edges are never met: the faces on either side hold whatever lies there. This is
+// and concave edges are never met: the faces on either side hold whatever lies there. A convex
+// edge too gentle to be active holds a round core only in the wedge between its triangles'
+// normals, where the core's feet fall beyond both (gentle_edge). This is
 // the "active edge" scheme of Jolt (Rouwé, JoltPhysics ActiveEdges.h) and of Bullet's
 // btAdjustInternalEdgeContacts (Coumans), with the edges' convexity found once when the terrain
 // is built.
@@ -202,6 +204,41 @@ std::uint32_t TriangleContacts::edge(const TriangleBody& body, const std::array<
     add_point(up, m.points[c].point_b, m.points[c].point_a,
               terrain_feature(edge_key, m.points[c].feature_id), true);
   return flags;
+}
+
+void TriangleContacts::gentle_edge(const TriangleBody& body, const std::array<Vec3, 3>& v,
+                                   const Vec3& n, int e, const Vec3& neighbour_normal,
+                                   std::uint64_t edge_key) {
+  const Vec3& p = v[e];
+  const Vec3& q = v[(e + 1) % 3];
+  const double radius = body.shape.radius();
+  for (int c = 0; c < body.core_count; ++c) {
+    const Vec3& core = body.core_ends[c];
+    const Vec3 along = q - p;
+    const double t = std::clamp((core - p).dot(along) / along.squaredNorm(), 0.0, 1.0);
+    const Vec3 on_edge = p + t * along;
+    const Vec3 gap = core - on_edge;
+    const double distance = gap.norm();
+    if (!(distance > 0) || radius - distance < -margin_) continue;
+    // In the wedge: turned from n towards the outside of the edge, short of the neighbour's
+    // normal. Elsewhere a face holds the core (its foot falls inside that triangle).
+    const Vec3 up = gap / distance;
+    const Vec3 outwards = along.normalized().cross(n);
+    const double angle = std::atan2(up.dot(outwards), up.dot(n));
+    if (!(angle > 0 && angle < std::atan2(neighbour_normal.dot(outwards), neighbour_normal.dot(n))))
+      continue;
+    add_point(up, core - radius * up, on_edge, terrain_feature(edge_key, kFeatureRound | c), true);
+  }
+}
+
+bool convex_edge(const std::array<Vec3, 3>& v, const Vec3& n, const std::array<Vec3, 3>& w) {
+  const double flat =
+      1e-9 * std::sqrt(std::max({(v[1] - v[0]).squaredNorm(), (v[2] - v[1]).squaredNorm(),
+                                 (v[0] - v[2]).squaredNorm()}));
+  double behind = 0;
+  for (const Vec3& corner : w)
+    behind = std::min(behind, (corner - v[0]).dot(n));
+  return behind < -flat;
 }
 
 void TriangleContacts::finish(TerrainContacts* out) {

@@ -48,6 +48,11 @@ class TriangleContacts {
   std::uint32_t edge(const TriangleBody& body, const std::array<Vec3, 3>& v, const Vec3& n, int e,
                      const Vec3* neighbour_normal, std::uint64_t edge_key,
                      const CollisionSettings& settings);
+  // A round body's core against edge e of triangle v where the edge is convex but too gentle to
+  // be active: a point only where the core lies in the wedge between the two triangles' normals,
+  // beyond both feet, where the face rule finds neither triangle.
+  void gentle_edge(const TriangleBody& body, const std::array<Vec3, 3>& v, const Vec3& n, int e,
+                   const Vec3& neighbour_normal, std::uint64_t edge_key);
   // The manifolds, normals from the body into the triangles.
   void finish(TerrainContacts* out);
 
@@ -65,6 +70,10 @@ class TriangleContacts {
 
 // Whether the point's foot on the triangle's plane lies inside it (edges included).
 bool inside_triangle(const std::array<Vec3, 3>& v, const Vec3& n, const Vec3& p);
+
+// Whether the edge of triangle v (normal n) that triangle w shares is convex: w's corners clearly
+// behind v's plane (the test that, with the turn past kSmoothEdgeAngle, makes an edge active).
+bool convex_edge(const std::array<Vec3, 3>& v, const Vec3& n, const std::array<Vec3, 3>& w);
 
 inline Vec3 normal_of(const std::array<Vec3, 3>& v) {
   return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
