@@ -212,22 +212,32 @@ void TriangleContacts::gentle_edge(const TriangleBody& body, const std::array<Ve
   const Vec3& p = v[e];
   const Vec3& q = v[(e + 1) % 3];
   const double radius = body.shape.radius();
-  for (int c = 0; c < body.core_count; ++c) {
-    const Vec3& core = body.core_ends[c];
-    const Vec3 along = q - p;
-    const double t = std::clamp((core - p).dot(along) / along.squaredNorm(), 0.0, 1.0);
-    const Vec3 on_edge = p + t * along;
+  const Vec3 along = q - p;
+  const Vec3 outwards = along.normalized().cross(n);
+  const double neighbour_angle =
+      std::atan2(neighbour_normal.dot(outwards), neighbour_normal.dot(n));
+  // A point of the core against its nearest point of the edge, kept where it lies in the wedge:
+  // turned from n towards the outside of the edge, short of the neighbour's normal. Elsewhere a
+  // face holds the core (its foot falls inside that triangle).
+  const auto meet = [&](const Vec3& core, const Vec3& on_edge, std::uint64_t id) {
     const Vec3 gap = core - on_edge;
     const double distance = gap.norm();
-    if (!(distance > 0) || radius - distance < -margin_) continue;
-    // In the wedge: turned from n towards the outside of the edge, short of the neighbour's
-    // normal. Elsewhere a face holds the core (its foot falls inside that triangle).
+    if (!(distance > 0) || radius - distance < -margin_) return;
     const Vec3 up = gap / distance;
-    const Vec3 outwards = along.normalized().cross(n);
     const double angle = std::atan2(up.dot(outwards), up.dot(n));
-    if (!(angle > 0 && angle < std::atan2(neighbour_normal.dot(outwards), neighbour_normal.dot(n))))
-      continue;
-    add_point(up, core - radius * up, on_edge, terrain_feature(edge_key, kFeatureRound | c), true);
+    if (!(angle > 0 && angle < neighbour_angle)) return;
+    add_point(up, core - radius * up, on_edge, terrain_feature(edge_key, id), true);
+  };
+  // The core's ends (a capsule along the ridge rests on both), and a capsule's core where it
+  // passes nearest the edge (one lying across the ridge rests on its middle).
+  for (int c = 0; c < body.core_count; ++c) {
+    const Vec3& core = body.core_ends[c];
+    const double t = std::clamp((core - p).dot(along) / along.squaredNorm(), 0.0, 1.0);
+    meet(core, p + t * along, kFeatureRound | c);
+  }
+  if (body.core_count == 2) {
+    const SegmentClosest c = closest_between_segments(p, q, body.core_ends[0], body.core_ends[1]);
+    if (c.t > 0 && c.t < 1) meet(c.on_second, c.on_first, kFeatureRound | 2);
   }
 }
 
