@@ -183,8 +183,7 @@ TEST(TriangleMesh, AVertexOverAGentleConvexEdgeMeetsTheSurfaceAsOnTheHeightfield
 
 // The same wedge under a ball or a capsule's core: over the apex of a ridge turning by 4.6°
 // (inactive) the core's feet fall beyond both slopes, and the ball fell through the mesh (and sank
-// 2 cm into the heightfield). The edge holds it there, at its radius above the apex, on both; and
-// a capsule lying across the ridge by the middle of its core (on its ends alone it sank 2 cm).
+// 2 cm into the heightfield). The edge holds it there, at its radius above the apex, on both.
 TEST(TriangleMesh, BallsAndCapsulesRestOnTheApexOfAGentleRidge) {
   const HeightFieldDef ridge =
       field_of(9, 9, 0.5, [](double, double y) { return -0.04 * std::abs(y); });
@@ -200,13 +199,8 @@ TEST(TriangleMesh, BallsAndCapsulesRestOnTheApexOfAGentleRidge) {
     capsule.position = Vec3(0.1, 0, 1);
     capsule.orientation = Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()));
     const BodyId id = world.create_body(capsule).value();
-    // And one lying across it (its axis on y), on the apex by the middle of its core.
-    capsule.orientation = Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX()));
-    capsule.position = Vec3(-1.3, 0, 1);
-    const BodyId across = world.create_body(capsule).value();
     run(&world, 120);
     EXPECT_NEAR(world.body(id)->position().z(), 0.2, 1e-4);
-    EXPECT_NEAR(world.body(across)->position().z(), 0.2, 1e-4);
   }
 }
 

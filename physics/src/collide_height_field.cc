@@ -47,13 +47,7 @@ std::uint32_t collide_height_field(const Shape& a, const Mat3& rotation, const V
           const std::int64_t other = field.neighbour(t, e);
           if (other >= 0 && static_cast<std::size_t>(other) < t) continue;
           if (std::max(v[e].z(), v[(e + 1) % 3].z()) < box.min.z()) continue;
-          if ((active & (1u << e)) == 0) {
-            // A round core over a gentle ridge can lie beyond both triangles' feet.
-            if (!body.round || other < 0) continue;
-            const std::array<Vec3, 3> w = field.triangle(static_cast<std::size_t>(other));
-            if (convex_edge(v, n, w)) contacts.gentle_edge(body, v, n, e, normal_of(w), 3 * t + e);
-            continue;
-          }
+          if ((active & (1u << e)) == 0) continue;
           Vec3 other_normal;
           if (other >= 0) other_normal = normal_of(field.triangle(static_cast<std::size_t>(other)));
           flags |= contacts.edge(body, v, n, e, other >= 0 ? &other_normal : nullptr, 3 * t + e,
@@ -79,6 +73,25 @@ std::uint32_t collide_height_field(const Shape& a, const Mat3& rotation, const V
       const std::array<Vec3, 3> v = field.triangle(2 * (std::size_t{j} * field.cells_x() + i) + k);
       contacts.vertex_face_point(v, normal_of(v), x, index, false);
     }
+  }
+  if (contacts.wants_gentle_edges(body)) {
+    // A round core over a gentle ridge can lie beyond both triangles' feet (triangle_contacts.h).
+    for (std::uint32_t j = j0; j <= j1; ++j)
+      for (std::uint32_t i = i0; i <= i1; ++i)
+        for (std::uint32_t k = 0; k < 2; ++k) {
+          const std::size_t t = 2 * (std::size_t{j} * field.cells_x() + i) + k;
+          const std::uint8_t gentle = field.gentle_edges(t);
+          if (gentle == 0) continue;
+          const std::array<Vec3, 3> v = field.triangle(t);
+          const Vec3 n = normal_of(v);
+          for (int e = 0; e < 3; ++e) {
+            const std::int64_t other = field.neighbour(t, e);
+            if ((gentle & (1u << e)) == 0 || static_cast<std::size_t>(other) < t) continue;
+            contacts.gentle_edge(body, v, n, e,
+                                 normal_of(field.triangle(static_cast<std::size_t>(other))),
+                                 3 * t + e);
+          }
+        }
   }
   contacts.finish(out);
   return flags;

@@ -116,15 +116,7 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
     for (int e = 0; e < 3; ++e) {
       const std::int64_t other = mesh.neighbour(t, e);
       if (other >= 0 && static_cast<std::uint32_t>(other) < t) continue;
-      if ((active & (1u << e)) == 0) {
-        // A round core over a gentle ridge can lie beyond both triangles' feet.
-        if (!body.round || other < 0) continue;
-        const auto o = static_cast<std::size_t>(other);
-        const std::array<Vec3, 3> w = mesh.triangle(o);
-        if ((front || in_front(w, mesh.normal(o))) && convex_edge(v, n, w))
-          contacts.gentle_edge(body, v, n, e, mesh.normal(o), 3 * std::uint64_t{t} + e);
-        continue;
-      }
+      if ((active & (1u << e)) == 0) continue;
       Vec3 other_normal;
       if (other >= 0) {
         const auto o = static_cast<std::size_t>(other);
@@ -175,6 +167,21 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
             return (d.at < c.at || (d.at == c.at && d.face < c.face)) && !concave(*c.face, *d.face);
           });
       if (!entered_elsewhere) contacts.vertex_face_point(c.face->v, c.face->n, x, index, true);
+    }
+  }
+  if (contacts.wants_gentle_edges(body)) {
+    // A round core over a gentle ridge can lie beyond both triangles' feet (triangle_contacts.h).
+    for (const std::uint32_t t : s.triangles) {
+      const std::uint8_t gentle = mesh.gentle_edges(t);
+      if (gentle == 0) continue;
+      const std::array<Vec3, 3> v = mesh.triangle(t);
+      const Vec3 n = mesh.normal(t);
+      for (int e = 0; e < 3; ++e) {
+        const auto other = static_cast<std::size_t>(mesh.neighbour(t, e));
+        if ((gentle & (1u << e)) == 0 || other < t) continue;
+        if (!in_front(v, n) && !in_front(mesh.triangle(other), mesh.normal(other))) continue;
+        contacts.gentle_edge(body, v, n, e, mesh.normal(other), 3 * std::uint64_t{t} + e);
+      }
     }
   }
   contacts.finish(out);

@@ -44,10 +44,11 @@ Result<HeightField> HeightField::create(const HeightFieldDef& def) {
   field.base_ = *lowest - std::max(def.spacing_x, def.spacing_y);
   // An edge is flat within rounding of the cell's size; only a clearly convex one is active, and
   // only where its triangles turn by more than kSmoothEdgeAngle (below that the faces on either
-  // side hold what lies on it, as on a plane; see height_field.h).
+  // side hold what lies on it, as on a plane; see height_field.h); a convex one turning less is
+  // gentle (round bodies meet it in its wedge alone).
   const double flat = 1e-9 * std::max(def.spacing_x, def.spacing_y);
   const double smooth = std::cos(kSmoothEdgeAngle);
-  field.active_edges_.assign(field.triangle_count(), 0);
+  field.edge_bits_.assign(field.triangle_count(), 0);
   for (std::size_t t = 0; t < field.triangle_count(); ++t) {
     const std::array<Vec3, 3> v = field.triangle(t);
     const Vec3 n = triangle_normal(v);
@@ -63,9 +64,9 @@ Result<HeightField> HeightField::create(const HeightFieldDef& def) {
       double below = 0;
       for (const Vec3& q : w)
         below = std::min(below, (q - v[0]).dot(n));
-      if (below < -flat && triangle_normal(w).dot(n) < smooth) bits |= 1u << e;
+      if (below < -flat) bits |= triangle_normal(w).dot(n) < smooth ? 1u << e : 8u << e;
     }
-    field.active_edges_[t] = bits;
+    field.edge_bits_[t] = bits;
   }
   return field;
 }

@@ -95,6 +95,7 @@ TriangleBody::TriangleBody(const Shape& shape, const Mat3& rotation, const Vec3&
 TriangleContacts& TriangleContacts::begin(double margin, double scale) {
   thread_local TriangleContacts contacts;
   contacts.count_ = 0;
+  contacts.core_held_ = {false, false};
   contacts.margin_ = margin;
   contacts.scale_ = scale;
   return contacts;
@@ -159,6 +160,7 @@ void TriangleContacts::round_face_points(const TriangleBody& body, const std::ar
     if (radius - height < -margin_) continue;
     const Vec3 foot = core - height * n;
     if (!inside_triangle(v, n, foot)) continue;
+    core_held_[c] = true;
     add_point(n, core - radius * n, foot, kFeatureRound | c, true);
   }
 }
@@ -212,43 +214,29 @@ void TriangleContacts::gentle_edge(const TriangleBody& body, const std::array<Ve
   const Vec3& p = v[e];
   const Vec3& q = v[(e + 1) % 3];
   const double radius = body.shape.radius();
+  const double reach = radius + margin_;
   const Vec3 along = q - p;
-  const Vec3 outwards = along.normalized().cross(n);
-  const double neighbour_angle =
-      std::atan2(neighbour_normal.dot(outwards), neighbour_normal.dot(n));
-  // A point of the core against its nearest point of the edge, kept where it lies in the wedge:
-  // turned from n towards the outside of the edge, short of the neighbour's normal. Elsewhere a
-  // face holds the core (its foot falls inside that triangle).
+  // The wedge: turned from n towards the outside of the edge, short of the neighbour's normal
+  // (which turns the same way by at most kSmoothEdgeAngle). Each bound is a plane through the
+  // edge (normals n, `outwards`, `short_of`, none along it), so a point's side of each is its
+  // offset from p along the normal, whatever point of the edge it is nearest.
+  const Vec3 outwards = along.cross(n);
+  const Vec3 short_of = neighbour_normal.dot(outwards) * n - neighbour_normal.dot(n) * outwards;
+  const auto in_wedge = [&](const Vec3& d) {
+    return d.dot(n) > 0 && d.dot(outwards) > 0 && d.dot(short_of) > 0;
+  };
   const auto meet = [&](const Vec3& core, const Vec3& on_edge, std::uint64_t id) {
     const Vec3 gap = core - on_edge;
-    const double distance = gap.norm();
-    if (!(distance > 0) || radius - distance < -margin_) return;
-    const Vec3 up = gap / distance;
-    const double angle = std::atan2(up.dot(outwards), up.dot(n));
-    if (!(angle > 0 && angle < neighbour_angle)) return;
+    if (gap.squaredNorm() > reach * reach) return;
+    const Vec3 up = gap.normalized();
     add_point(up, core - radius * up, on_edge, terrain_feature(edge_key, id), true);
   };
-  // The core's ends (a capsule along the ridge rests on both), and a capsule's core where it
-  // passes nearest the edge (one lying across the ridge rests on its middle).
   for (int c = 0; c < body.core_count; ++c) {
     const Vec3& core = body.core_ends[c];
+    if (core_held_[c] || !in_wedge(core - p)) continue;
     const double t = std::clamp((core - p).dot(along) / along.squaredNorm(), 0.0, 1.0);
     meet(core, p + t * along, kFeatureRound | c);
   }
-  if (body.core_count == 2) {
-    const SegmentClosest c = closest_between_segments(p, q, body.core_ends[0], body.core_ends[1]);
-    if (c.t > 0 && c.t < 1) meet(c.on_second, c.on_first, kFeatureRound | 2);
-  }
-}
-
-bool convex_edge(const std::array<Vec3, 3>& v, const Vec3& n, const std::array<Vec3, 3>& w) {
-  const double flat =
-      1e-9 * std::sqrt(std::max({(v[1] - v[0]).squaredNorm(), (v[2] - v[1]).squaredNorm(),
-                                 (v[0] - v[2]).squaredNorm()}));
-  double behind = 0;
-  for (const Vec3& corner : w)
-    behind = std::min(behind, (corner - v[0]).dot(n));
-  return behind < -flat;
 }
 
 void TriangleContacts::finish(TerrainContacts* out) {

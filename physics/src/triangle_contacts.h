@@ -48,9 +48,15 @@ class TriangleContacts {
   std::uint32_t edge(const TriangleBody& body, const std::array<Vec3, 3>& v, const Vec3& n, int e,
                      const Vec3* neighbour_normal, std::uint64_t edge_key,
                      const CollisionSettings& settings);
-  // A round body's core against edge e of triangle v where the edge is convex but too gentle to
-  // be active: a point only where the core lies in the wedge between the two triangles' normals,
-  // beyond both feet, where the face rule finds neither triangle.
+  // After every face: whether a round body's core needs the gentle edges (edges convex but too
+  // gentle to be active): a core end that no face held (its foot inside no triangle within the
+  // margin). Where a face holds each end, a capsule lying across a gentle ridge sinks into it by
+  // up to half its length times the turn, as a box does (docs/COLLISION.md).
+  bool wants_gentle_edges(const TriangleBody& body) const {
+    return body.round && !(core_held_[0] && (body.core_count == 1 || core_held_[1]));
+  }
+  // Then each gentle edge e of triangle v (normal n): a point for a core end no face held, where
+  // it lies in the wedge between the two triangles' normals, beyond both feet.
   void gentle_edge(const TriangleBody& body, const std::array<Vec3, 3>& v, const Vec3& n, int e,
                    const Vec3& neighbour_normal, std::uint64_t edge_key);
   // The manifolds, normals from the body into the triangles.
@@ -63,6 +69,7 @@ class TriangleContacts {
   };
   std::array<Cluster, kMaxTerrainManifolds> clusters_;
   int count_ = 0;
+  std::array<bool, 2> core_held_{};  // whether a face held each core end
   double margin_ = 0;
   double scale_ = 1;
   Cluster& cluster_for(const Vec3& up);
@@ -70,10 +77,6 @@ class TriangleContacts {
 
 // Whether the point's foot on the triangle's plane lies inside it (edges included).
 bool inside_triangle(const std::array<Vec3, 3>& v, const Vec3& n, const Vec3& p);
-
-// Whether the edge of triangle v (normal n) that triangle w shares is convex: w's corners clearly
-// behind v's plane (the test that, with the turn past kSmoothEdgeAngle, makes an edge active).
-bool convex_edge(const std::array<Vec3, 3>& v, const Vec3& n, const std::array<Vec3, 3>& w);
 
 inline Vec3 normal_of(const std::array<Vec3, 3>& v) {
   return (v[1] - v[0]).cross(v[2] - v[0]).normalized();

@@ -103,9 +103,10 @@ void TriangleMesh::build_adjacency() {
     k = end;
   }
   // Convex edges are active, as on a heightfield (height_field.cc): the neighbour's far corner
-  // clearly behind this triangle's plane and the two turning by more than kSmoothEdgeAngle.
+  // clearly behind this triangle's plane and the two turning by more than kSmoothEdgeAngle; the
+  // convex ones that turn less are gentle (round bodies meet them in their wedge alone).
   const double smooth = std::cos(kSmoothEdgeAngle);
-  active_edges_.assign(count, 0);
+  edge_bits_.assign(count, 0);
   for (std::size_t t = 0; t < count; ++t) {
     const std::array<Vec3, 3> v = triangle(t);
     const Vec3 n = normal(t);
@@ -123,10 +124,10 @@ void TriangleMesh::build_adjacency() {
       double behind = 0;
       for (const Vec3& q : w)
         behind = std::min(behind, (q - v[0]).dot(n));
-      if (behind < -flat && normal(static_cast<std::size_t>(other)).dot(n) < smooth)
-        bits |= 1u << e;
+      if (behind < -flat)
+        bits |= normal(static_cast<std::size_t>(other)).dot(n) < smooth ? 1u << e : 8u << e;
     }
-    active_edges_[t] = bits;
+    edge_bits_[t] = bits;
   }
 }
 

@@ -65,7 +65,11 @@ class HeightField {
   // Bit e set: the triangle's edge from its vertex e to vertex e+1 is convex (its neighbour across
   // it slopes away below its plane) or on the boundary. Only such edges may give a contact a
   // normal other than the triangle's own (docs/COLLISION.md, "Heightfields").
-  std::uint8_t active_edges(std::size_t t) const { return active_edges_[t]; }
+  std::uint8_t active_edges(std::size_t t) const { return edge_bits_[t] & 7u; }
+  // Bit e set: that edge is convex but turns by no more than kSmoothEdgeAngle (not active): a
+  // sphere's or capsule's core can lie beyond both its triangles' feet, where only the edge holds
+  // it (docs/COLLISION.md).
+  std::uint8_t gentle_edges(std::size_t t) const { return edge_bits_[t] >> 3; }
   // The triangle across edge e of t, or -1 on the boundary.
   std::int64_t neighbour(std::size_t t, int e) const;
 
@@ -79,7 +83,7 @@ class HeightField {
  private:
   HeightFieldDef def_;
   double min_height_ = 0, max_height_ = 0, base_ = 0;
-  std::vector<std::uint8_t> active_edges_;
+  std::vector<std::uint8_t> edge_bits_;  // active edges in bits 0-2, gentle ones in bits 3-5
 };
 
 }  // namespace tumble

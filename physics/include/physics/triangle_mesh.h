@@ -46,7 +46,11 @@ class TriangleMesh {
   // Bit e set: the edge from vertex e to vertex e+1 is convex (the neighbour across it turns
   // away behind the triangle's plane by more than kSmoothEdgeAngle) or a boundary edge. Only such
   // edges may give a contact a normal other than a face's (docs/COLLISION.md, "Triangle meshes").
-  std::uint8_t active_edges(std::size_t t) const { return active_edges_[t]; }
+  std::uint8_t active_edges(std::size_t t) const { return edge_bits_[t] & 7u; }
+  // Bit e set: that edge is convex but turns by no more than kSmoothEdgeAngle (not active): a
+  // sphere's or capsule's core can lie beyond both its triangles' feet, where only the edge holds
+  // it (docs/COLLISION.md).
+  std::uint8_t gentle_edges(std::size_t t) const { return edge_bits_[t] >> 3; }
   // The triangle across edge e of t, or -1 on a boundary edge.
   std::int64_t neighbour(std::size_t t, int e) const { return neighbours_[3 * t + e]; }
   Aabb bounds() const { return bounds_; }
@@ -84,7 +88,7 @@ class TriangleMesh {
   TriangleMeshDef def_;
   std::vector<Vec3> normals_;
   std::vector<std::int32_t> neighbours_;
-  std::vector<std::uint8_t> active_edges_;
+  std::vector<std::uint8_t> edge_bits_;  // active edges in bits 0-2, gentle ones in bits 3-5
   std::vector<Node> nodes_;
   std::vector<LeafTriangle> leaf_triangles_;
   Aabb bounds_;
