@@ -184,8 +184,14 @@ std::uint32_t TriangleContacts::edge(const TriangleBody& body, const std::array<
     const Vec3 gap = c.on_second - c.on_first;
     const double distance = gap.norm();
     if (radius - distance < -margin_) return kCollisionOk;
-    const Vec3 up = edge_normal(v, n, e, neighbour_normal, distance > 0 ? Vec3(gap / distance) : n);
-    add_point(up, c.on_second - radius * up, c.on_first, terrain_feature(edge_key, kFeatureRound),
+    const Vec3 along_gap = distance > 0 ? Vec3(gap / distance) : n;
+    const Vec3 up = edge_normal(v, n, e, neighbour_normal, along_gap);
+    // Along a clamped normal the pair's offset is not their gap: a core beside an edge a metre
+    // off (continuous collision's sweeps ask with such margins) is level with it along the
+    // face's normal, and read as touching it, and the sweep let a ball at 100 m/s through the
+    // hills. The gap along the clamped normal is the distance.
+    const Vec3 on_terrain = up == along_gap ? c.on_first : Vec3(c.on_second - distance * up);
+    add_point(up, c.on_second - radius * up, on_terrain, terrain_feature(edge_key, kFeatureRound),
               true);
     return kCollisionOk;
   }
