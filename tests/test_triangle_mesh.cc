@@ -41,6 +41,14 @@ TriangleMeshDef cube_mesh(const Vec3& h, bool facing_in) {
   return mesh;
 }
 
+// The standard terrain scene's rolling hills (terrain:N), `samples` a side 0.5 m apart: every
+// edge turns by about 1.4°, too gently to be active.
+HeightFieldDef rolling_hills(std::uint32_t samples) {
+  return field_of(samples, samples, 0.5, [](double x, double y) {
+    return 0.4 * std::sin(0.35 * x) * std::cos(0.3 * y) + 0.15 * std::sin(0.9 * x + 0.7 * y);
+  });
+}
+
 std::string refusal(const TriangleMeshDef& def) {
   const Result<Shape> shape = Shape::create(def);
   return shape ? "" : shape.status().message();
@@ -209,9 +217,7 @@ TEST(TriangleMesh, BallsAndCapsulesRestOnTheApexOfAGentleRidge) {
 // core in their wedge, balls of 0.25 m sank here up to 4.7 cm into the heightfield and 15 cm into
 // the mesh, capsules 14 cm into either.
 TEST(TriangleMesh, BallsAndCapsulesOnRollingHillsNeverSinkIntoThem) {
-  const HeightFieldDef hills = field_of(41, 41, 0.5, [](double x, double y) {
-    return 0.4 * std::sin(0.35 * x) * std::cos(0.3 * y) + 0.15 * std::sin(0.9 * x + 0.7 * y);
-  });
+  const HeightFieldDef hills = rolling_hills(41);
   const HeightField surface = HeightField::create(hills).value();
   for (const ShapeDef& ground : {ShapeDef{hills}, ShapeDef{mesh_of(hills)}}) {
     World world;
@@ -260,9 +266,7 @@ TEST(TriangleMesh, BallsAndCapsulesOnRollingHillsNeverSinkIntoThem) {
 // of these 200 through the mesh; on the standard scene's hills 3 balls and 6 capsules of 100
 // through the mesh, 1 capsule through the heightfield).
 TEST(TriangleMesh, FastBallsAndCapsulesNeverPassThroughTheHills) {
-  const HeightFieldDef hills = field_of(81, 81, 0.5, [](double x, double y) {
-    return 0.4 * std::sin(0.35 * x) * std::cos(0.3 * y) + 0.15 * std::sin(0.9 * x + 0.7 * y);
-  });
+  const HeightFieldDef hills = rolling_hills(81);
   const HeightField surface = HeightField::create(hills).value();
   for (const ShapeDef& ground : {ShapeDef{hills}, ShapeDef{mesh_of(hills)}}) {
     for (const ShapeDef& shape : {ShapeDef{SphereDef{0.1}}, ShapeDef{CapsuleDef{0.05, 0.2}}}) {

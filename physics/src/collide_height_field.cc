@@ -45,9 +45,9 @@ std::uint32_t collide_height_field(const Shape& a, const Mat3& rotation, const V
         for (int e = 0; e < 3; ++e) {
           // Each edge once: from the lower of its two triangles.
           const std::int64_t other = field.neighbour(t, e);
-          if (other >= 0 && static_cast<std::size_t>(other) < t) continue;
+          if ((active & (1u << e)) == 0 || (other >= 0 && static_cast<std::size_t>(other) < t))
+            continue;
           if (std::max(v[e].z(), v[(e + 1) % 3].z()) < box.min.z()) continue;
-          if ((active & (1u << e)) == 0) continue;
           Vec3 other_normal;
           if (other >= 0) other_normal = normal_of(field.triangle(static_cast<std::size_t>(other)));
           flags |= contacts.edge(body, v, n, e, other >= 0 ? &other_normal : nullptr, 3 * t + e,

@@ -115,8 +115,8 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
     const std::uint8_t active = mesh.active_edges(t);
     for (int e = 0; e < 3; ++e) {
       const std::int64_t other = mesh.neighbour(t, e);
-      if (other >= 0 && static_cast<std::uint32_t>(other) < t) continue;
-      if ((active & (1u << e)) == 0) continue;
+      if ((active & (1u << e)) == 0 || (other >= 0 && static_cast<std::uint32_t>(other) < t))
+        continue;
       Vec3 other_normal;
       if (other >= 0) {
         const auto o = static_cast<std::size_t>(other);
