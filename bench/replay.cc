@@ -11,7 +11,8 @@
 //   ROUNDS   rounds (default 5)
 //   THREADS  step threads (default 1)
 // TUMBLE_SOLVER=exact|pgs|soft|auto in the environment replaces the scene's solver, and
-// TUMBLE_SUBSTEPS=N (1 to 32) its substeps.
+// TUMBLE_SUBSTEPS=N (1 to 32) its substeps, and TUMBLE_JOINT_FRICTION=F (N m, 0 or more) every
+// joint's friction (bench_joints times the ragdolls with 0: no peer maps it).
 // Sleeping is off, so the whole scene is awake. Each round restores the state, takes two untimed
 // steps (the restored world's buffers warm up) and times STEPS more. Prints the mean time per step
 // of each stage per round, then each stage's minimum and median over the rounds, and the state's
@@ -22,6 +23,7 @@
 // Comparing builds A and B: run them alternately, e.g.
 //   for r in 1 2 3; do A/bench_replay pile:16000; B/bench_replay pile:16000; done
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -98,6 +100,17 @@ int main(int argc, char** argv) {
       return 2;
     }
     scene.value().world.solver.substeps = count;
+  }
+  if (const char* friction = std::getenv("TUMBLE_JOINT_FRICTION")) {
+    char* end = nullptr;
+    const double value = std::strtod(friction, &end);
+    if (*end != '\0' || !(value >= 0) || !std::isfinite(value)) {
+      std::fprintf(stderr, "bench_replay: TUMBLE_JOINT_FRICTION=%s is not a force of 0 or more\n",
+                   friction);
+      return 2;
+    }
+    for (SceneJoint& joint : scene.value().joints)
+      joint.def.friction = value;
   }
   scene.value().world.solver.sleeping = false;
   const double dt = scene.value().dt;
