@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "narrow_phase.h"
+#include "ray_shape.h"
 #include "rotation.h"
 
 namespace tumble {
@@ -14,6 +16,53 @@ Pose pose_at(const SweptMotion& motion, double t) {
       t == 0 ? motion.start.orientation : rotated(motion.start.orientation, t * motion.rotation);
   return pose;
 }
+
+namespace {
+
+// A pair touching at the start of the step is the contact solver's: its contacts, speculative as
+// far as the body moves, keep it out. Against a convex shape they do; against a terrain they are
+// planes of the triangles near the start, and a body that the solve sends far along the surface
+// or turning fast (a box landing on one corner at 100 m/s pivots about it at 100 rad/s) can leave
+// them behind and end under the surface: its centre crossed it, where no contact holds it any
+// more (a mesh holds only bodies whose centre is in front of it). So where the body's centre
+// crosses the terrain's surface in the step, it stops at the last time before (bisected) at which
+// it is no deeper in than it started by more than `target`.
+void stop_short_of_crossing(const Shape& a, const SweptMotion& motion_a, const Shape& b,
+                            const SweptMotion& motion_b, double start_depth, double target,
+                            int max_iterations, ImpactResult* result) {
+  const bool terrain_a = is_terrain(a.type());
+  const SweptMotion& body = terrain_a ? motion_b : motion_a;
+  const SweptMotion& terrain = terrain_a ? motion_a : motion_b;
+  // The centre's path in the terrain's frame, as a segment from its start to its end.
+  const auto centre_in_terrain = [&](double t) {
+    const Pose frame = pose_at(terrain, t);
+    return Vec3(frame.orientation.conjugate() * (pose_at(body, t).position - frame.position));
+  };
+  const Vec3 from = centre_in_terrain(0);
+  const Vec3 path = centre_in_terrain(1) - from;
+  const double length = path.norm();
+  ShapeRayHit hit;
+  // A centre that starts inside a heightfield's solid meets it at once: it is on its way out.
+  if (!(length > 0) || !ray_shape(terrain_a ? a : b, from, path / length, length, &hit) ||
+      hit.t == 0)
+    return;
+  const double threshold = std::max(start_depth, 0.0) + target;
+  CollisionSettings settings;
+  settings.feature_slack = 0;
+  settings.margin = target;
+  ContactManifold manifold;
+  double good = 0, bad = hit.t / length;
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    const double t = 0.5 * (good + bad);
+    collide(a, pose_at(motion_a, t), b, pose_at(motion_b, t), settings, &manifold);
+    (manifold.count == 0 || manifold.depth <= threshold ? good : bad) = t;
+  }
+  result->status = ImpactStatus::kHit;
+  result->t = good;
+  result->in_contact = true;
+}
+
+}  // namespace
 
 ImpactResult time_of_impact(const Shape& a, const SweptMotion& motion_a, const Shape& b,
                             const SweptMotion& motion_b, double target, double tolerance,
@@ -39,13 +88,14 @@ ImpactResult time_of_impact(const Shape& a, const SweptMotion& motion_a, const S
     if (gap <= target + tolerance) {
       result.status = t == 0 ? ImpactStatus::kTouchingAtStart : ImpactStatus::kHit;
       result.t = t;
+      if (t == 0 && is_terrain_pair(a, b))
+        stop_short_of_crossing(a, motion_a, b, motion_b, -gap, target, max_iterations, &result);
       return result;
     }
-    // The nearest parts' normal bounds how fast a compound's other parts close only along it: a
-    // compound's gap closes at most at the whole relative speed.
-    const double along = a.type() == ShapeType::kCompound || b.type() == ShapeType::kCompound
-                             ? translation.norm()
-                             : -manifold.normal.dot(translation);
+    // The nearest parts' normal bounds how fast a compound's other parts (a terrain's other
+    // triangles) close only along it: their gap closes at most at the whole relative speed.
+    const double along =
+        is_many_manifold_pair(a, b) ? translation.norm() : -manifold.normal.dot(translation);
     const double closing = along + turning;
     if (closing <= 0) return result;  // moving apart along the normal, not turning: kMiss
     t += (gap - target) / closing;

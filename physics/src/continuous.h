@@ -39,6 +39,9 @@ struct ImpactResult {
   double t = 1;
   Vec3 normal = Vec3::UnitZ();  // from A to B at t
   int iterations = 0;
+  // A hit of a pair touching from the start (a body whose centre would cross a terrain's surface,
+  // stopped short of it): the solve already met the contact, and its velocities stand.
+  bool in_contact = false;
 };
 
 // `target`: the gap (m) to stop at, > 0 so that the next step still sees a speculative contact;

@@ -127,6 +127,9 @@ struct StepScratch {
   std::vector<std::uint32_t> swept_pairs;
   std::vector<ImpactResult> impacts;
   std::vector<double> first_impact;
+  // Whether a body's first impact stopped it in a contact it touched from the start (its solved
+  // velocities stand: the solve already met that contact).
+  std::vector<std::uint8_t> impact_in_contact;
   std::vector<std::uint32_t> support_level;               // for tall_stacks.h
   std::vector<std::vector<LevelSums>> thread_level_sums;  // for tall_stacks.h, one per thread
   // An island's joints in components: joints joined through bodies that move (statics, kinematic

@@ -208,9 +208,13 @@ std::uint32_t TriangleContacts::edge(const TriangleBody& body, const std::array<
   if (m.count == 0) return flags;
   manifold_to_world(body.rotation, body.translation, &m);
   const Vec3 up = edge_normal(v, n, e, neighbour_normal, m.normal);
-  for (int c = 0; c < m.count; ++c)
-    add_point(up, m.points[c].point_b, m.points[c].point_a,
-              terrain_feature(edge_key, m.points[c].feature_id), true);
+  // As for a round core above: along a clamped normal the gap is the pair's distance (its depth
+  // along their own normal), not the points' offset along it.
+  for (int c = 0; c < m.count; ++c) {
+    const ContactPoint& point = m.points[c];
+    const Vec3 on_terrain = up == m.normal ? point.point_a : Vec3(point.point_b + point.depth * up);
+    add_point(up, point.point_b, on_terrain, terrain_feature(edge_key, point.feature_id), true);
+  }
   return flags;
 }
 
