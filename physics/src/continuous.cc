@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "narrow_phase.h"
+#include "physics/compound.h"
 #include "ray_shape.h"
 #include "rotation.h"
 
@@ -31,27 +32,41 @@ void stop_short_of_crossing(const Shape& a, const SweptMotion& motion_a, const S
                             const SweptMotion& motion_b, double start_depth, double target,
                             int max_iterations, ImpactResult* result) {
   const bool terrain_a = is_terrain(a.type());
+  const Shape& body_shape = terrain_a ? b : a;
   const SweptMotion& body = terrain_a ? motion_b : motion_a;
   const SweptMotion& terrain = terrain_a ? motion_a : motion_b;
-  // The centre's path in the terrain's frame, as a segment from its start to its end.
-  const auto centre_in_terrain = [&](double t) {
+  // Where a point of the body's frame is at time t, in the terrain's frame.
+  const auto in_terrain = [&](const Vec3& local, double t) {
     const Pose frame = pose_at(terrain, t);
-    return Vec3(frame.orientation.conjugate() * (pose_at(body, t).position - frame.position));
+    const Pose at = pose_at(body, t);
+    return Vec3(frame.orientation.conjugate() *
+                (at.position + at.orientation * local - frame.position));
   };
-  const Vec3 from = centre_in_terrain(0);
-  const Vec3 path = centre_in_terrain(1) - from;
-  const double length = path.norm();
-  ShapeRayHit hit;
-  // A centre that starts inside a heightfield's solid meets it at once: it is on its way out.
-  if (!(length > 0) || !ray_shape(terrain_a ? a : b, from, path / length, length, &hit) ||
-      hit.t == 0)
-    return;
+  // The first time a centre's path (a segment from its start to its end) crosses the surface: the
+  // body's, or each part's of a compound (a dumbbell's balls lie beside its centre).
+  double crossing = 2;
+  const auto cross = [&](const Vec3& local) {
+    const Vec3 from = in_terrain(local, 0);
+    const Vec3 path = in_terrain(local, 1) - from;
+    const double length = path.norm();
+    ShapeRayHit hit;
+    // A centre that starts inside a heightfield's solid meets it at once: it is on its way out.
+    if (length > 0 && ray_shape(terrain_a ? a : b, from, path / length, length, &hit) && hit.t > 0)
+      crossing = std::min(crossing, hit.t / length);
+  };
+  if (body_shape.type() == ShapeType::kCompound) {
+    for (const Compound::Part& part : body_shape.compound()->parts())
+      cross(part.pose.position);
+  } else {
+    cross(Vec3::Zero());
+  }
+  if (crossing > 1) return;
   const double threshold = std::max(start_depth, 0.0) + target;
   CollisionSettings settings;
   settings.feature_slack = 0;
   settings.margin = target;
   ContactManifold manifold;
-  double good = 0, bad = hit.t / length;
+  double good = 0, bad = crossing;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     const double t = 0.5 * (good + bad);
     collide(a, pose_at(motion_a, t), b, pose_at(motion_b, t), settings, &manifold);
