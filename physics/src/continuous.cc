@@ -30,7 +30,8 @@ namespace {
 // it is no deeper in than it started by more than `target`.
 void stop_short_of_crossing(const Shape& a, const SweptMotion& motion_a, const Shape& b,
                             const SweptMotion& motion_b, double start_depth, double target,
-                            int max_iterations, ImpactResult* result) {
+                            double tolerance, double reach, int max_iterations,
+                            ImpactResult* result) {
   const bool terrain_a = is_terrain(a.type());
   const Shape& body_shape = terrain_a ? b : a;
   const SweptMotion& body = terrain_a ? motion_b : motion_a;
@@ -67,7 +68,10 @@ void stop_short_of_crossing(const Shape& a, const SweptMotion& motion_a, const S
   settings.margin = target;
   ContactManifold manifold;
   double good = 0, bad = crossing;
-  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+  // Halved until no point moves more than the tolerance between the two: within it of where the
+  // body would pass the threshold.
+  for (int iteration = 0; iteration < max_iterations && (bad - good) * reach > tolerance;
+       ++iteration) {
     const double t = 0.5 * (good + bad);
     collide(a, pose_at(motion_a, t), b, pose_at(motion_b, t), settings, &manifold);
     (manifold.count == 0 || manifold.depth <= threshold ? good : bad) = t;
@@ -104,7 +108,8 @@ ImpactResult time_of_impact(const Shape& a, const SweptMotion& motion_a, const S
       result.status = t == 0 ? ImpactStatus::kTouchingAtStart : ImpactStatus::kHit;
       result.t = t;
       if (t == 0 && is_terrain_pair(a, b))
-        stop_short_of_crossing(a, motion_a, b, motion_b, -gap, target, max_iterations, &result);
+        stop_short_of_crossing(a, motion_a, b, motion_b, -gap, target, tolerance, reach,
+                               max_iterations, &result);
       return result;
     }
     // The nearest parts' normal bounds how fast a compound's other parts (a terrain's other
