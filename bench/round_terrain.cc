@@ -3,9 +3,12 @@
 // triangles as a mesh: the median time a step over the rounds, and how far any body sank into
 // the surface (vertically, at its core's lowest end, less its radius: a bound on the depth along
 // the normal), sampled after every step, untimed. What the gentle edges cost round bodies and
-// what they hold (docs/COLLISION.md, "Heightfields").
+// what they hold (docs/COLLISION.md, "Heightfields"). With a small RADIUS (0.05 m) the bodies are
+// fast for their size (they move more than 3/4 of their radius a step), and continuous collision
+// sweeps every one touching the hills each step (docs/DYNAMICS.md, "Continuous collision").
 //
-// Usage: bench_round_terrain [BODIES [ROUNDS]]   (defaults 200, 3; one thread, 10 s at 60 Hz)
+// Usage: bench_round_terrain [BODIES [ROUNDS [RADIUS]]]   (defaults 200, 3, 0.25 m: a ball's
+// radius; a capsule's is 0.6 of it and its core 2.4 of it long; one thread, 10 s at 60 Hz)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,7 +29,7 @@ struct Run {
   double deepest = 0;  // m
 };
 
-Run run(const BodyDef& ground, const HeightField& hills, bool capsules, int bodies) {
+Run run(const BodyDef& ground, const HeightField& hills, bool capsules, int bodies, double size) {
   WorldSettings settings;
   settings.threads = 1;
   World world(settings);
@@ -37,7 +40,8 @@ Run run(const BodyDef& ground, const HeightField& hills, bool capsules, int bodi
   for (int i = 0; i < bodies; ++i) {
     BodyDef body;
     body.mass = 1;
-    body.shape = capsules ? ShapeDef{CapsuleDef{0.15, 0.3}} : ShapeDef{SphereDef{0.25}};
+    body.shape =
+        capsules ? ShapeDef{CapsuleDef{0.6 * size, 1.2 * size}} : ShapeDef{SphereDef{size}};
     body.position = Vec3(across(random), across(random), 2 + 0.02 * i);
     body.linear_velocity = Vec3(sideways(random), sideways(random), -5);
     body.orientation = Quat(Eigen::AngleAxisd(
@@ -45,7 +49,7 @@ Run run(const BodyDef& ground, const HeightField& hills, bool capsules, int bodi
     ids.push_back(world.create_body(body).value());
   }
   const Pose pose{ground.position, ground.orientation};
-  const double radius = capsules ? 0.15 : 0.25;
+  const double radius = capsules ? 0.6 * size : size;
   Run out;
   double seconds = 0;
   const int steps = 600;
@@ -57,7 +61,7 @@ Run run(const BodyDef& ground, const HeightField& hills, bool capsules, int bodi
       const BodyView body = world.body(id);
       for (const double end : {-1.0, 1.0}) {
         const Vec3 core = pose.inverse_transform(
-            body.position() + body.orientation() * Vec3(0, 0, capsules ? 0.3 * end : 0.0));
+            body.position() + body.orientation() * Vec3(0, 0, capsules ? 1.2 * size * end : 0.0));
         // Bodies that rolled off the hills' edge fall past them: not sinking.
         if (std::abs(core.x()) > 28 || std::abs(core.y()) > 28) continue;
         out.deepest = std::max(out.deepest, hills.height_at(core.x(), core.y()) - core.z() + radius);
@@ -75,8 +79,11 @@ int main(int argc, char** argv) {
   using namespace tumble;
   const int bodies = argc > 1 ? std::atoi(argv[1]) : 200;
   const int rounds = argc > 2 ? std::atoi(argv[2]) : 3;
-  if (bodies < 1 || bodies > 10000 || rounds < 1 || rounds > 100) {
-    std::fprintf(stderr, "usage: bench_round_terrain [BODIES 1..10000 [ROUNDS 1..100]]\n");
+  const double size = argc > 3 ? std::atof(argv[3]) : 0.25;
+  if (bodies < 1 || bodies > 10000 || rounds < 1 || rounds > 100 || !(size >= 0.01 && size <= 1)) {
+    std::fprintf(
+        stderr,
+        "usage: bench_round_terrain [BODIES 1..10000 [ROUNDS 1..100 [RADIUS 0.01..1 m]]]\n");
     return 2;
   }
   const SceneDef scene = terrain_pile_scene(1000);
@@ -86,16 +93,16 @@ int main(int argc, char** argv) {
   BodyDef mesh_ground = field_ground;
   mesh_ground.shape = mesh_of_height_field(hills);
   std::printf(
-      "%d balls (0.25 m) or capsules (0.15 m, core 0.6 m) thrown onto the rolling hills, 10 s at "
-      "60 Hz, one thread, %d rounds\n",
-      bodies, rounds);
+      "%d balls (%g m) or capsules (%g m, core %g m) thrown onto the rolling hills, 10 s at 60 Hz, "
+      "one thread, %d rounds\n",
+      bodies, size, 0.6 * size, 2.4 * size, rounds);
   const char* names[4] = {"balls, heightfield", "capsules, heightfield", "balls, mesh",
                           "capsules, mesh"};
   std::vector<double> ms[4];
   double deepest[4] = {0, 0, 0, 0};
   for (int round = 0; round < rounds; ++round)
     for (int k = 0; k < 4; ++k) {
-      const Run r = run(k < 2 ? field_ground : mesh_ground, hills, k % 2 == 1, bodies);
+      const Run r = run(k < 2 ? field_ground : mesh_ground, hills, k % 2 == 1, bodies, size);
       ms[k].push_back(r.ms_per_step);
       deepest[k] = std::max(deepest[k], r.deepest);
     }

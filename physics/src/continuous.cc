@@ -36,10 +36,14 @@ void stop_short_of_crossing(const Shape& a, const SweptMotion& motion_a, const S
   const Shape& body_shape = terrain_a ? b : a;
   const SweptMotion& body = terrain_a ? motion_b : motion_a;
   const SweptMotion& terrain = terrain_a ? motion_a : motion_b;
-  // Where a point of the body's frame is at time t, in the terrain's frame.
-  const auto in_terrain = [&](const Vec3& local, double t) {
-    const Pose frame = pose_at(terrain, t);
-    const Pose at = pose_at(body, t);
+  // The body's and the terrain's poses at the start and the end (a static terrain's are one).
+  const Pose body_start = body.start, body_end = pose_at(body, 1);
+  const Pose frame_start = terrain.start;
+  const Pose frame_end = terrain.translation.isZero() && terrain.rotation.isZero()
+                             ? terrain.start
+                             : pose_at(terrain, 1);
+  // Where a point of the body's frame is, in the terrain's frame.
+  const auto in_terrain = [](const Pose& frame, const Pose& at, const Vec3& local) {
     return Vec3(frame.orientation.conjugate() *
                 (at.position + at.orientation * local - frame.position));
   };
@@ -47,8 +51,8 @@ void stop_short_of_crossing(const Shape& a, const SweptMotion& motion_a, const S
   // body's, or each part's of a compound (a dumbbell's balls lie beside its centre).
   double crossing = 2;
   const auto cross = [&](const Vec3& local) {
-    const Vec3 from = in_terrain(local, 0);
-    const Vec3 path = in_terrain(local, 1) - from;
+    const Vec3 from = in_terrain(frame_start, body_start, local);
+    const Vec3 path = in_terrain(frame_end, body_end, local) - from;
     const double length = path.norm();
     ShapeRayHit hit;
     // A centre that starts inside a heightfield's solid meets it at once: it is on its way out.
