@@ -102,6 +102,28 @@ TEST(Determinism, DefaultSceneWithSweptBodiesSameBitsForAnyThreadCountAndRun) {
   expect_same_bits(scene, 300);
 }
 
+// Piles on the hills, as a heightfield and as a mesh, with boxes thrown at 150 m/s among them:
+// the terrain's contacts and the sweeps that stop a body short of crossing the surface
+// (continuous.cc) are each pair's own, the same on any team.
+TEST(Determinism, TerrainPilesWithFastBodiesSameBitsForAnyThreadCount) {
+  for (SceneDef scene : {terrain_pile_scene(216), terrain_mesh_pile_scene(216)}) {
+    for (int k = 0; k < 32; ++k) {
+      BodyDef thrown;
+      thrown.shape = BoxDef{Vec3(0.1, 0.1, 0.1)};
+      thrown.mass = 1;
+      thrown.position = Vec3(-12 + 0.75 * k, 12 - 0.5 * k, 3);
+      thrown.linear_velocity = Vec3(20 - 1.3 * k, 1.1 * k - 15, -150);
+      thrown.angular_velocity = Vec3(7, -3, 0.3 * k);
+      scene.bodies.push_back(thrown);
+    }
+    World world = build(scene);
+    std::uint32_t impacts = 0;
+    run(world, scene.dt, 60, [&](long) { impacts += world.last_step().continuous_impacts; });
+    EXPECT_GT(impacts, 0u) << scene.name;
+    expect_same_bits(scene, 60);
+  }
+}
+
 // Packs (contact_packs.h) are a layout for the sweeps, not another solver: swept in packs or row
 // by row, every solver gives the same bits (and the same residual), on one thread and on two, for
 // the pile's small islands (side by side in lanes) and the pyramid's one (a colour's manifolds in
