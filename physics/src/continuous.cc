@@ -80,7 +80,9 @@ void stop_short_of_crossing(const Shape& a, const SweptMotion& motion_a, const S
     collide(a, pose_at(motion_a, t), b, pose_at(motion_b, t), settings, &manifold);
     (manifold.count == 0 || manifold.depth <= threshold ? good : bad) = t;
   }
-  result->status = ImpactStatus::kHit;
+  // Stopped by the bound, `good` is still a time the body may stop at, and the bound is reported.
+  result->status =
+      (bad - good) * reach > tolerance ? ImpactStatus::kIterationLimit : ImpactStatus::kHit;
   result->t = good;
   result->in_contact = true;
 }
