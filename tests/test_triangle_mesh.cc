@@ -259,6 +259,25 @@ TEST(TriangleMesh, BallsAndCapsulesOnRollingHillsNeverSinkIntoThem) {
   }
 }
 
+// A hundred bodies of `shape` thrown from 3 m over a square of half side `half_span`, falling at
+// `down` m/s, sideways at up to `sideways` m/s, turning at up to 10 rad/s about each axis.
+std::vector<BodyId> throw_bodies(World* world, const ShapeDef& shape, double half_span,
+                                 double sideways, double down) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> across(-half_span, half_span), unit(-1, 1);
+  std::vector<BodyId> bodies;
+  for (int k = 0; k < 100; ++k) {
+    BodyDef body;
+    body.mass = 1;
+    body.shape = shape;
+    body.position = Vec3(across(random), across(random), 3);
+    body.linear_velocity = Vec3(sideways * unit(random), sideways * unit(random), -down);
+    body.angular_velocity = 10 * Vec3(unit(random), unit(random), unit(random));
+    bodies.push_back(world->create_body(body).value());
+  }
+  return bodies;
+}
+
 // Balls and capsules thrown at 100 m/s onto rolling hills are swept (continuous collision) and
 // stop on them. The sweep asks for contacts with a margin of its whole motion, 1.7 m here, and
 // an edge's contact with its normal clamped to the face's read a core level with an edge a metre
@@ -272,18 +291,7 @@ TEST(TriangleMesh, FastBallsAndCapsulesNeverPassThroughTheHills) {
     for (const ShapeDef& shape : {ShapeDef{SphereDef{0.1}}, ShapeDef{CapsuleDef{0.05, 0.2}}}) {
       World world;
       add_static(&world, ground);
-      std::mt19937 random(3);
-      std::uniform_real_distribution<double> across(-15, 15), unit(-1, 1);
-      std::vector<BodyId> bodies;
-      for (int k = 0; k < 100; ++k) {
-        BodyDef body;
-        body.mass = 1;
-        body.shape = shape;
-        body.position = Vec3(across(random), across(random), 3);
-        body.linear_velocity = Vec3(30 * unit(random), 30 * unit(random), -100);
-        body.angular_velocity = 10 * Vec3(unit(random), unit(random), unit(random));
-        bodies.push_back(world.create_body(body).value());
-      }
+      const std::vector<BodyId> bodies = throw_bodies(&world, shape, 15, 30, 100);
       run(&world, 60);
       const bool mesh = std::holds_alternative<TriangleMeshDef>(ground);
       for (std::size_t k = 0; k < bodies.size(); ++k) {
@@ -315,19 +323,7 @@ TEST(TriangleMesh, FastBoxesAndCompoundsNeverPassThroughTheHills) {
       for (const double speed : {100.0, 150.0, 300.0}) {
         World world;
         add_static(&world, ground);
-        std::mt19937 random(3);
-        std::uniform_real_distribution<double> across(-20, 20), unit(-1, 1);
-        std::vector<BodyId> bodies;
-        for (int k = 0; k < 100; ++k) {
-          BodyDef body;
-          body.mass = 1;
-          body.shape = shape;
-          body.position = Vec3(across(random), across(random), 3);
-          body.linear_velocity =
-              Vec3(0.3 * speed * unit(random), 0.3 * speed * unit(random), -speed);
-          body.angular_velocity = 10 * Vec3(unit(random), unit(random), unit(random));
-          bodies.push_back(world.create_body(body).value());
-        }
+        const std::vector<BodyId> bodies = throw_bodies(&world, shape, 20, 0.3 * speed, speed);
         run(&world, 60);
         const bool mesh = std::holds_alternative<TriangleMeshDef>(ground);
         const bool box = std::holds_alternative<BoxDef>(shape);
