@@ -486,41 +486,101 @@ void HashGrid::resting_near(const Aabb& box, std::vector<std::uint32_t>* out) co
   }
 }
 
-bool sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
+void SweepAndPrune::sort_order() {
+  const std::size_t n = order_.size();
+  std::size_t moves = 0;
+  const std::size_t budget = 8 * n + 64;
+  for (std::size_t i = 1; i < n; ++i) {
+    const Entry entry = order_[i];
+    std::size_t k = i;
+    while (k > 0 && entry < order_[k - 1]) {
+      order_[k] = order_[k - 1];
+      --k;
+    }
+    order_[k] = entry;
+    moves += i - k;
+    if (moves > budget) {
+      std::sort(order_.begin(), order_.end());
+      return;
+    }
+  }
+}
+
+void SweepAndPrune::order_pairs(std::vector<BodyPair>* pairs, std::size_t slots) {
+  // Two stable counting passes (least significant key first): by b, then by a.
+  spare_.resize(pairs->size());
+  counts_.assign(slots + 1, 0);
+  for (const BodyPair& p : *pairs)
+    ++counts_[p.b + 1];
+  for (std::size_t k = 1; k <= slots; ++k)
+    counts_[k] += counts_[k - 1];
+  for (const BodyPair& p : *pairs)
+    spare_[counts_[p.b]++] = p;
+  counts_.assign(slots + 1, 0);
+  for (const BodyPair& p : spare_)
+    ++counts_[p.a + 1];
+  for (std::size_t k = 1; k <= slots; ++k)
+    counts_[k] += counts_[k - 1];
+  for (const BodyPair& p : spare_)
+    (*pairs)[counts_[p.a]++] = p;
+}
+
+bool SweepAndPrune::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
   const std::size_t max_pairs = input.max_pairs;
   const std::size_t compact_at =
       max_pairs > static_cast<std::size_t>(-1) / 2 ? max_pairs : 2 * max_pairs;
-  std::atomic<bool> cut{false};
+  bool cut = false;
   const auto& bounds = input.bounds;
-  // Kept per thread and reused, so that stepping small worlds allocates nothing.
-  thread_local std::vector<std::uint32_t> order, unbounded;
-  order.clear();
-  unbounded.clear();
-  for (std::uint32_t i = 0; i < bounds.size(); ++i) {
-    if (is_dead(bounds[i])) continue;
-    (bounds[i].is_bounded() ? order : unbounded).push_back(i);
+  const std::size_t slots = bounds.size();
+  // The last call's order, less the bodies gone, dead or unbounded since, with fresh keys; then
+  // the bodies it did not hold.
+  listed_.assign(slots, 0);
+  std::size_t kept = 0;
+  for (const Entry& entry : order_) {
+    const std::uint32_t i = entry.body;
+    if (i >= slots || is_dead(bounds[i]) || !bounds[i].is_bounded()) continue;
+    listed_[i] = 1;
+    order_[kept++] = {bounds[i].min.x(), i};
   }
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return bounds[a].min.x() < bounds[b].min.x() ||
-           (bounds[a].min.x() == bounds[b].min.x() && a < b);
-  });
+  order_.resize(kept);
+  unbounded_.clear();
+  for (std::uint32_t i = 0; i < slots; ++i) {
+    if (listed_[i] || is_dead(bounds[i])) continue;
+    if (bounds[i].is_bounded())
+      order_.push_back({bounds[i].min.x(), i});
+    else
+      unbounded_.push_back(i);
+  }
+  sort_order();
   auto emit = [&](std::uint32_t a, std::uint32_t b) {
     if (!(input.movable[a] || input.movable[b]) || !bounds[a].overlaps(bounds[b])) return;
     pairs->push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
     if (pairs->size() >= compact_at && keep_first_pairs(pairs, max_pairs)) cut = true;
   };
-  for (std::size_t i = 0; i < order.size(); ++i)
-    for (std::size_t j = i + 1;
-         j < order.size() && bounds[order[j]].min.x() <= bounds[order[i]].max.x(); ++j)
-      emit(order[i], order[j]);
-  for (std::size_t k = 0; k < unbounded.size(); ++k) {
-    for (std::uint32_t i : order)
-      emit(i, unbounded[k]);
-    for (std::size_t m = k + 1; m < unbounded.size(); ++m)
-      emit(unbounded[k], unbounded[m]);
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    const double max_x = bounds[order_[i].body].max.x();
+    for (std::size_t j = i + 1; j < order_.size() && order_[j].min_x <= max_x; ++j)
+      emit(order_[i].body, order_[j].body);
   }
-  return keep_first_pairs(pairs, max_pairs) || cut;
+  for (std::size_t k = 0; k < unbounded_.size(); ++k) {
+    for (const Entry& entry : order_)
+      emit(entry.body, unbounded_[k]);
+    for (std::size_t m = k + 1; m < unbounded_.size(); ++m)
+      emit(unbounded_[k], unbounded_[m]);
+  }
+  // Each pair was emitted once (a body is in order_ or unbounded_, and the sweep meets each
+  // overlapping pair from its first body along x), unless a cut compacted the list meanwhile.
+  if (cut) return keep_first_pairs(pairs, max_pairs) || cut;
+  order_pairs(pairs, slots);
+  if (pairs->size() <= max_pairs) return false;
+  pairs->resize(max_pairs);
+  return true;
+}
+
+bool sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
+  thread_local SweepAndPrune sweep;
+  return sweep.find_pairs(input, pairs);
 }
 
 }  // namespace tumble

@@ -111,6 +111,39 @@ class HashGrid {
   double base_ = 1.0;                  // level 0's cell, m; kept with the resting cells
 };
 
+// Sweep and prune along x, for small worlds (World picks it below a body count). A world keeps
+// one: the bodies' order along x barely changes from step to step, so each call starts from the
+// last call's order and insertion-sorts it, a pass over the bodies where they moved little (Baraff
+// 1992's coherent sort; Bullet's btAxisSweep3 and Jolt's broad phase keep theirs sorted too). The
+// pairs come out in (a, b) order by two counting passes over the body slots, not a comparison
+// sort. The result is the sorted set of overlapping pairs, whatever order the last call left.
+class SweepAndPrune {
+ public:
+  // The pairs, sorted; true when input.max_pairs cut them short.
+  bool find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);
+
+ private:
+  struct Entry {
+    double min_x;
+    std::uint32_t body;
+    bool operator<(const Entry& o) const {
+      return min_x < o.min_x || (min_x == o.min_x && body < o.body);
+    }
+  };
+  // Sorts order_ (the last call's order, then the bodies new to it), insertion first; past a
+  // budget of moves in proportion to the bodies (a shuffled scene), a comparison sort.
+  void sort_order();
+  // Puts `pairs` in (a, b) order: counting by b, then stably by a (slots below `slots`).
+  void order_pairs(std::vector<BodyPair>* pairs, std::size_t slots);
+
+  std::vector<Entry> order_;
+  std::vector<std::uint32_t> unbounded_;
+  std::vector<std::uint8_t> listed_;  // by slot: in order_ this call
+  std::vector<std::uint32_t> counts_;
+  std::vector<BodyPair> spare_;
+};
+
+// A SweepAndPrune of the calling thread's (tests and benchmarks; the world keeps its own).
 bool sweep_and_prune(const BroadPhaseInput& input, std::vector<BodyPair>* pairs);
 
 }  // namespace tumble

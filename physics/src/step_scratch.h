@@ -57,6 +57,7 @@ constexpr std::uint32_t kNoSolverBody = UINT32_MAX;
 struct StepScratch {
   // The world's own (it keeps the cells of the bodies that do not move from step to step).
   HashGrid grid;
+  SweepAndPrune sweep;  // likewise its order along x
   // The step's bodies, dense, by solver index: the moving bodies in slot order, then the other
   // bodies this step's contacts touch (statics: inverse mass 0, never written). A step visits
   // these and not every slot of the world. Every per-body array below, the islands, the colouring

@@ -754,7 +754,7 @@ void World::run_broad_phase() {
   recent_sleepers_.clear();
   input.max_pairs = max_pairs();
   const bool cut = method == BroadPhaseMethod::kSweepAndPrune
-                       ? sweep_and_prune(input, &pairs_)
+                       ? scratch_->sweep.find_pairs(input, &pairs_)
                        : scratch_->grid.find_pairs(input, &pairs_);
   if (cut) ++stats_.pair_limit_hits;
   // The bounds (compute_bounds comes first) and the grid have seen every change so far.
