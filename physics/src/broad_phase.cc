@@ -400,17 +400,29 @@ bool HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
   const std::int64_t entry_count = static_cast<std::int64_t>(moving_entries_.size());
   const std::int64_t grid_count = static_cast<std::int64_t>(on_grid.size());
   const std::int64_t moving_count = static_cast<std::int64_t>(moving.size());
+  entry_bounds_.resize(moving_entries_.size());
   run_region(threads, true, [&] {
     auto& out = thread_pairs_[omp_get_thread_num()];
     out.clear();
-    // Moving bodies in the same cell: each run of equal keys, visited from its first entry.
+    // Each entry's box beside it: a crowded cell tests every two of its entries, most of them
+    // apart, and reading the boxes by body for each test went to memory at random (in a pile of
+    // 1000 boxes on hills, 28,000 tests a step for 3,800 overlaps).
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < entry_count; ++i)
+      entry_bounds_[i] = bounds[moving_entries_[i].body()];
+      // Moving bodies in the same cell: each run of equal keys, visited from its first entry.
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < entry_count; ++i) {
       const std::uint32_t key = moving_entries_[i].key();
       if (i > 0 && moving_entries_[i - 1].key() == key) continue;
-      for (std::int64_t j = i; j < entry_count && moving_entries_[j].key() == key; ++j) {
+      std::int64_t end = i + 1;
+      while (end < entry_count && moving_entries_[end].key() == key)
+        ++end;
+      for (std::int64_t j = i; j < end; ++j) {
+        const Aabb& box = entry_bounds_[j];
         const std::uint32_t a = moving_entries_[j].body();
-        for (std::int64_t k = j + 1; k < entry_count && moving_entries_[k].key() == key; ++k) {
+        for (std::int64_t k = j + 1; k < end; ++k) {
+          if (!box.overlaps(entry_bounds_[k])) continue;
           const std::uint32_t b = moving_entries_[k].body();
           // Bodies of different levels meet in the coarser level's lookup below (here only
           // through a collision of keys).

@@ -93,6 +93,7 @@ class HashGrid {
   std::vector<std::vector<Entry>> thread_entries_, thread_scratch_;
   std::vector<std::vector<BodyPair>> thread_pairs_;
   std::vector<Entry> moving_entries_, resting_entries_, merge_buffer_;
+  std::vector<Aabb> entry_bounds_;  // by moving entry: its body's box
   std::vector<BodyPair> pair_buffer_;
   std::vector<std::int8_t> level_;  // by slot
   std::vector<double> sizes_;
