@@ -336,7 +336,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
                                          std::tuple{row.b, anchors.rb, force_on_b}}) {
       if (body == kWorldAnchor || index_->node_of_body[body] == kNone) continue;
       TreeBody& body_node = tree_bodies_[index_->node_of_body[body]];
-      body_node.linear_stiffness += linear;
+      if (joint.kind == JointKind::kDistance) body_node.linear_stiffness += linear;
       const double arm = r.norm();
       if (arm > body_node.longest_lever.norm()) body_node.longest_lever = r;
       // Only the pull along the lever turns the body back into line (a chain's tension); a force
@@ -377,10 +377,14 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     stiffness *= rho > resolved ? 1 - resolved / rho : 0.0;
     any = any || rho > resolved;
   };
+  // A stiffness of nothing keeps nothing (its margin is the mass itself), without the test: most
+  // bodies have no rod and many no pull (building their masses cost a tenth of the pass).
   for (TreeBody& node : tree_bodies_) {
     const SolverBody& body = bodies[node.index];
-    keep_excess(node.linear_stiffness, Mat3(Mat3::Identity() / body.inverse_mass),
-                [&] { return Mat3(body.inverse_mass * Mat3::Identity()); });
+    if (!node.linear_stiffness.isZero(0))
+      keep_excess(node.linear_stiffness, Mat3(Mat3::Identity() / body.inverse_mass),
+                  [&] { return Mat3(body.inverse_mass * Mat3::Identity()); });
+    if (node.angular_stiffness.isZero(0)) continue;
     // A turn moves the anchors, and the joints move the body with them: against its longest
     // lever r the turn's inertia is at least I + m (|r|^2 - r r^T) (a pendulum's bob turns about
     // its pivot, not its centre).
