@@ -91,7 +91,8 @@ class HashGrid {
   void update_resting(const BroadPhaseInput& input);
 
   std::vector<std::vector<Entry>> thread_entries_, thread_scratch_;
-  std::vector<std::vector<BodyPair>> thread_pairs_;
+  std::vector<std::vector<BodyPair>> thread_pairs_, thread_spare_;
+  std::vector<std::vector<std::uint32_t>> thread_counts_;
   std::vector<Entry> moving_entries_, resting_entries_, merge_buffer_;
   std::vector<Aabb> entry_bounds_;  // by moving entry: its body's box
   std::vector<BodyPair> pair_buffer_;
