@@ -41,7 +41,8 @@ double solve_bound(JointBodies& j, const AxialRow& row, double mass, double gap,
   const double total = std::max(*impulse + step, 0.0);
   const double applied = total - *impulse;
   *impulse = total;
-  apply_row(j, row, applied);
+  // A bound far from its stop (most of them, most sweeps) applies nothing.
+  if (applied != 0) apply_row(j, row, applied);
   return std::abs(applied) * mass;
 }
 
