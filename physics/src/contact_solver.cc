@@ -363,6 +363,9 @@ struct PairVelocities {
 
 TUMBLE_INLINE double solve_friction(ContactRow& row, PairVelocities& pair) {
   if (row.friction <= 0) return 0;
+  // A point that carries no load and held no friction has none to give (a speculative point
+  // short of touching): the cone clamps it to nothing.
+  if (row.normal_impulse == 0 && row.tangent_impulse1 == 0 && row.tangent_impulse2 == 0) return 0;
   const Vec3 dv = pair.vb - pair.va;
   const double v1 =
       row.tangent1.dot(dv) + pair.wb.dot(row.rb_cross_t1) - pair.wa.dot(row.ra_cross_t1);
