@@ -296,21 +296,19 @@ namespace {
 // order (two std::sorts were two thirds of a small world's broad phase).
 void count_sort_pairs(std::vector<BodyPair>* pairs, std::size_t slots, std::vector<BodyPair>* spare,
                       std::vector<std::uint32_t>* counts) {
+  // One stable pass: `from` into `to` in the order of the body key(p) picks.
+  const auto pass = [&](const std::vector<BodyPair>& from, std::vector<BodyPair>& to, auto key) {
+    counts->assign(slots + 1, 0);
+    for (const BodyPair& p : from)
+      ++(*counts)[key(p) + 1];
+    for (std::size_t k = 1; k <= slots; ++k)
+      (*counts)[k] += (*counts)[k - 1];
+    for (const BodyPair& p : from)
+      to[(*counts)[key(p)]++] = p;
+  };
   spare->resize(pairs->size());
-  counts->assign(slots + 1, 0);
-  for (const BodyPair& p : *pairs)
-    ++(*counts)[p.b + 1];
-  for (std::size_t k = 1; k <= slots; ++k)
-    (*counts)[k] += (*counts)[k - 1];
-  for (const BodyPair& p : *pairs)
-    (*spare)[(*counts)[p.b]++] = p;
-  counts->assign(slots + 1, 0);
-  for (const BodyPair& p : *spare)
-    ++(*counts)[p.a + 1];
-  for (std::size_t k = 1; k <= slots; ++k)
-    (*counts)[k] += (*counts)[k - 1];
-  for (const BodyPair& p : *spare)
-    (*pairs)[(*counts)[p.a]++] = p;
+  pass(*pairs, *spare, [](const BodyPair& p) { return p.b; });
+  pass(*spare, *pairs, [](const BodyPair& p) { return p.a; });
 }
 
 }  // namespace
@@ -557,10 +555,6 @@ void SweepAndPrune::sort_order() {
   }
 }
 
-void SweepAndPrune::order_pairs(std::vector<BodyPair>* pairs, std::size_t slots) {
-  count_sort_pairs(pairs, slots, &spare_, &counts_);
-}
-
 bool SweepAndPrune::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* pairs) {
   pairs->clear();
   const std::size_t max_pairs = input.max_pairs;
@@ -608,7 +602,7 @@ bool SweepAndPrune::find_pairs(const BroadPhaseInput& input, std::vector<BodyPai
   // Each pair was emitted once (a body is in order_ or unbounded_, and the sweep meets each
   // overlapping pair from its first body along x), unless a cut compacted the list meanwhile.
   if (cut) return keep_first_pairs(pairs, max_pairs) || cut;
-  order_pairs(pairs, slots);
+  count_sort_pairs(pairs, slots, &spare_, &counts_);
   if (pairs->size() <= max_pairs) return false;
   pairs->resize(max_pairs);
   return true;

@@ -135,8 +135,6 @@ class SweepAndPrune {
   // Sorts order_ (the last call's order, then the bodies new to it), insertion first; past a
   // budget of moves in proportion to the bodies (a shuffled scene), a comparison sort.
   void sort_order();
-  // Puts `pairs` in (a, b) order: counting by b, then stably by a (slots below `slots`).
-  void order_pairs(std::vector<BodyPair>* pairs, std::size_t slots);
 
   std::vector<Entry> order_;
   std::vector<std::uint32_t> unbounded_;
