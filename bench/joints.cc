@@ -3,20 +3,24 @@
 // joints come apart (the largest gap between a link's end and the next link's, or the pivot, over
 // every step, read from the bodies' poses the same way for every engine) and the median step time;
 // then the standard chain:100 (released level, swinging clear of the ground) and the pile of eight
-// ragdolls (awake, without their joints' friction) for step time alone.
-// Ours with the direct solve of joint trees (auto, with the default four substeps and with one)
-// and with Gauss-Seidel joints (soft, pgs); Bullet 3.24
-// float and double, btPoint2PointConstraint, 10 sequential-impulse iterations, and Bullet's
-// btMultiBody (float, generalised coordinates; trees from the world alone). ODE and MuJoCo join
-// in the report's joints section (make report). Usage: bench_joints [seconds] (default 20).
+// ragdolls (awake, without their joints' friction): the largest distance between a joint's two
+// anchors (report::JointGaps) over the run and its mean over the steps, beside the step time, and
+// for the ragdolls Bullet again with 20, 50 and 100 iterations: what its error does with our time
+// and more. Ours with the direct solve of joint trees (auto, with the default four substeps and
+// with one) and with Gauss-Seidel joints (soft, pgs); Bullet 3.24 float and double (its constraint
+// of each joint's kind, 10 sequential-impulse iterations) and Bullet's btMultiBody (float,
+// generalised coordinates; trees from the world alone). ODE and MuJoCo join in the report's joints
+// section (make report). Usage: bench_joints [seconds] (default 20).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
 #include "peers/simulation.h"
+#include "report/joint_gaps.h"
 #include "scenes/standard.h"
 
 namespace tumble::bench {
@@ -48,6 +52,8 @@ double largest_gap(const Simulation& sim) {
 
 struct Run {
   double gap = 0, median_ms = 0;
+  double gap_sum = 0;  // of each step's gap, for their mean
+  int steps = 0;
   bool ran = false;
   std::string why_not;
 };
@@ -61,7 +67,10 @@ Run run(Simulation* sim, int steps, Measure measure) {
     if (!sim->step()) break;
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                      .count());
-    r.gap = std::max(r.gap, measure(*sim));
+    const double gap = measure(*sim);
+    r.gap = std::max(r.gap, gap);
+    r.gap_sum += gap;
+    ++r.steps;
   }
   std::sort(ms.begin(), ms.end());
   r.median_ms = ms.empty() ? 0 : ms[ms.size() / 2];
@@ -91,8 +100,9 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
     std::string why;
     auto sim = make_tumble(scene, &why);
     const Run r = sim ? run(sim.get(), steps, measure) : Run{};
-    std::printf("  %-8s %-24s gap %11.3e m  median %8.4f ms%s\n", label, ours.label, r.gap,
-                r.median_ms, sim ? "" : (" -- " + why).c_str());
+    std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms%s\n", label, ours.label,
+                r.gap, r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms,
+                sim ? "" : (" -- " + why).c_str());
   }
   const SceneDef scene = make_scene(SolverKind::kSoft);
   const PeerScene peer = peer_scene(scene);
@@ -108,7 +118,32 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
       continue;
     }
     const Run r = run(sim.get(), steps, measure);
-    std::printf("  %-8s %-24s gap %11.3e m  median %8.4f ms\n", label, name, r.gap, r.median_ms);
+    std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms\n", label, name, r.gap,
+                r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms);
+  }
+}
+
+// Bullet float on `scene` with more sequential-impulse iterations than its default ten: how far
+// its error falls as it is given our time and more.
+template <class Measure>
+void bullet_iterations(const SceneDef& scene, std::initializer_list<int> counts, int steps,
+                       Measure measure, const char* label) {
+  const PeerScene peer = peer_scene(scene);
+  for (const int iterations : counts) {
+    PeerOptions options;
+    options.sleeping = false;
+    options.iterations = iterations;
+    std::string why;
+    auto sim = make_bullet(peer, options, &why);
+    char name[64];
+    std::snprintf(name, sizeof name, "Bullet float, %d iter.", iterations);
+    if (!sim) {
+      std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
+      continue;
+    }
+    const Run r = run(sim.get(), steps, measure);
+    std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms\n", label, name, r.gap,
+                r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms);
   }
 }
 
@@ -127,7 +162,9 @@ int main(int argc, char** argv) {
     each_engine([&](SolverKind solver) { return heavy_chain(ratio, solver); }, steps, largest_gap,
                 label);
   }
-  std::printf("chain:100 (standard scene, released level), %g s: step time\n", seconds);
+  const report::JointGaps chain_gaps(chain_scene(100));
+  std::printf("chain:100 (standard scene, released level), %g s: joints' anchor gap, step time\n",
+              seconds);
   each_engine(
       [&](SolverKind solver) {
         SceneDef scene = chain_scene(100);
@@ -135,19 +172,24 @@ int main(int argc, char** argv) {
         scene.world.threads = 1;
         return scene;
       },
-      steps, [](const Simulation&) { return 0.0; }, "chain100");
+      steps, [&](const Simulation& sim) { return chain_gaps.largest(sim); }, "chain100");
   // The ragdoll pile awake, without its joints' friction (no peer adapter maps it).
-  std::printf("ragdolls:8 (standard scene, awake, no joint friction), %g s: step time\n", seconds);
-  each_engine(
-      [&](SolverKind solver) {
-        SceneDef scene = ragdolls_scene(8);
-        scene.world.solver.kind = solver;
-        scene.world.solver.sleeping = false;
-        scene.world.threads = 1;
-        for (SceneJoint& joint : scene.joints)
-          joint.def.friction = 0;
-        return scene;
-      },
-      steps, [](const Simulation&) { return 0.0; }, "ragdoll8");
+  const report::JointGaps ragdoll_gaps(ragdolls_scene(8));
+  std::printf(
+      "ragdolls:8 (standard scene, awake, no joint friction), %g s: joints' anchor gap, step "
+      "time\n",
+      seconds);
+  const auto ragdolls = [&](SolverKind solver) {
+    SceneDef scene = ragdolls_scene(8);
+    scene.world.solver.kind = solver;
+    scene.world.solver.sleeping = false;
+    scene.world.threads = 1;
+    for (SceneJoint& joint : scene.joints)
+      joint.def.friction = 0;
+    return scene;
+  };
+  const auto ragdoll_gap = [&](const Simulation& sim) { return ragdoll_gaps.largest(sim); };
+  each_engine(ragdolls, steps, ragdoll_gap, "ragdoll8");
+  bullet_iterations(ragdolls(SolverKind::kSoft), {20, 50, 100}, steps, ragdoll_gap, "ragdoll8");
   return 0;
 }

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <deque>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "peers/simulation.h"
@@ -39,8 +40,10 @@ class BulletSimulation final : public Simulation {
         world_(&dispatcher_, &broadphase_, &solver_, &configuration_),
         dt_(scene.dt) {
     engine_ = kEngine;
-    settings_ = std::string("sequential impulse, 10 iterations, split impulse, sleeping ") +
-                (options.sleeping ? "on" : "off") + (options.ccd ? ", swept-sphere CCD" : "");
+    if (options.iterations > 0) world_.getSolverInfo().m_numIterations = options.iterations;
+    settings_ = "sequential impulse, " + std::to_string(world_.getSolverInfo().m_numIterations) +
+                " iterations, split impulse, sleeping " + (options.sleeping ? "on" : "off") +
+                (options.ccd ? ", swept-sphere CCD" : "");
     world_.setGravity(to_bt(scene.world.gravity));
   }
 

@@ -62,6 +62,9 @@ struct PeerOptions {
   // ODE: dWorldStep (its direct, pivoting LCP solver: cubic in a island's rows) instead of
   // dWorldQuickStep; offered on scenes with joints only, where it is ODE's accurate choice.
   bool ode_world_step = false;
+  // Bullet: sequential-impulse iterations a step (0: Bullet's default, 10), to see how its error
+  // falls as it is given more time.
+  int iterations = 0;
 };
 
 // Ours, with the scene's world settings (solver, threads, sleeping) as they are.

@@ -1,6 +1,7 @@
 // The joints' stability scenarios: a chain's end made heavier, a chain made longer, a motor
 // driven faster, a heavy slider driven into its stop faster, and Newton's cradle with more balls;
 // each until an engine fails.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -266,15 +267,28 @@ std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
     scene.world.solver.sleeping = false;
     for (SceneJoint& joint : scene.joints)
       joint.def.friction = 0;
+    const JointGaps gaps(scene);
     for (const Engine& engine : engines) {
       bench::PeerOptions peer_options;
       peer_options.sleeping = false;
+      // The cost's error beside it (outside the timed steps): an iterative solver's chain is
+      // cheap where it has come apart.
+      double worst = 0, sum = 0;
       const RunOutcome outcome = run_scene(
-          engine, scene, peer_options, [](const bench::Simulation&, double, bool) { return true; },
+          engine, scene, peer_options,
+          [&](const bench::Simulation& sim, double, bool) {
+            const double gap = gaps.largest(sim);
+            worst = std::max(worst, gap);
+            sum += gap;
+            return true;
+          },
           options.time_limit);
-      CostRow row{spec, engine.label, outcome.settings, 0, outcome.why_not};
-      if (outcome.steps > 0 && outcome.why_not.empty())
+      CostRow row{spec, engine.label, outcome.settings, 0, 0, 0, outcome.why_not};
+      if (outcome.steps > 0 && outcome.why_not.empty()) {
         row.ms_per_step = 1e3 * outcome.step_seconds / static_cast<double>(outcome.steps);
+        row.worst_gap = worst;
+        row.mean_gap = sum / static_cast<double>(outcome.steps);
+      }
       rows.push_back(row);
       if (options.progress)
         options.progress(std::string("cost ") + spec + ", " + engine.label, rows.size(), total);

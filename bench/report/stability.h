@@ -40,6 +40,9 @@ std::vector<ScenarioInfo> stability_scenarios(bool quick);
 struct CostRow {
   std::string scene, engine, settings;
   double ms_per_step = 0;
+  // How far the joints came apart (JointGaps: the largest distance between a joint's two anchors),
+  // m: the largest over the run, and each step's largest averaged over the steps.
+  double worst_gap = 0, mean_gap = 0;
   std::string note;
 };
 std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
