@@ -78,6 +78,15 @@ Run run(Simulation* sim, int steps, Measure measure) {
   return r;
 }
 
+// One line of the table: a run's gaps and median step, and where the engine stopped early (it
+// reported that it cannot go on), after how many steps: its gap covers those alone.
+void print_run(const char* label, const char* name, const Run& r, int steps) {
+  std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms", label, name, r.gap,
+              r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms);
+  if (r.steps < steps) std::printf("  -- stopped after %d of %d steps", r.steps, steps);
+  std::printf("\n");
+}
+
 // Ours as configured: the solver, and the substeps (0: the settings' default).
 struct Ours {
   const char* label;
@@ -99,10 +108,11 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
     if (ours.substeps > 0) scene.world.solver.substeps = ours.substeps;
     std::string why;
     auto sim = make_tumble(scene, &why);
-    const Run r = sim ? run(sim.get(), steps, measure) : Run{};
-    std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms%s\n", label, ours.label,
-                r.gap, r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms,
-                sim ? "" : (" -- " + why).c_str());
+    if (!sim) {
+      std::printf("  %-8s %-24s not run: %s\n", label, ours.label, why.c_str());
+      continue;
+    }
+    print_run(label, ours.label, run(sim.get(), steps, measure), steps);
   }
   const SceneDef scene = make_scene(SolverKind::kSoft);
   const PeerScene peer = peer_scene(scene);
@@ -117,9 +127,7 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
       std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
       continue;
     }
-    const Run r = run(sim.get(), steps, measure);
-    std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms\n", label, name, r.gap,
-                r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms);
+    print_run(label, name, run(sim.get(), steps, measure), steps);
   }
 }
 
@@ -141,9 +149,7 @@ void bullet_iterations(const SceneDef& scene, std::initializer_list<int> counts,
       std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
       continue;
     }
-    const Run r = run(sim.get(), steps, measure);
-    std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms\n", label, name, r.gap,
-                r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms);
+    print_run(label, name, run(sim.get(), steps, measure), steps);
   }
 }
 
