@@ -25,6 +25,7 @@ struct Run {
   int through = 0;
   double fastest = 0;
   bool ran = false;
+  bool stopped = false;  // the engine reported that it cannot go on: ms holds the steps it took
   std::string why_not;
 };
 
@@ -33,7 +34,10 @@ Run run(Simulation* sim, int steps) {
   std::vector<std::uint8_t> under(sim->body_count(), 0);
   for (int k = 0; k < steps; ++k) {
     const auto start = std::chrono::steady_clock::now();
-    if (!sim->step()) break;
+    if (!sim->step()) {
+      r.stopped = true;
+      break;
+    }
     r.ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
             .count());
@@ -109,8 +113,9 @@ int main(int argc, char** argv) {
     const double m = median(e.ms);
     std::printf(
         "  %-36s median %8.3f ms/step  (ours / this %.2f)  through %d  fastest at the "
-        "end %.3g m/s\n",
-        e.label, m, m > 0 ? ours / m : 0.0, e.last.through, e.last.fastest);
+        "end %.3g m/s%s\n",
+        e.label, m, m > 0 ? ours / m : 0.0, e.last.through, e.last.fastest,
+        e.last.stopped ? "  (stopped early: the median of the steps taken)" : "");
   }
   return 0;
 }

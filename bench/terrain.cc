@@ -55,6 +55,8 @@ struct Run {
   double settled = 0;      // m: the deepest any vertex lies under it after the last step
   double fastest = 0;      // m/s: the fastest box at the end
   std::size_t points = 0;  // contact points in the last step
+  // Where the engine reported that it cannot go on: the steps it took (the times are theirs).
+  int stopped_after = -1;
 };
 
 // How far below the ground (the plane z = 0, or the hills at the ground's pose) a point lies.
@@ -107,13 +109,18 @@ Run timed_run(const SceneDef& scene, const HeightField& hills, std::size_t boxes
   std::vector<std::uint8_t> through(boxes, 0), dipped(boxes, 0);
   Run out;
   double seconds = 0, first_seconds = 0;
-  for (int k = 0; k < steps; ++k) {
+  int taken = 0;
+  for (; taken < steps; ++taken) {
     const auto start = std::chrono::steady_clock::now();
-    if (!step()) break;
+    if (!step()) {
+      out.stopped_after = taken;
+      break;
+    }
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (k + 1 == first_steps) first_seconds = seconds;
+    if (taken + 1 == first_steps) first_seconds = seconds;
     sample_depths(field, ground_pose, boxes, box_at, &through, &dipped, &out.deepest);
   }
+  if (taken < first_steps) first_seconds = seconds;
   std::vector<std::uint8_t> unused_through(boxes, 0), unused_dipped(boxes, 0);
   sample_depths(field, ground_pose, boxes, box_at, &unused_through, &unused_dipped, &out.settled);
   for (std::size_t k = 0; k < boxes; ++k) {
@@ -121,8 +128,8 @@ Run timed_run(const SceneDef& scene, const HeightField& hills, std::size_t boxes
     out.dipped += dipped[k];
     out.fastest = std::max(out.fastest, speed_of(k));
   }
-  out.ms_per_step = 1e3 * seconds / steps;
-  out.first_ms_per_step = 1e3 * first_seconds / first_steps;
+  out.ms_per_step = taken > 0 ? 1e3 * seconds / taken : 0.0;
+  out.first_ms_per_step = taken > 0 ? 1e3 * first_seconds / std::min(taken, first_steps) : 0.0;
   return out;
 }
 
@@ -135,11 +142,7 @@ Run run(SceneDef scene, int threads, const HeightField& hills) {
     if (id.is_valid() && !world.body(id).is_static()) ids.push_back(id);
   }
   Run out = timed_run(
-      scene, hills, ids.size(),
-      [&] {
-        (void)world.step(scene.dt);
-        return true;
-      },
+      scene, hills, ids.size(), [&] { return world.step(scene.dt).is_ok(); },
       [&](std::size_t k) {
         const BodyView body = world.body(ids[k]);
         return BoxPose{body.position(), body.orientation(), body.shape().half_extents()};
@@ -172,6 +175,11 @@ Run run_bullet(const SceneDef& scene, const HeightField& hills) {
       [&](std::size_t k) { return sim->body(k).linear_velocity.norm(); });
 }
 #endif
+
+std::string stop_note(const Run& r) {
+  return r.stopped_after < 0 ? ""
+                             : "  (stopped after " + std::to_string(r.stopped_after) + " steps)";
+}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -228,9 +236,9 @@ int main(int argc, char** argv) {
       const Run r = run(scenes[k], threads, hills);
       times[k].push_back(r.ms_per_step);
       first[k].push_back(r.first_ms_per_step);
-      std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f  %6zu\n", round,
+      std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f  %6zu%s\n", round,
                   names[k].c_str(), r.ms_per_step, r.first_ms_per_step, r.through, r.dipped,
-                  r.deepest, r.settled, r.fastest, r.points);
+                  r.deepest, r.settled, r.fastest, r.points, stop_note(r).c_str());
     }
 #ifdef TUMBLE_HAVE_PEERS
     // Bullet steps on one thread: beside ours on one alone.
@@ -238,9 +246,9 @@ int main(int argc, char** argv) {
       const Run r = run_bullet(scenes[k], hills);
       bullet_times[k].push_back(r.ms_per_step);
       bullet_first[k].push_back(r.first_ms_per_step);
-      std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f       -\n", round,
+      std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f       -%s\n", round,
                   ("Bullet " + names[k]).c_str(), r.ms_per_step, r.first_ms_per_step, r.through,
-                  r.dipped, r.deepest, r.settled, r.fastest);
+                  r.dipped, r.deepest, r.settled, r.fastest, stop_note(r).c_str());
     }
 #endif
   }
