@@ -8,39 +8,63 @@
 namespace tumble {
 namespace {
 
-// Solves I (w1 - w0) + h wm x (I wm) = 0 with wm = (w0 + w1) / 2, body axes.
+// Solves I (w1 - w0) + h wm x (I wm) = 0 with wm = (w0 + w1) / 2, body axes. Written out in
+// scalars, each the sum Eigen forms in the same order: Eigen takes a 3-vector as a pair and a
+// single, and a pair loaded from two singles just stored waits for them to retire (store
+// forwarding fails across stores): a fifth of the integration's time in a pile of ragdolls.
 bool gyroscopic_midpoint(const Mat3& inertia, const Vec3& w0, double h, Vec3* w1) {
-  Vec3 w = w0;
+  const double i00 = inertia(0, 0), i01 = inertia(0, 1), i02 = inertia(0, 2);
+  const double i10 = inertia(1, 0), i11 = inertia(1, 1), i12 = inertia(1, 2);
+  const double i20 = inertia(2, 0), i21 = inertia(2, 1), i22 = inertia(2, 2);
+  const double x0 = w0.x(), y0 = w0.y(), z0 = w0.z();
+  double x = x0, y = y0, z = z0;
   const double tolerance = 1e-13 * (w0.norm() + 1e-300);
+  const double half_h = 0.5 * h;
   for (int iteration = 0; iteration < kGyroscopicIterations; ++iteration) {
-    const Vec3 mid = 0.5 * (w0 + w);
-    const Vec3 momentum = inertia * mid;
-    const Vec3 f = inertia * (w - w0) + h * mid.cross(momentum);
+    const double mx = 0.5 * (x0 + x), my = 0.5 * (y0 + y), mz = 0.5 * (z0 + z);
+    // The momentum I wm, and f = I (w - w0) + h wm x (I wm).
+    const double px = i00 * mx + i01 * my + i02 * mz;
+    const double py = i10 * mx + i11 * my + i12 * mz;
+    const double pz = i20 * mx + i21 * my + i22 * mz;
+    const double dx = x - x0, dy = y - y0, dz = z - z0;
+    const double fx = (i00 * dx + i01 * dy + i02 * dz) + h * (my * pz - mz * py);
+    const double fy = (i10 * dx + i11 * dy + i12 * dz) + h * (mz * px - mx * pz);
+    const double fz = (i20 * dx + i21 * dy + i22 * dz) + h * (mx * py - my * px);
     // The Jacobian I + h/2 ([wm]x I - [I wm]x), column by column: column j is I's plus h/2 of
-    // wm x (I e_j) - (I wm) x e_j. (Built as 3 x 3 products its temporaries went through memory
-    // in pieces the loads could not forward: a tenth of a ragdoll pile's integration.)
-    const double half_h = 0.5 * h;
-    const Vec3 c0 = inertia.col(0) +
-                    half_h * (mid.cross(inertia.col(0)) - Vec3(0, momentum.z(), -momentum.y()));
-    const Vec3 c1 = inertia.col(1) +
-                    half_h * (mid.cross(inertia.col(1)) - Vec3(-momentum.z(), 0, momentum.x()));
-    const Vec3 c2 = inertia.col(2) +
-                    half_h * (mid.cross(inertia.col(2)) - Vec3(momentum.y(), -momentum.x(), 0));
+    // wm x (I e_j) - (I wm) x e_j.
+    const double c0x = i00 + half_h * (my * i20 - mz * i10);
+    const double c0y = i10 + half_h * ((mz * i00 - mx * i20) - pz);
+    const double c0z = i20 + half_h * ((mx * i10 - my * i00) - -py);
+    const double c1x = i01 + half_h * ((my * i21 - mz * i11) - -pz);
+    const double c1y = i11 + half_h * (mz * i01 - mx * i21);
+    const double c1z = i21 + half_h * ((mx * i11 - my * i01) - px);
+    const double c2x = i02 + half_h * ((my * i22 - mz * i12) - py);
+    const double c2y = i12 + half_h * ((mz * i02 - mx * i22) - -px);
+    const double c2z = i22 + half_h * (mx * i12 - my * i02);
     // Cramer's rule through the columns' cross products: the rows of the inverse times the
     // determinant. The matrix is the inertia plus a small turn, far from singular, and an inexact
     // solve would only slow Newton, which stops on the step f gives; Eigen's pivoted LU was 40% of
     // the integration's instructions in a pile of ragdolls.
-    const Vec3 r0 = c1.cross(c2), r1 = c2.cross(c0), r2 = c0.cross(c1);
-    const double determinant = c0.dot(r0);
+    const double r0x = c1y * c2z - c1z * c2y, r0y = c1z * c2x - c1x * c2z,
+                 r0z = c1x * c2y - c1y * c2x;
+    const double r1x = c2y * c0z - c2z * c0y, r1y = c2z * c0x - c2x * c0z,
+                 r1z = c2x * c0y - c2y * c0x;
+    const double r2x = c0y * c1z - c0z * c1y, r2y = c0z * c1x - c0x * c1z,
+                 r2z = c0x * c1y - c0y * c1x;
+    const double determinant = c0x * r0x + c0y * r0y + c0z * r0z;
     if (!(std::abs(determinant) > 0)) break;
-    const Vec3 step = Vec3(r0.dot(f), r1.dot(f), r2.dot(f)) / determinant;
-    w -= step;
-    if (step.norm() <= tolerance) {
-      *w1 = w;
+    const double sx = (r0x * fx + r0y * fy + r0z * fz) / determinant;
+    const double sy = (r1x * fx + r1y * fy + r1z * fz) / determinant;
+    const double sz = (r2x * fx + r2y * fy + r2z * fz) / determinant;
+    x -= sx;
+    y -= sy;
+    z -= sz;
+    if (std::sqrt(sx * sx + sy * sy + sz * sz) <= tolerance) {
+      *w1 = Vec3(x, y, z);
       return true;
     }
   }
-  *w1 = w;
+  *w1 = Vec3(x, y, z);
   return false;
 }
 
