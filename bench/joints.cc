@@ -5,12 +5,12 @@
 // then the standard chain:100 (released level, swinging clear of the ground) and the pile of eight
 // ragdolls (awake, without their joints' friction): the largest distance between a joint's two
 // anchors (report::JointGaps) over the run and its mean over the steps, beside the step time, and
-// for the ragdolls Bullet again with 20, 50 and 100 iterations: what its error does with our time
-// and more. Ours with the direct solve of joint trees (auto, with the default four substeps and
-// with one) and with Gauss-Seidel joints (soft, pgs); Bullet 3.24 float and double (its constraint
-// of each joint's kind, 10 sequential-impulse iterations) and Bullet's btMultiBody (float,
-// generalised coordinates; trees from the world alone). ODE and MuJoCo join in the report's joints
-// section (make report). Usage: bench_joints [seconds] (default 20).
+// Bullet again with 20, 50 and 100 iterations: what its error does with our time and more. Ours
+// with the direct solve of joint trees (auto, with the default four substeps and with one) and with
+// Gauss-Seidel joints (soft, pgs); Bullet 3.24 float and double (its constraint of each joint's
+// kind, 10 sequential-impulse iterations) and Bullet's btMultiBody (float, generalised coordinates;
+// trees from the world alone). ODE and MuJoCo join in the report's joints section (make report).
+// Usage: bench_joints [seconds] (default 20).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -27,27 +27,12 @@ namespace tumble::bench {
 namespace {
 
 constexpr int kLinks = 20;
-constexpr double kLink = 0.2;
 
 SceneDef heavy_chain(double ratio, SolverKind solver) {
   SceneDef scene = hanging_chain_scene(kLinks, ratio);
   scene.world.solver.kind = solver;
   scene.world.threads = 1;
   return scene;
-}
-const Vec3 kPivot = hanging_chain_scene(kLinks).joints[0].def.anchor;
-
-// The largest gap at any joint now: each link's ends from its pose.
-double largest_gap(const Simulation& sim) {
-  double largest = 0;
-  Vec3 above = kPivot;
-  for (std::size_t i = 0; i < sim.body_count(); ++i) {
-    const BodyState s = sim.body(i);
-    const Vec3 half = s.orientation * Vec3(0, 0, kLink / 2);
-    largest = std::max(largest, (s.position + half - above).norm());
-    above = s.position - half;
-  }
-  return largest;
 }
 
 struct Run {
@@ -162,23 +147,27 @@ int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::atof(argv[1]) : 20;
   const int steps = static_cast<int>(seconds * 60);
   std::printf("heavy chain: 20 links hanging, end R times heavier, kicked 1 m/s, %g s\n", seconds);
+  // Every ratio's chain has the same joints (a link's ends, the pivot).
+  const report::JointGaps heavy_chain_gaps(hanging_chain_scene(kLinks));
+  const auto heavy_chain_gap = [&](const Simulation& sim) { return heavy_chain_gaps.largest(sim); };
   for (double ratio : {1.0, 10.0, 100.0, 1000.0}) {
     char label[32];
     std::snprintf(label, sizeof label, "1:%g", ratio);
-    each_engine([&](SolverKind solver) { return heavy_chain(ratio, solver); }, steps, largest_gap,
-                label);
+    each_engine([&](SolverKind solver) { return heavy_chain(ratio, solver); }, steps,
+                heavy_chain_gap, label);
   }
   const report::JointGaps chain_gaps(chain_scene(100));
   std::printf("chain:100 (standard scene, released level), %g s: joints' anchor gap, step time\n",
               seconds);
-  each_engine(
-      [&](SolverKind solver) {
-        SceneDef scene = chain_scene(100);
-        scene.world.solver.kind = solver;
-        scene.world.threads = 1;
-        return scene;
-      },
-      steps, [&](const Simulation& sim) { return chain_gaps.largest(sim); }, "chain100");
+  const auto chain = [&](SolverKind solver) {
+    SceneDef scene = chain_scene(100);
+    scene.world.solver.kind = solver;
+    scene.world.threads = 1;
+    return scene;
+  };
+  const auto chain_gap = [&](const Simulation& sim) { return chain_gaps.largest(sim); };
+  each_engine(chain, steps, chain_gap, "chain100");
+  bullet_iterations(chain(SolverKind::kSoft), {20, 50, 100}, steps, chain_gap, "chain100");
   // The ragdoll pile awake, without its joints' friction (no peer adapter maps it).
   const report::JointGaps ragdoll_gaps(ragdolls_scene(8));
   std::printf(
