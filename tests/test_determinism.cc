@@ -253,12 +253,14 @@ TEST(Determinism, RagdollHeapOnTheTeamSameBitsForAnyThreadCount) {
 // lying on the ground and on each other) with every solver, and the chain with a 1000 times
 // heavier end (the direct solve with the joints' geometric stiffness). Their joints' visits,
 // direct solves and position passes must give these bits whatever is reorganised beneath them.
+// (The direct solve's were re-pinned when a hinge's five rows were factored at a width of five
+// instead of padded to six: the same equations solved, with other rounding.)
 TEST(Determinism, PinnedJointSceneHashes) {
   const std::pair<SolverKind, std::uint64_t> ragdolls[] = {
-      {SolverKind::kAuto, 0x2b1a2d31ade10a9bull},
+      {SolverKind::kAuto, 0x2187c71f747c52d2ull},
       {SolverKind::kSoft, 0x0fb844c70108f3c2ull},
       {SolverKind::kPgs, 0xbe3f1fb0380100f6ull},
-      {SolverKind::kExact, 0x2b1a2d31ade10a9bull}};
+      {SolverKind::kExact, 0x2187c71f747c52d2ull}};
   for (const auto& [kind, pinned] : ragdolls) {
     SceneDef scene = ragdolls_scene(4);
     scene.world.solver.kind = kind;

@@ -21,20 +21,25 @@ bool moves(std::span<const SolverBody> bodies, std::uint32_t body) {
   return body != kWorldAnchor && bodies[body].inverse_mass > 0;
 }
 
-// The inverse of a symmetric definite 6x6 block (a body's, positive; a joint's, negative) by its
-// 3x3 blocks' Schur complement: fixed-size closed forms, several times faster than a general
-// factorisation of a small matrix. A singular block gives non-finite entries.
-Eigen::Matrix<double, 6, 6> inverse_of_definite(const Eigen::Matrix<double, 6, 6>& m) {
-  const Mat3 a_inverse = m.topLeftCorner<3, 3>().inverse();
-  const Mat3 b = m.topRightCorner<3, 3>();
-  const Mat3 a_inverse_b = a_inverse * b;
-  const Mat3 schur_inverse = (m.bottomRightCorner<3, 3>() - b.transpose() * a_inverse_b).inverse();
-  const Mat3 corner = -a_inverse_b * schur_inverse;
-  Eigen::Matrix<double, 6, 6> inverse;
-  inverse.topLeftCorner<3, 3>() = a_inverse - corner * a_inverse_b.transpose();
-  inverse.topRightCorner<3, 3>() = corner;
-  inverse.bottomLeftCorner<3, 3>() = corner.transpose();
-  inverse.bottomRightCorner<3, 3>() = schur_inverse;
+// The inverse of a symmetric definite N x N block (N = 5 or 6: a joint's rows) through its leading
+// 3 x 3 block and that block's Schur complement (N - 3 square): fixed-size closed forms, several
+// times faster than a general factorisation of a small matrix. A singular block gives non-finite
+// entries.
+template <int N>
+Eigen::Matrix<double, N, N> inverse_of_definite(const Eigen::Matrix<double, N, N>& m) {
+  constexpr int R = N - 3;
+  using Corner = Eigen::Matrix<double, 3, R>;
+  const Mat3 a_inverse = m.template topLeftCorner<3, 3>().inverse();
+  const Corner b = m.template topRightCorner<3, R>();
+  const Corner a_inverse_b = a_inverse * b;
+  const Eigen::Matrix<double, R, R> schur_inverse =
+      (m.template bottomRightCorner<R, R>() - b.transpose() * a_inverse_b).inverse();
+  const Corner corner = -a_inverse_b * schur_inverse;
+  Eigen::Matrix<double, N, N> inverse;
+  inverse.template topLeftCorner<3, 3>() = a_inverse - corner * a_inverse_b.transpose();
+  inverse.template topRightCorner<3, R>() = corner;
+  inverse.template bottomLeftCorner<R, 3>() = corner.transpose();
+  inverse.template bottomRightCorner<R, R>() = schur_inverse;
   return inverse;
 }
 
@@ -398,11 +403,13 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
 
 namespace {
 
-// Calls f.template operator()<W>() with the fixed width W (3 or 6) of a joint's rows.
+// Calls f.template operator()<W>() with the fixed width W (3, 5 or 6) of a joint's rows.
 template <class F>
 void with_width(int width, F&& f) {
   if (width == 3)
     f.template operator()<3>();
+  else if (width == 5)
+    f.template operator()<5>();
   else
     f.template operator()<6>();
 }
@@ -463,7 +470,7 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
   for (std::size_t k = 0; k < joints_.size(); ++k) {
     TreeJoint& joint = joints_[k];
     equations(k, &equations_[k]);
-    joint.width = equations_[k].rows <= 3 ? 3 : 6;
+    joint.width = equations_[k].rows <= 3 ? 3 : equations_[k].rows <= 5 ? 5 : 6;
     with_width(joint.width, [&]<int W>() {
       Eigen::Matrix<double, W, W> pivot = Eigen::Matrix<double, W, W>::Zero();
       for (const bool side_b : {false, true}) {
@@ -508,8 +515,11 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
     with_width(joint.width, [&]<int W>() {
       if constexpr (W == 3)
         joint.pivot.topLeftCorner<3, 3>() = Mat3(joint.pivot.topLeftCorner<3, 3>()).inverse();
+      else if constexpr (W == 5)
+        joint.pivot.topLeftCorner<5, 5>() =
+            inverse_of_definite<5>(Eigen::Matrix<double, 5, 5>(joint.pivot.topLeftCorner<5, 5>()));
       else
-        joint.pivot = inverse_of_definite(joint.pivot);
+        joint.pivot = inverse_of_definite<6>(joint.pivot);
     });
     if (joint.hub == kNone) continue;
     const Hub& hub = hubs_[joint.hub];
