@@ -137,8 +137,8 @@ class JointTree {
   };
   // A joint of the forest, in elimination order (children before parents). Its rows are padded
   // to a width of 3, 5 or 6 (a padded row: 1 on the diagonal, 0 elsewhere), so that every block
-  // has a fixed size: a ball's 3, a hinge's 5 (and a ball's with a bound of a position pass), a
-  // fixed joint's 6 (padding a hinge to 6 cost its factoring a tenth more instructions).
+  // has a fixed size: a ball's 3, a hinge's or slider's 5 (and a ball's with a bound of a position
+  // pass), a fixed joint's 6 (padding a hinge to 6 cost the tree a tenth more instructions).
   struct TreeJoint {
     std::uint32_t row = 0;                         // index into the rows
     std::uint32_t body_a = kNone, body_b = kNone;  // tree bodies; kNone: static or the world
