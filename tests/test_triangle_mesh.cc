@@ -475,7 +475,9 @@ TEST(TriangleMesh, ABoxMeetsEveryTriangleWhoseBoundsItMeets) {
         bounds.grow(v);
       const bool meets = (bounds.min.array() <= box.max.array()).all() &&
                          (box.min.array() <= bounds.max.array()).all();
-      if (meets) EXPECT_EQ(seen[t], 1) << k << " " << t;
+      if (meets) {
+        EXPECT_EQ(seen[t], 1) << k << " " << t;
+      }
     }
   }
 }
