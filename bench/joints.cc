@@ -39,8 +39,6 @@ struct Run {
   double gap = 0, median_ms = 0;
   double gap_sum = 0;  // of each step's gap, for their mean
   int steps = 0;
-  bool ran = false;
-  std::string why_not;
 };
 
 template <class Measure>
@@ -59,7 +57,6 @@ Run run(Simulation* sim, int steps, Measure measure) {
   }
   std::sort(ms.begin(), ms.end());
   r.median_ms = ms.empty() ? 0 : ms[ms.size() / 2];
-  r.ran = true;
   return r;
 }
 

@@ -601,7 +601,10 @@ bool SweepAndPrune::find_pairs(const BroadPhaseInput& input, std::vector<BodyPai
   }
   // Each pair was emitted once (a body is in order_ or unbounded_, and the sweep meets each
   // overlapping pair from its first body along x), unless a cut compacted the list meanwhile.
-  if (cut) return keep_first_pairs(pairs, max_pairs) || cut;
+  if (cut) {
+    keep_first_pairs(pairs, max_pairs);
+    return true;
+  }
   count_sort_pairs(pairs, slots, &spare_, &counts_);
   if (pairs->size() <= max_pairs) return false;
   pairs->resize(max_pairs);
