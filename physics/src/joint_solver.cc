@@ -600,7 +600,7 @@ namespace {
 // or not (the rows of the factoring their targets are solved with).
 template <class Out>
 void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses, bool choose,
-                       std::uint8_t* which) {
+                       std::uint8_t* which, double slack = 0) {
   const Joint& joint = row.joint;
   const bool world_b = row.b == kWorldAnchor;
   const Pose& pose_a = poses[row.a];
@@ -619,7 +619,7 @@ void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses,
   if (has_cone(joint) && (choose || (*which & kConeRow))) {
     const Swing swing = swing_of(joint, pose_a.orientation, pose_b.orientation);
     const double over = swing.exists ? swing.angle - joint.max_swing : 0.0;
-    if (!choose || (swing.exists && over > 0 && e.rows < 6)) {
+    if (!choose || (swing.exists && over > slack && e.rows < 6)) {
       add(swing.row, over);
       if (choose) *which |= kConeRow;
     }
@@ -632,7 +632,8 @@ void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses,
       past = c.position - joint.limit.lower;
     else if (c.exists && c.position > joint.limit.upper)
       past = c.position - joint.limit.upper;
-    if (!choose || (c.exists && (past != 0 || locked) && e.rows < 6)) {
+    const bool chosen = slack > 0 ? std::abs(past) > slack : past != 0 || locked;
+    if (!choose || (c.exists && chosen && e.rows < 6)) {
       add(c.row, past);
       if (choose) *which |= kLimitRow;
     }
@@ -642,10 +643,10 @@ void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses,
 }  // namespace
 
 void position_equations(JointEquations* e, const JointRow& row, std::span<const SolverBody> bodies,
-                        std::span<const Pose> poses, std::uint8_t* bounds) {
+                        std::span<const Pose> poses, std::uint8_t* bounds, double bound_slack) {
   clear_equations(e);
   equations_of(*e, row, bodies, poses, nullptr);
-  if (bounds != nullptr) append_bound_rows(*e, row, poses, true, bounds);
+  if (bounds != nullptr) append_bound_rows(*e, row, poses, true, bounds, bound_slack);
 }
 
 JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,

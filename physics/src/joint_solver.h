@@ -85,11 +85,12 @@ bool motor_row(const JointRow& row, const JointEquations& equations);
 // poses are past (or a locked limit) follow as rows of their own, held where they are met for the
 // pass, and *bounds says which (kConeRow, kLimitRow): a position pass of the direct solve then
 // corrects the bounds and the joint's own rows at once, where a separate pass of the bounds and
-// one of the rows each undid part of the other.
+// one of the rows each undid part of the other. With a `bound_slack` (m or rad), only those past
+// by more (a locked limit too).
 inline constexpr std::uint8_t kConeRow = 1, kLimitRow = 2;
 void position_equations(JointEquations* equations, const JointRow& row,
                         std::span<const SolverBody> bodies, std::span<const Pose> poses,
-                        std::uint8_t* bounds = nullptr);
+                        std::uint8_t* bounds = nullptr, double bound_slack = 0);
 // Their targets alone (position_equations' target), with the bound rows `bounds` (as
 // position_equations chose them for the factoring these targets are solved with).
 JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,

@@ -799,7 +799,7 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
 
 double JointTree::solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                                   std::span<Pose> poses, bool refactor, double velocity_substep,
-                                  bool bounds) {
+                                  bool bounds, double bound_slack) {
   if (joints_.empty()) return 0;
   // A move came before: the next sweeps take their targets afresh, and factor again unless this
   // pass or one before it since the move factored for them.
@@ -815,7 +815,7 @@ double JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solv
     factor(bodies, false, [&](std::size_t k, JointEquations* equations) {
       joints_[k].bounds = 0;
       position_equations(equations, rows[joints_[k].row], bodies, poses,
-                         bounds ? &joints_[k].bounds : nullptr);
+                         bounds ? &joints_[k].bounds : nullptr, bound_slack);
       bound_rows = bound_rows || joints_[k].bounds != 0;
     });
     // The velocity sweeps hold no bound as an equality: a factoring with bound rows is not theirs;

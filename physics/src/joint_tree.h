@@ -71,11 +71,13 @@ class JointTree {
   // velocity sweeps too, where no body takes stiffness for a substep of that length (their
   // systems are then the same: the same rows and masses; the passes after it move the bodies by a
   // millionth of this one's correction): settle_velocity_factors says after the last pass.
-  // Returns the largest error it corrected (its targets' largest, m or rad; infinity where the
-  // solve gave no finite answer and nothing moved): a Newton pass leaves about its square.
+  // With `bounds`, a refactoring pass holds the limits and cones the poses are past by more than
+  // `bound_slack` (position_equations). Returns the largest error it corrected (its targets'
+  // largest, m or rad; infinity where the solve gave no finite answer and nothing moved): a Newton
+  // pass leaves about its square.
   double solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                          std::span<Pose> poses, bool refactor, double velocity_substep = 0,
-                         bool bounds = true);
+                         bool bounds = true, double bound_slack = 0);
   // After a move's position passes: whether the factors of the pass given velocity_substep h serve
   // the velocity sweeps (no body takes stiffness at the poses the passes left). Where some body
   // does, and `keep_stiffness`, the stiffness worked out here is the next velocity factoring's

@@ -160,13 +160,21 @@ void team_integrate_positions(const IslandContext& c, double h, bool solo) {
 // corrections along one link a pass, which the next moves' passes carry on. Solved directly
 // (joint_tree.h), the first two passes are Newton steps and the last reuses the second's rows (on
 // a chain of 20 dropped from the horizontal: 7e-6 m at worst, 1.8e-7 m refactoring every pass,
-// for a fifth less time); the first also holds the limits and cones the poses are past (the later
-// ones' rows are the velocity sweeps' too, which hold no bound).
+// for a fifth less time); the first also holds the limits and cones the poses are past (the
+// second's rows are the velocity sweeps' too, which hold no bound).
 constexpr int kJointPositionPasses = 3;
 constexpr int kJointRefactoredPasses = 2;
 static_assert(kJointRefactoredPasses >= 1, "the first pass after a move refactors");
-// A Newton pass that corrected errors below this (m, or rad) left errors near their square over
-// the joints' lever arms: under 1e-16 for levers down to a centimetre, below the poses' rounding.
+// Where contacts act through the trees, the move has no curvature targets (SerialIsland::
+// tree_target) and opens each joint by its turn's curvature, ~w^2 r h^2: the first pass corrects
+// millimetres where it corrected micrometres, and what it leaves, the second's, is more than a
+// chord step on the second's rows takes out (a chain of 20 dropped from level at dt 1/30 opened
+// 2.7e-6 m that way, against 3.6e-8 m from a Newton step). So there the last pass is a Newton step
+// too where the second corrected more than kNewtonAfter, and it holds the bounds the poses are
+// past by more than kLaterBoundSlack (the first pass's larger corrections carried limbs past
+// bounds it did not hold: the ragdoll pile's worst 1.3e-2 rad, against 2.8e-3 so).
+constexpr double kNewtonAfter = 1e-5;      // m or rad
+constexpr double kLaterBoundSlack = 1e-6;  // m or rad
 constexpr double kSettledJointError = 1e-9;
 
 // advance_with's parts for one island on one thread (any island: exact, soft, pgs), or, for an
@@ -189,6 +197,11 @@ class SerialIsland {
     if (team_) c_.scratch.barrier.wait();
     if (report_->joint_tree && !c.joints.empty())
       trees_ = std::span(c.scratch.joint_trees).subspan(c.first_component, c.component_count);
+    // (The island's trees share the thread's index: the first holds any of their bodies.)
+    contacts_through_tree_ =
+        !trees_.empty() && std::any_of(c.rows.begin(), c.rows.end(), [&](std::uint32_t id) {
+          return trees_[0].holds(c.scratch.rows[id].a) || trees_[0].holds(c.scratch.rows[id].b);
+        });
     // Only the trees' own rows: their solve is exact, and a second sweep would find it so (unless
     // one holds stiffness: JointTree::stiffened).
     one_sweep_solves_ = !trees_.empty() && c.rows.empty() &&
@@ -263,10 +276,14 @@ class SerialIsland {
           // A pass after the refactored ones corrects what the last left, about the square of
           // what that one corrected: nothing where that was already below kSettledJointError.
           if (pass >= kJointRefactoredPasses && corrected < kSettledJointError) break;
+          const bool later_newton =
+              pass >= kJointRefactoredPasses && contacts_through_tree_ && corrected > kNewtonAfter;
+          const bool newton = pass < kJointRefactoredPasses || later_newton;
           // The last refactored pass factors the velocity sweeps' system too (joint_tree.h).
           corrected = trees_[component].solve_positions(
-              c_.scratch.joint_rows, bodies_, c_.scratch.poses, pass < kJointRefactoredPasses,
-              pass == kJointRefactoredPasses - 1 ? h : 0.0, pass == 0);
+              c_.scratch.joint_rows, bodies_, c_.scratch.poses, newton,
+              pass == kJointRefactoredPasses - 1 || later_newton ? h : 0.0,
+              pass == 0 || later_newton, later_newton ? kLaterBoundSlack : 0.0);
           continue;
         }
         for (std::uint32_t j : joints_of(component))
@@ -333,8 +350,9 @@ class SerialIsland {
                              : solve_joint(row, bodies_, c_.scratch.poses, target, terms));
         }
         if (direct)
-          change = std::max(change, trees_[component].solve_velocities(
-                                        c_.scratch.joint_rows, bodies_, c_.scratch.poses, target));
+          change = std::max(
+              change, trees_[component].solve_velocities(c_.scratch.joint_rows, bodies_,
+                                                         c_.scratch.poses, tree_target(target)));
       }
     }
     // Each thread's trees' stiffness goes with its change: past the barrier another may already
@@ -490,15 +508,30 @@ class SerialIsland {
       index.turns.resize(index.node_of_body.size());
     // An island with a contact on one of the tree's bodies is solved as auto solves it: contacts
     // through the tree held a 1000 kg box on a 1 kg hinged bar to 1e-6 m, but a chain of 20
-    // dropped from level gained energy that way once it struck the ground or itself (4x in a
-    // second at dt 1/240, gaps of 1.8 mm) while each LCP's answer checked out against its own
-    // matrix; the cause is not yet found. Limits and cones, and contacts between bodies no joint
+    // swinging into itself gained energy that way (100 J in 0.15 s from 460) while each LCP's
+    // answer checked out against its own matrix. Held at rate zero as the sweeps hold them there
+    // (tree_target), the joints left the LCP nothing to gain by, and the chain still gained
+    // energy over the moves, which the exact recipe follows with no relaxation sweeps (docs/
+    // DYNAMICS.md, "Exact with joints"). Limits and cones, and contacts between bodies no joint
     // holds, are the LCP's.
     if (report->exact_joints) {
       for (std::uint32_t id : c.rows)
         if (trees[0].holds(c.scratch.rows[id].a) || trees[0].holds(c.scratch.rows[id].b))
           report->exact_joints = false;
     }
+  }
+  // What the trees hold the joints' rows to in a sweep. Where a contact acts on a tree's body, at
+  // rate zero, without the curvature targets of a move ahead (JointTree::solve_velocities; the
+  // position passes close what the curvature opens over the move, kNewtonAfter): the joints then
+  // push along rows whose rates are zero, which does no work, whatever the contacts do. With the
+  // targets, chains of 12 to 40 links swinging into themselves gained 56 to 406 J in 20 s (a
+  // fifth to a quarter of their energy), taking the targets afresh from the velocities the
+  // contacts left in every sweep as well; held at zero they gain at most 0.3% (the step's own
+  // swing; docs/DYNAMICS.md, "Joints and contacts"). The drives keep the sweep's target (a
+  // spring acts before a move).
+  JointTarget tree_target(JointTarget target) const {
+    if (contacts_through_tree_) target.h = 0;
+    return target;
   }
   // Whether this thread does the island's serial parts (the contacts, in order).
   bool lead() const {
@@ -557,6 +590,7 @@ class SerialIsland {
   std::pair<std::uint32_t, std::uint32_t> mine_;  // this thread's components [first, second)
   std::span<JointTree> trees_;  // the components' joints solved directly (joint_tree.h), if so
   bool one_sweep_solves_ = false;
+  bool contacts_through_tree_ = false;  // a contact acts on a body of the island's trees
   bool joint_terms_current_ = false;
   std::uint64_t reductions_ = 0;
   double moved_for_ = 0;  // s: the moves so far this step
