@@ -167,14 +167,16 @@ constexpr int kJointRefactoredPasses = 2;
 static_assert(kJointRefactoredPasses >= 1, "the first pass after a move refactors");
 // Where contacts act through the trees, the move has no curvature targets (SerialIsland::
 // tree_target) and opens each joint by its turn's curvature, ~w^2 r h^2: the first pass corrects
-// millimetres where it corrected micrometres, and what it leaves, the second's, is more than a
-// chord step on the second's rows takes out (a chain of 20 dropped from level at dt 1/30 opened
-// 2.7e-6 m that way, against 3.6e-8 m from a Newton step). So there the last pass is a Newton step
-// too where the second corrected more than kNewtonAfter, and it holds the bounds the poses are
-// past by more than kLaterBoundSlack (the first pass's larger corrections carried limbs past
-// bounds it did not hold: the ragdoll pile's worst 1.3e-2 rad, against 2.8e-3 so).
-constexpr double kNewtonAfter = 1e-5;      // m or rad
+// millimetres where it corrected micrometres, and carries limbs past bounds it did not hold. There
+// the second pass holds the bounds the poses are past by more than kLaterBoundSlack too (its
+// factors then do not serve the sweeps), the third is a Newton step where the second corrected
+// more than kNewtonAfter (a chord step's rows had turned too far: a chain of 20 dropped from level
+// at dt 1/30 opened 2.7e-6 m against 3.6e-8), and a fourth, a chord step, follows. Measured on the
+// pile of eight ragdolls at one substep (300 steps): the anchors' largest gap 2.3e-10 m, the
+// bounds' mean 1.1e-7 and largest 2.6e-4 rad (with the targets and three passes: 2.3e-8 m,
+// 1.1e-6 and 3.2e-3 rad; without the second's bounds, 1.7e-11 m, 6.1e-6 and 1.3e-2 rad).
 constexpr double kLaterBoundSlack = 1e-6;  // m or rad
+constexpr double kNewtonAfter = 1e-5;      // m or rad
 constexpr double kSettledJointError = 1e-9;
 
 // advance_with's parts for one island on one thread (any island: exact, soft, pgs), or, for an
@@ -271,19 +273,22 @@ class SerialIsland {
     }
     for (std::uint32_t component = mine_.first; component < mine_.second; ++component) {
       double corrected = std::numeric_limits<double>::infinity();
-      for (int pass = 0; pass < kJointPositionPasses; ++pass) {
+      // (Where contacts act through the trees, one chord pass more: kLaterBoundSlack.)
+      const int passes = kJointPositionPasses + (contacts_through_tree_ ? 1 : 0);
+      for (int pass = 0; pass < passes; ++pass) {
         if (!trees_.empty()) {
           // A pass after the refactored ones corrects what the last left, about the square of
           // what that one corrected: nothing where that was already below kSettledJointError.
           if (pass >= kJointRefactoredPasses && corrected < kSettledJointError) break;
           const bool later_newton =
-              pass >= kJointRefactoredPasses && contacts_through_tree_ && corrected > kNewtonAfter;
+              pass == kJointRefactoredPasses && contacts_through_tree_ && corrected > kNewtonAfter;
           const bool newton = pass < kJointRefactoredPasses || later_newton;
+          const bool later_bounds = pass == 1 && contacts_through_tree_;
           // The last refactored pass factors the velocity sweeps' system too (joint_tree.h).
           corrected = trees_[component].solve_positions(
               c_.scratch.joint_rows, bodies_, c_.scratch.poses, newton,
               pass == kJointRefactoredPasses - 1 || later_newton ? h : 0.0,
-              pass == 0 || later_newton, later_newton ? kLaterBoundSlack : 0.0);
+              pass == 0 || later_bounds, later_bounds ? kLaterBoundSlack : 0.0);
           continue;
         }
         for (std::uint32_t j : joints_of(component))
