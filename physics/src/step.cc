@@ -177,6 +177,8 @@ static_assert(kJointRefactoredPasses >= 1, "the first pass after a move refactor
 // 1.1e-6 and 3.2e-3 rad; without the second's bounds, 1.7e-11 m, 6.1e-6 and 1.3e-2 rad).
 constexpr double kLaterBoundSlack = 1e-6;  // m or rad
 constexpr double kNewtonAfter = 1e-5;      // m or rad
+// A Newton pass that corrected errors below this (m, or rad) left errors near their square over
+// the joints' lever arms: under 1e-16 for levers down to a centimetre, below the poses' rounding.
 constexpr double kSettledJointError = 1e-9;
 
 // advance_with's parts for one island on one thread (any island: exact, soft, pgs), or, for an
@@ -514,11 +516,11 @@ class SerialIsland {
     // An island with a contact on one of the tree's bodies is solved as auto solves it: contacts
     // through the tree held a 1000 kg box on a 1 kg hinged bar to 1e-6 m, but a chain of 20
     // swinging into itself gained energy that way (100 J in 0.15 s from 460) while each LCP's
-    // answer checked out against its own matrix. Held at rate zero as the sweeps hold them there
-    // (tree_target), the joints left the LCP nothing to gain by, and the chain still gained
-    // energy over the moves, which the exact recipe follows with no relaxation sweeps (docs/
-    // DYNAMICS.md, "Exact with joints"). Limits and cones, and contacts between bodies no joint
-    // holds, are the LCP's.
+    // answer checked out against its own matrix. In a probe with the joints held at rate zero
+    // (as tree_target holds them in the sweeps) no LCP raised the kinetic energy, and the chain
+    // still gained, over the moves and passes of the exact recipe, which has no relaxation
+    // sweeps (docs/DYNAMICS.md, "Exact with joints"). Limits and cones, and contacts between
+    // bodies no joint holds, are the LCP's.
     if (report->exact_joints) {
       for (std::uint32_t id : c.rows)
         if (trees[0].holds(c.scratch.rows[id].a) || trees[0].holds(c.scratch.rows[id].b))
@@ -529,9 +531,9 @@ class SerialIsland {
   // rate zero, without the curvature targets of a move ahead (JointTree::solve_velocities; the
   // position passes close what the curvature opens over the move, kNewtonAfter): the joints then
   // push along rows whose rates are zero, which does no work, whatever the contacts do. With the
-  // targets, chains of 12 to 40 links swinging into themselves gained 56 to 406 J in 20 s (a
-  // fifth to a quarter of their energy), taking the targets afresh from the velocities the
-  // contacts left in every sweep as well; held at zero they gain at most 0.3% (the step's own
+  // targets, chains of 12 to 40 links swinging into themselves gained 69 to 406 J in 20 s (23 to
+  // 35% of their energy), and still 56 to 225 J with the targets taken afresh, in every sweep,
+  // from the velocities the contacts left; held at zero they gain at most 0.3% (the step's own
   // swing; docs/DYNAMICS.md, "Joints and contacts"). The drives keep the sweep's target (a
   // spring acts before a move).
   JointTarget tree_target(JointTarget target) const {
