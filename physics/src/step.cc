@@ -206,6 +206,16 @@ class SerialIsland {
         !trees_.empty() && std::any_of(c.rows.begin(), c.rows.end(), [&](std::uint32_t id) {
           return trees_[0].holds(c.scratch.rows[id].a) || trees_[0].holds(c.scratch.rows[id].b);
         });
+    // An island with a contact on one of the tree's bodies is solved as auto solves it: contacts
+    // through the tree held a 1000 kg box on a 1 kg hinged bar to 1e-6 m, but a chain of 20
+    // swinging into itself gained energy that way (100 J in 0.15 s from 460) while each LCP's
+    // answer checked out against its own matrix. In a probe with the joints held at rate zero
+    // (as tree_target holds them in the sweeps) no LCP raised the kinetic energy, and the chain
+    // still gained, over the moves and passes of the exact recipe, which has no relaxation
+    // sweeps (docs/DYNAMICS.md, "Exact with joints"). Limits and cones, and contacts between
+    // bodies no joint holds, are the LCP's. (Such an island is never the team's: no thread of a
+    // team writes it.)
+    if (contacts_through_tree_ && report_->exact_joints) report_->exact_joints = false;
     // Only the trees' own rows: their solve is exact, and a second sweep would find it so (unless
     // one holds stiffness: JointTree::stiffened).
     one_sweep_solves_ = !trees_.empty() && c.rows.empty() &&
@@ -286,7 +296,8 @@ class SerialIsland {
               pass == kJointRefactoredPasses && contacts_through_tree_ && corrected > kNewtonAfter;
           const bool newton = pass < kJointRefactoredPasses || later_newton;
           const bool later_bounds = pass == 1 && contacts_through_tree_;
-          // The last refactored pass factors the velocity sweeps' system too (joint_tree.h).
+          // The last refactored pass (and a later Newton one) factors the velocity sweeps'
+          // system too (joint_tree.h).
           corrected = trees_[component].solve_positions(
               c_.scratch.joint_rows, bodies_, c_.scratch.poses, newton,
               pass == kJointRefactoredPasses - 1 || later_newton ? h : 0.0,
@@ -513,19 +524,6 @@ class SerialIsland {
     // Sized here, on one thread: the trees' solves on the team write their bodies' turns.
     if (index.turns.size() < index.node_of_body.size())
       index.turns.resize(index.node_of_body.size());
-    // An island with a contact on one of the tree's bodies is solved as auto solves it: contacts
-    // through the tree held a 1000 kg box on a 1 kg hinged bar to 1e-6 m, but a chain of 20
-    // swinging into itself gained energy that way (100 J in 0.15 s from 460) while each LCP's
-    // answer checked out against its own matrix. In a probe with the joints held at rate zero
-    // (as tree_target holds them in the sweeps) no LCP raised the kinetic energy, and the chain
-    // still gained, over the moves and passes of the exact recipe, which has no relaxation
-    // sweeps (docs/DYNAMICS.md, "Exact with joints"). Limits and cones, and contacts between
-    // bodies no joint holds, are the LCP's.
-    if (report->exact_joints) {
-      for (std::uint32_t id : c.rows)
-        if (trees[0].holds(c.scratch.rows[id].a) || trees[0].holds(c.scratch.rows[id].b))
-          report->exact_joints = false;
-    }
   }
   // What the trees hold the joints' rows to in a sweep. Where a contact acts on a tree's body, at
   // rate zero, without the curvature targets of a move ahead (JointTree::solve_velocities; the
