@@ -54,7 +54,7 @@ double solve_point(JointRow& row, JointBodies& j, const JointPoseTerms& terms,
   // The move's drift beyond the velocities' first order (the turns' curvature), which the
   // velocities must cancel to end the move on the joint.
   Vec3 drift = Vec3::Zero();
-  if (t.h > 0)
+  if (t.h > 0 && t.curvature)
     drift = turn_curvature(t.h * b.w, anchors.rb) - turn_curvature(t.h * j.a->w, anchors.ra);
   const Vec3 impulse = -terms.point_solver.solve(anchor_velocity(j, anchors) +
                                                  drift_velocity(drift, t.h, t.most_speed));
@@ -90,7 +90,7 @@ double solve_hinge_axes(JointRow& row, JointBodies& j, const JointTarget& t,
   const Vec3 relative_w = b.w - j.a->w;
   if (!terms.hinge_usable) return 0;
   Eigen::Vector2d velocity(relative_w.dot(g1), relative_w.dot(g2));
-  if (t.h > 0) {
+  if (t.h > 0 && t.curvature) {
     // The turns' curvature over the move, beyond the velocities' first order.
     const Vec3 turn_a = t.h * j.a->w, turn_b = t.h * b.w;
     const auto turned = [](const Vec3& theta, const Vec3& r) {
@@ -145,7 +145,7 @@ double solve_distance(JointRow& row, JointBodies& j, const Anchors& anchors, con
   // sweep takes that kinetic energy away).
   const Vec3 u = anchor_velocity(j, anchors);
   double velocity = n.dot(u);
-  if (t.h > 0) {
+  if (t.h > 0 && t.curvature) {
     const Vec3 d_next = d + anchor_move(b, anchors.rb, t.h) - anchor_move(*j.a, anchors.ra, t.h);
     velocity += drift_velocity(d_next.norm() - length - t.h * velocity, t.h, t.most_speed);
   }

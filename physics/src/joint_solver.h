@@ -52,6 +52,10 @@ struct JointTarget {
   // The island's energy is its joints' alone (no contacts, drives or bounds to take any): the
   // direct solve's curvature targets are iterated until they settle (joint_tree.cc).
   bool conserving = false;
+  // Whether a Gauss-Seidel visit (solve_joint) holds the joint's own rows at the move's curvature
+  // or at rate zero (its drives and bounds keep h either way). The curvature keeps energy only
+  // where the visit's answer is the joint's whole solve (SerialIsland::sweep says where).
+  bool curvature = true;
 };
 
 // The rows a joint must hold exactly (its point, axes, rotation, a rod's length, a slider's line;
