@@ -646,8 +646,9 @@ TEST(StandardScenes, GaussSeidelJointsPumpNoEnergyIn) {
 // The joint scenes of docs/SCENES.md run and do what they are for: the cradle passes its swing to
 // the far ball and never gains energy; the double pendulum (chaotic) stays within 0.5% of its
 // energy (solved directly it rose at most 0.26% over 20 s, and never drifts up: the test above;
-// soft, 4%); the door stops at its quarter turn and closes again; the rope bridge's loop
-// of joints is named in the statistics.
+// soft, holding its joints at rate zero, loses a quarter in 20 s: GaussSeidelJointsPumpNoEnergyIn);
+// the door stops at its quarter turn and closes again; the rope bridge's loop of joints is named
+// in the statistics.
 TEST(StandardScenes, JointScenesDoWhatTheyAreFor) {
   {
     SceneDef scene = standard_scene("double-pendulum").value();
