@@ -25,6 +25,7 @@ struct JointWorkspace {
   std::vector<JointTree::BodyImpulse> impulses;
   std::vector<Vec6> totals;                  // an impulse per row body
   std::vector<double> tangent_1, tangent_2;  // a point's tangents' responses
+  std::vector<double> bound_gaps;            // the bounds' gaps, for the push-out
 };
 
 JointWorkspace& joint_workspace() {
@@ -250,10 +251,15 @@ ExactSolveResult solve_island_exact(std::span<ContactRow> rows,
   store_contact_impulses(layout, rows, ids, z);
   for (int b = 0; b < bounds; ++b)
     keep_bound_impulse(joint_rows[w.bound_joint[b]].joint, w.bounds[b].side, z[points + b]);
-  result.pushed_out = push_out(rows, ids, true, bodies, settings, h, workspace, &result);
+  // The push-out keeps the bounds too (exact_solver.h, push_out).
+  w.bound_gaps.clear();
+  for (int b = 0; b < bounds; ++b)
+    w.bound_gaps.push_back(w.bounds[b].gap);
+  result.pushed_out =
+      push_out(rows, ids, true, bodies, settings, h, workspace, &result, w.bound_gaps);
   if (result.pushed_out && points > 0) {
-    const Eigen::Map<const Eigen::VectorXd> push(workspace.push_z.data(), points);
-    gather(w, std::span(jac).first(points), push);
+    const Eigen::Map<const Eigen::VectorXd> push(workspace.push_z.data(), points + bounds);
+    gather(w, std::span(jac).first(points + bounds), push);
     result.pushed_out = apply_totals(w, tree, joint_rows, bodies, true);
   }
   return result;

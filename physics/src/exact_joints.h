@@ -6,10 +6,10 @@
 // the bodies (every joint's rates unchanged), so the LCP's matrix is J S J^T with S the tree's
 // constrained mobility: the contacts' Delassus matrix in the joints' null space, the mixed LCP's
 // equalities eliminated by their Schur complement (Cottle, Pang and Stone 1992, ch. 1; as ODE's
-// dWorldStep solves a mixed LCP, but with the equalities eliminated in linear time). The step
-// (step.cc) sends it islands whose contacts touch no jointed body: through the tree, contacts
-// held a heavy load on a light hinged bar exactly, but a whipping chain gained energy
-// (docs/DYNAMICS.md, "Exact with joints").
+// dWorldStep solves a mixed LCP, but with the equalities eliminated in linear time). Where its
+// contacts act on jointed bodies the step (step.cc) holds the joints at rate zero in the tree's
+// solve and relaxes each substep after its move, as the soft recipe does (without, a chain
+// swinging into itself gained energy: docs/DYNAMICS.md, "Exact with joints").
 #pragma once
 
 #include <span>

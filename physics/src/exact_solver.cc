@@ -164,13 +164,18 @@ void store_contact_impulses(const Layout& layout, std::span<ContactRow> rows,
 // 1 kg box is pushed out from under 1000 kg as surely as the velocities are.
 bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
               bool substep_gaps, std::span<const SolverBody> bodies, const SolverSettings& settings,
-              double h, Workspace& workspace, ExactSolveResult* result) {
+              double h, Workspace& workspace, ExactSolveResult* result,
+              std::span<const double> bound_gaps) {
   const int points = static_cast<int>(ids.size());
+  const int rows_pushed = points + static_cast<int>(bound_gaps.size());
   const Eigen::Index n = static_cast<Eigen::Index>(workspace.q.size());
   const Eigen::Map<const Eigen::MatrixXd> m(workspace.m.data(), n, n);
-  workspace.push_q.resize(points);
-  workspace.push_z.assign(points, 0.0);
-  Eigen::Map<Eigen::VectorXd> q(workspace.push_q.data(), points);
+  workspace.push_q.resize(rows_pushed);
+  workspace.push_z.assign(rows_pushed, 0.0);
+  Eigen::Map<Eigen::VectorXd> q(workspace.push_q.data(), rows_pushed);
+  for (std::size_t b = 0; b < bound_gaps.size(); ++b)
+    q[points + static_cast<Eigen::Index>(b)] =
+        velocity_along(workspace.jacobians[points + b], bodies) + std::max(bound_gaps[b], 0.0) / h;
   bool any = false;
   for (int p = 0; p < points; ++p) {
     const ContactRow& row = rows[ids[p]];
@@ -185,16 +190,16 @@ bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> i
     any |= q[p] < 0;
   }
   if (!any) return true;
-  workspace.push_m.resize(static_cast<std::size_t>(points) * points);
-  Eigen::Map<Eigen::MatrixXd> mp(workspace.push_m.data(), points, points);
-  Eigen::Map<Eigen::VectorXd> z(workspace.push_z.data(), points);
-  mp = m.topLeftCorner(points, points);
+  workspace.push_m.resize(static_cast<std::size_t>(rows_pushed) * rows_pushed);
+  Eigen::Map<Eigen::MatrixXd> mp(workspace.push_m.data(), rows_pushed, rows_pushed);
+  Eigen::Map<Eigen::VectorXd> z(workspace.push_z.data(), rows_pushed);
+  mp = m.topLeftCorner(rows_pushed, rows_pushed);
   const LemkeResult lemke = solve_lcp_lemke(
-      mp, q, std::max(100, settings.lemke_pivots_per_unknown * points), z, &workspace.lemke);
+      mp, q, std::max(100, settings.lemke_pivots_per_unknown * rows_pushed), z, &workspace.lemke);
   result->lemke.pivots += lemke.pivots;
   if (lemke.outcome != LemkeOutcome::kSolved || !z.allFinite()) return false;
   const double error =
-      exact_velocity_error(mp, std::span(workspace.diagonal).first(points), q, z, points);
+      exact_velocity_error(mp, std::span(workspace.diagonal).first(rows_pushed), q, z, rows_pushed);
   return error <= settings.exact_velocity_tolerance;
 }
 

@@ -126,10 +126,15 @@ void store_contact_impulses(const Layout& layout, std::span<ContactRow> rows,
 // velocities after the solve, each point's gap its separation (at the step's start, or the
 // substep's with `substep_gaps`). Its answer, the normal rows' pseudo-impulses, is left in
 // workspace.push_z (all 0 where nothing needed pushing) for the caller to give the bodies. False
-// when it found none (penetration is then left to position correction).
+// when it found none (penetration is then left to position correction). With `bound_gaps`, the
+// joints' bound rows that follow the normals in the layout (exact_joints.h) join it, each held
+// from passing its bound (by more than it is past already): without them a push between a heavy
+// body and a light one on its limit moved the light one through the limit alone, and the heavy
+// one sank on at its answer's compliance.
 bool push_out(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,
               bool substep_gaps, std::span<const SolverBody> bodies, const SolverSettings& settings,
-              double h, Workspace& workspace, ExactSolveResult* result);
+              double h, Workspace& workspace, ExactSolveResult* result,
+              std::span<const double> bound_gaps = {});
 
 }  // namespace exact_detail
 

@@ -70,8 +70,8 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
         contact_softness(std::min(hertz, 0.25 / h), solver.contact_damping_ratio, h);
     for (int sub = 0; sub < substeps; ++sub) {
       run.integrate_velocities(h);
-      // Exact with joints: one LCP instead of the sweeps, and no relaxation (it has no bias to
-      // relax); where it finds no answer, the sweeps go on from what it left.
+      // Exact with joints: one LCP instead of the sweeps; where it finds no answer, the sweeps go
+      // on from what it left.
       bool exact = false, tried = false;
       if constexpr (Runner::kSolvesExact) {
         if (report->exact_joints) {
@@ -87,7 +87,12 @@ void advance_with(Runner& run, IslandReport* report, const SolverSettings& solve
       }
       run.integrate_positions(h);
       run.refresh_separations();  // the relaxation sweeps see where the move left the bodies
-      if (exact) continue;
+      // The LCP has no bias to relax; but where its contacts act on jointed bodies, the velocities
+      // are taken back onto the joints and contacts where the move left them (RATTLE's
+      // projection, SerialIsland::relaxes_exact_substeps).
+      if constexpr (Runner::kSolvesExact) {
+        if (exact && !run.relaxes_exact_substeps()) continue;
+      }
       for (int i = 0; i < solver.relax_iterations; ++i)
         if (run.sweep(nullptr, h, (sub + i) % 2 == 0) <= solver.velocity_tolerance) break;
     }
@@ -206,16 +211,6 @@ class SerialIsland {
         !trees_.empty() && std::any_of(c.rows.begin(), c.rows.end(), [&](std::uint32_t id) {
           return trees_[0].holds(c.scratch.rows[id].a) || trees_[0].holds(c.scratch.rows[id].b);
         });
-    // An island with a contact on one of the tree's bodies is solved as auto solves it: contacts
-    // through the tree held a 1000 kg box on a 1 kg hinged bar to 1e-6 m, but a chain of 20
-    // swinging into itself gained energy that way (100 J in 0.15 s from 460) while each LCP's
-    // answer checked out against its own matrix. In a probe with the joints held at rate zero
-    // (as tree_target holds them in the sweeps) no LCP raised the kinetic energy, and the chain
-    // still gained, over the moves and passes of the exact recipe, which has no relaxation
-    // sweeps (docs/DYNAMICS.md, "Exact with joints"). Limits and cones, and contacts between
-    // bodies no joint holds, are the LCP's. (Such an island is never the team's: no thread of a
-    // team writes it.)
-    if (contacts_through_tree_ && report_->exact_joints) report_->exact_joints = false;
     // Only the trees' own rows: their solve is exact, and a second sweep would find it so (unless
     // one holds stiffness: JointTree::stiffened).
     one_sweep_solves_ = !trees_.empty() && c.rows.empty() &&
@@ -442,8 +437,8 @@ class SerialIsland {
         change =
             std::max(change, solve_joint_drives(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses,
                                                 target, c_.scratch.joint_terms[j], false));
-      change = std::max(
-          change, tree.solve_velocities(c_.scratch.joint_rows, bodies_, c_.scratch.poses, target));
+      change = std::max(change, tree.solve_velocities(c_.scratch.joint_rows, bodies_,
+                                                      c_.scratch.poses, tree_target(target)));
       // The first visit's change leaves out the tree's first solve of the substep (its targets'
       // base), so it is never taken as converged.
       if ((one_sweep_solves_ && !tree.stiffened()) ||
@@ -460,6 +455,18 @@ class SerialIsland {
     }
     report_->needs_position_correction |= !exact.pushed_out;
     return true;
+  }
+  // Whether an exact substep with joints is followed by relaxation sweeps, as a soft one is:
+  // where a contact acts on a body of the island's tree. There the LCP's answer holds the joints
+  // at rate zero (tree_target) and the move opens them by their turns' curvature, which the
+  // position passes close, turning the rows; the velocities the move ends with then push along
+  // rows that are no longer the joints' or the contacts', and a chain of 12 swinging into itself
+  // gained 341 J in 20 s from 200 (a probe: with every LCP's answer checked against its own
+  // matrix, and no LCP raising the kinetic energy). Relaxed, it keeps its energy as auto does
+  // (docs/DYNAMICS.md, "Exact with joints"). Islands whose contacts touch no jointed body keep
+  // the exact recipe whole.
+  bool relaxes_exact_substeps() const {
+    return contacts_through_tree_;
   }
   // True when the LCP's answer was taken; false when it was refused (then pgs solves the island).
   bool solve_exact(double dt) {

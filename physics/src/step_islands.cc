@@ -100,9 +100,9 @@ void World::choose_island_solvers(double dt) {
         }
         // An island with joints is solved on one thread, in the soft recipe's substeps.
         s.reports[i].joints = s.islands.joint_begin[i + 1] - s.islands.joint_begin[i];
-        // Exact and auto solve its joints' rows directly (joint_tree.h); exact its limits and
-        // cones (and contacts, where none touches a jointed body: SerialIsland) as one LCP each
-        // substep (exact_joints.h) while they fit its bound, auto (and exact past it) soft.
+        // Exact and auto solve its joints' rows directly (joint_tree.h); exact its limits, cones
+        // and contacts as one LCP each substep (exact_joints.h) while they fit its bound, auto
+        // (and exact past it) soft.
         s.reports[i].joint_tree = false;
         s.reports[i].joint_loop = false;
         s.reports[i].exact_joints = false;
