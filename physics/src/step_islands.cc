@@ -102,14 +102,21 @@ void World::choose_island_solvers(double dt) {
         s.reports[i].joints = s.islands.joint_begin[i + 1] - s.islands.joint_begin[i];
         // Exact and auto solve its joints' rows directly (joint_tree.h); exact its limits, cones
         // and contacts as one LCP each substep (exact_joints.h) while they fit its bound, auto
-        // (and exact past it) soft.
+        // (and exact past it) soft, but for an island of few contact points where the soft ones
+        // would fail (kAutoExactJointedMassRatio), which auto gives the LCP as exact does.
         s.reports[i].joint_tree = false;
         s.reports[i].joint_loop = false;
         s.reports[i].exact_joints = false;
         if (s.reports[i].joints > 0 &&
             (solver.kind == SolverKind::kExact || solver.kind == SolverKind::kAuto)) {
           s.reports[i].joint_tree = true;
-          if (solver.kind == SolverKind::kExact && kind == IslandSolver::kExact) {
+          const bool auto_exact =
+              solver.kind == SolverKind::kAuto && points > 0 &&
+              points <= static_cast<std::uint32_t>(
+                            std::min(solver.exact_max_points, solver.exact_max_island_points)) &&
+              soft_would_differ(island_bodies, island_links, s.links, s.body_of, s.dynamic,
+                                settings_.gravity.norm(), solver, kAutoExactJointedMassRatio);
+          if ((solver.kind == SolverKind::kExact && kind == IslandSolver::kExact) || auto_exact) {
             // A bound row is one unknown, a point 2 + k: counted as points, the bound is kept
             // with room to spare.
             std::uint32_t rows = points;
@@ -119,7 +126,7 @@ void World::choose_island_solvers(double dt) {
             // solves them (the exact recipe without relaxation let a falling chain of 20 open
             // 5e-5 m at dt 1/60, and one with a 1000 times heavier end 2 cm).
             if (rows > static_cast<std::uint32_t>(solver.exact_max_island_points))
-              s.reports[i].exact_oversized = true;
+              s.reports[i].exact_oversized = !auto_exact;
             else if (rows > 0)
               s.reports[i].exact_joints = true;
           }
