@@ -87,9 +87,10 @@ double exact_period(double degrees, double length) {
 
 // dt 1/60 in four substeps: the symplectic step's error in the period is of order (omega h)^2 =
 // 2e-4 of it (measured: 7e-6 at 10 degrees, 2e-5 at 90, 1.5e-5 at 170, for both solvers).
-// Gauss-Seidel (soft) takes the move's curvature afresh each sweep; the direct solve (auto,
-// joint_tree.h) takes it twice a substep where SHAKE's iteration converges (taken once, the
-// pendulum lost energy every swing: 2e-3 short at 170 degrees).
+// Gauss-Seidel (soft) takes the move's curvature afresh each sweep (a lone joint clear of
+// contacts: SerialIsland::gauss_seidel_target; other joints it holds at rate zero); the direct
+// solve (auto, joint_tree.h) takes it twice a substep where SHAKE's iteration converges (taken
+// once, the pendulum lost energy every swing: 2e-3 short at 170 degrees).
 double period_tolerance(SolverKind) {
   return 1e-4;
 }
