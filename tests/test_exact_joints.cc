@@ -45,6 +45,15 @@ JointId hinge_bar(World& world, BodyId bar, const JointLimit& limit = {}) {
   return world.create_joint(def).value();
 }
 
+// A 0.2 m box of `mass` 1 mm above the level bar's top, 0.8 m out from the hinge.
+BodyId add_box_on_bar(World& world, double mass) {
+  BodyDef def;
+  def.shape = BoxDef{Vec3(0.1, 0.1, 0.1)};
+  def.position = Vec3(0.8, 0, 5.151);
+  def.mass = mass;
+  return world.create_body(def).value();
+}
+
 TEST(ExactJoints, ABarOnItsHingesLimitCarriesItsWeightsTorqueThere) {
   // The bar released level falls onto the bound 0.5 rad below it (a is the bar and b the world:
   // the world turns by -angle relative to the bar).
@@ -98,11 +107,7 @@ TEST(ExactJoints, AHeavyBoxRestsOnALightHingedBarOnItsLimit) {
     World world(settings);
     const BodyId bar = add_bar(world);
     const JointId hinge = hinge_bar(world, bar, {true, 0, 0.5});
-    BodyDef box_def;
-    box_def.shape = BoxDef{Vec3(0.1, 0.1, 0.1)};
-    box_def.position = Vec3(0.8, 0, 5.151);  // 1 mm above the bar's top
-    box_def.mass = 1000;
-    const BodyId box = world.create_body(box_def).value();
+    const BodyId box = add_box_on_bar(world, 1000);
     double rest_z = 0;
     for (int i = 0; i < 180; ++i) {
       ASSERT_TRUE(world.step(kDt));
@@ -124,11 +129,7 @@ TEST(ExactJoints, AHeavyBoxRestsOnALightHingedBarOnItsLimit) {
   settings.solver.kind = SolverKind::kAuto;
   World world(settings);
   hinge_bar(world, add_bar(world), {true, 0, 0.5});
-  BodyDef box_def;
-  box_def.shape = BoxDef{Vec3(0.1, 0.1, 0.1)};
-  box_def.position = Vec3(0.8, 0, 5.151);
-  box_def.mass = 10;
-  world.create_body(box_def).value();
+  add_box_on_bar(world, 10);
   std::uint32_t exact = 0;
   for (int i = 0; i < 60; ++i) {
     ASSERT_TRUE(world.step(kDt));
