@@ -439,6 +439,7 @@ void set_rotation_rows(JointEquations& e, int first) {
 void clear_equations(JointEquations* e) {
   e->rows = 0;
   e->point_rows = false;
+  e->turning_rest = false;
   e->on_a.setZero();
   e->on_b.setZero();
   e->target.setZero();
@@ -667,7 +668,13 @@ void add_equation_impulses(JointRow& row, const JointEquations& equations,
   // A row that pushes a's centre is a force at the anchors; one that only turns is a torque.
   int rows = equations.rows;
   if (motor_row(row, equations)) joint.motor_impulse += impulses[--rows];
-  for (int i = 0; i < rows; ++i) {
+  int i = 0;
+  if (equations.point_rows) {
+    // A point's rows push along the world axes (on a: -I).
+    joint.linear_impulse += impulses.head<3>();
+    i = 3;
+  }
+  for (; i < rows; ++i) {
     const Vec3 linear = -equations.on_a.block<1, 3>(i, 0).transpose();
     if (!linear.isZero())
       joint.linear_impulse += impulses[i] * linear;

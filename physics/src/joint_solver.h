@@ -69,6 +69,10 @@ struct JointEquations {
   // Whether the first three rows are a point's (a ball's, a hinge's, a fixed joint's): on a,
   // [-I, [r_a]x]; on b, [I, -[r_b]x] (JointTree's products take that shape).
   bool point_rows = false;
+  // Whether the rows after the point's (all of them, without a point) turn the bodies alone, their
+  // linear columns zero (a hinge's axis rows, a cone or a twist limit): JointTree sets it where it
+  // factors, and its products skip those columns.
+  bool turning_rest = false;
   Eigen::Matrix<double, 6, 6> on_a = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 6> on_b = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> target = Eigen::Matrix<double, 6, 1>::Zero();

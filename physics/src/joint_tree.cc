@@ -439,6 +439,13 @@ TUMBLE_INLINE Eigen::Matrix<double, A, X::ColsAtCompileTime> rows_times(
     }
     first = 3;
   }
+  // (Rows that only turn: their zero linear columns left out, the same sums but for a zero's sign.)
+  if (equations.turning_rest) {
+    for (int col = 0; col < x.cols(); ++col)
+      for (int i = first; i < A; ++i)
+        out(i, col) = rows(i, 3) * x(3, col) + rows(i, 4) * x(4, col) + rows(i, 5) * x(5, col);
+    return out;
+  }
   for (int col = 0; col < x.cols(); ++col)
     for (int i = first; i < A; ++i) {
       double sum = rows(i, 0) * x(0, col);
@@ -447,6 +454,15 @@ TUMBLE_INLINE Eigen::Matrix<double, A, X::ColsAtCompileTime> rows_times(
       out(i, col) = sum;
     }
   return out;
+}
+
+// Whether the equations' rows after the point's have no linear part (JointEquations::turning_rest).
+bool turns_only_after_point(const JointEquations& equations) {
+  const int first = equations.point_rows ? 3 : 0;
+  for (int i = first; i < equations.rows; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (equations.on_a(i, k) != 0 || equations.on_b(i, k) != 0) return false;
+  return true;
 }
 
 }  // namespace
@@ -470,6 +486,7 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
   for (std::size_t k = 0; k < joints_.size(); ++k) {
     TreeJoint& joint = joints_[k];
     equations(k, &equations_[k]);
+    equations_[k].turning_rest = turns_only_after_point(equations_[k]);
     joint.width = equations_[k].rows <= 3 ? 3 : equations_[k].rows <= 5 ? 5 : 6;
     with_width(joint.width, [&]<int W>() {
       Eigen::Matrix<double, W, W> pivot = Eigen::Matrix<double, W, W>::Zero();
