@@ -37,6 +37,9 @@ struct IslandContext {
   StepScratch& scratch;
   const WorldSettings& settings;
   std::span<const Body* const> body_of;  // by solver index
+  // Its colours in StepScratch::colouring, [first, last): none where its contacts are swept row by
+  // row, in the island's order.
+  std::uint32_t first_colour = 0, last_colour = 0;
 };
 
 // How many manifolds island i has.
@@ -186,6 +189,15 @@ constexpr double kNewtonAfter = 1e-5;      // m or rad
 // the joints' lever arms: under 1e-16 for levers down to a centimetre, below the poses' rounding.
 constexpr double kSettledJointError = 1e-9;
 
+// The visits of a coloured island's contacts, colour by colour (defined with the team's islands
+// below).
+template <class PackFn, class ManifoldFn>
+double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
+                   bool solo, PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce = true);
+template <class Fn>
+double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
+                     bool solo, Fn&& fn, bool reduce = true);
+
 // advance_with's parts for one island on one thread (any island: exact, soft, pgs), or, for an
 // island of several joint components (`team`), on the whole team: every thread calls every
 // member; each solves its share of the components' joints (components share no moving body, and
@@ -211,6 +223,7 @@ class SerialIsland {
         !trees_.empty() && std::any_of(c.rows.begin(), c.rows.end(), [&](std::uint32_t id) {
           return trees_[0].holds(c.scratch.rows[id].a) || trees_[0].holds(c.scratch.rows[id].b);
         });
+    coloured_contacts_ = c.last_colour > c.first_colour;
     // Only the trees' own rows: their solve is exact, and a second sweep would find it so (unless
     // one holds stiffness: JointTree::stiffened).
     one_sweep_solves_ = !trees_.empty() && c.rows.empty() &&
@@ -310,7 +323,21 @@ class SerialIsland {
     joint_terms_current_ = false;
   }
   void refresh_separations() {
-    if (lead()) update_separations(rows_, c_.rows, bodies_, kinematic_time());
+    if (lead() && coloured_contacts_) {
+      visit_contacts(
+          false,
+          [&](ContactPack& pack) {
+            update_separations(pack, bodies_, kinematic_time());
+            return 0.0;
+          },
+          [&](const ManifoldRows& manifold) {
+            update_separations(rows_, std::span(manifold.ids, manifold.count), bodies_,
+                               kinematic_time());
+            return 0.0;
+          });
+    } else if (lead()) {
+      update_separations(rows_, c_.rows, bodies_, kinematic_time());
+    }
     if (team_) c_.scratch.barrier.wait();
   }
   // How long the island's bodies have moved in this step, which kinematic bodies' motion in its
@@ -334,8 +361,21 @@ class SerialIsland {
       }
     }
     if (team_) c_.scratch.barrier.wait();
-    if (lead())
+    if (lead() && coloured_contacts_) {
+      visit_contacts(
+          false,
+          [&](ContactPack& pack) {
+            tumble::warm_start(pack, bodies_, keep_last_substep, kinematic_time());
+            return 0.0;
+          },
+          [&](const ManifoldRows& manifold) {
+            tumble::warm_start(rows_, cold_, std::span(manifold.ids, manifold.count), bodies_,
+                               keep_last_substep, kinematic_time());
+            return 0.0;
+          });
+    } else if (lead()) {
       tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep, kinematic_time());
+    }
     if (team_) c_.scratch.barrier.wait();
   }
   // Joints first, then contacts (Box2D v3's order: the contacts have the last word on
@@ -380,9 +420,20 @@ class SerialIsland {
     if (one_sweep_solves_ && !any_stiff) return 0;
     if (c_.rows.empty()) return change;
     double contacts = 0;
-    if (lead())
+    if (lead() && coloured_contacts_) {
+      contacts = visit_contacts(
+          backward,
+          [&](ContactPack& pack) {
+            return solve_pack(pack, kAllLanes, bodies_, c_.settings.solver, soft, h);
+          },
+          [&](const ManifoldRows& manifold) {
+            return solve_manifold(rows_, manifold, c_.scratch.blocks, bodies_, c_.settings.solver,
+                                  soft, h);
+          });
+    } else if (lead()) {
       contacts = solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver,
                                 soft, h, backward);
+    }
     return std::max(change, team_largest(contacts, false).first);
   }
   // One substep of an exact island with joints (exact_joints.h): the drives swept and the tree
@@ -485,14 +536,41 @@ class SerialIsland {
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    if (lead()) report_->residual = normal_residual(rows_, c_.rows, bodies_, h, kinematic_time());
+    if (lead() && coloured_contacts_) {
+      // The packs give the rows their impulses, for the residual and restitution.
+      report_->residual = visit_contacts(
+          false,
+          [&](const ContactPack& pack) {
+            store_impulses(pack, rows_, cold_);
+            double lane_residuals[kWideLanes];
+            pack_residuals(pack, bodies_, h, lane_residuals, kinematic_time());
+            return *std::max_element(std::begin(lane_residuals), std::end(lane_residuals));
+          },
+          [&](const ManifoldRows& manifold) {
+            return normal_residual(rows_, std::span(manifold.ids, manifold.count), bodies_, h,
+                                   kinematic_time());
+          });
+    } else if (lead()) {
+      report_->residual = normal_residual(rows_, c_.rows, bodies_, h, kinematic_time());
+    }
     if (team_) c_.scratch.barrier.wait();
     move();
     if (lead()) apply_restitution();
   }
   void apply_restitution() {
-    tumble::apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_,
-                              c_.settings.solver);
+    if (!coloured_contacts_) {
+      tumble::apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_,
+                                c_.settings.solver);
+      return;
+    }
+    sweep_colours(
+        c_.scratch, c_.first_colour, c_.last_colour, false, true,
+        [&](std::span<const std::uint32_t> ids) {
+          tumble::apply_restitution(rows_, cold_, ids, c_.scratch.blocks, bodies_,
+                                    c_.settings.solver);
+          return 0.0;
+        },
+        false);
   }
 
  private:
@@ -559,6 +637,14 @@ class SerialIsland {
     if (contacts_through_tree_) target.h = 0;
     return target;
   }
+  // A coloured island's contacts (IslandContext::first_colour), visited colour by colour on the
+  // lead thread: its packs where the step sweeps them, else its manifolds in the same order (the
+  // same bits: visit_colours).
+  template <class PackFn, class ManifoldFn>
+  double visit_contacts(bool backward, PackFn&& pack_fn, ManifoldFn&& manifold_fn) {
+    return sweep_packs(c_.scratch, c_.first_colour, c_.last_colour, backward, true, pack_fn,
+                       manifold_fn);
+  }
   // Whether this thread does the island's serial parts (the contacts, in order).
   bool lead() const {
     return !team_ || thread_ == 0;
@@ -617,6 +703,7 @@ class SerialIsland {
   std::span<JointTree> trees_;  // the components' joints solved directly (joint_tree.h), if so
   bool one_sweep_solves_ = false;
   bool contacts_through_tree_ = false;  // a contact acts on a body of the island's trees
+  bool coloured_contacts_ = false;      // its contacts are visited colour by colour
   bool joint_terms_current_ = false;
   std::uint64_t reductions_ = 0;
   double moved_for_ = 0;  // s: the moves so far this step
@@ -635,7 +722,9 @@ IslandContext island_context(StepScratch& s, const WorldSettings& settings, std:
       s.first_component[i + 1] - s.first_component[i],
       s,
       settings,
-      s.body_of};
+      s.body_of,
+      s.island_colour_begin[i],
+      s.island_colour_begin[i + 1]};
 }
 
 // advance_with's parts for up to kWideLanes small islands of the same recipe (soft with the
@@ -846,14 +935,14 @@ double visit_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bo
 // The step's packs where it sweeps them, else the rows.
 template <class PackFn, class ManifoldFn>
 double sweep_packs(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                   bool solo, PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce = true) {
+                   bool solo, PackFn&& pack_fn, ManifoldFn&& manifold_fn, bool reduce) {
   return visit_colours(s, first, last, backward, s.packed, solo, pack_fn, manifold_fn, reduce);
 }
 
 // fn(row ids of a manifold) for every manifold, through the rows.
 template <class Fn>
 double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
-                     bool solo, Fn&& fn, bool reduce = true) {
+                     bool solo, Fn&& fn, bool reduce) {
   return visit_colours(
       s, first, last, backward, false, solo, [](const ContactPack&) { return 0.0; },
       [&](const ManifoldRows& m) { return fn(std::span<const std::uint32_t>(m.ids, m.count)); },
@@ -1213,7 +1302,7 @@ void World::solve_islands(double dt) {
     team_for_dynamic(work, [&](std::int64_t k) {
       const std::span<const std::uint32_t> islands =
           std::span(s.work_islands).subspan(s.work_begin[k], s.work_begin[k + 1] - s.work_begin[k]);
-      if (islands.size() == 1 && coloured(islands[0])) {
+      if (islands.size() == 1 && coloured(islands[0]) && s.reports[islands[0]].joints == 0) {
         const IslandContext context = island_context(s, settings_, islands[0]);
         TeamIsland alone(context, s.island_colour_begin[islands[0]],
                          s.island_colour_begin[islands[0] + 1], &s.reports[islands[0]], true);

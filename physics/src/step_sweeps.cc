@@ -71,21 +71,25 @@ void World::group_for_sweeps() {
     s.island_manifold_begin.push_back(static_cast<std::uint32_t>(s.island_manifolds.size()));
   }
 
-  // Large iterative islands are coloured for the team; the others go one island per thread.
+  // Large iterative islands are coloured for the team; the others go one island per thread. A
+  // large island with joints (not exact) is coloured too, for its contacts' sweeps in packs, but
+  // stays one thread's (SerialIsland: its joints are not solved colour by colour).
   s.colouring.clear();
   s.island_colour_begin.assign(1, 0);
   s.team_islands.clear();
   s.single_islands.clear();
   for (std::size_t i = 0; i < islands; ++i) {
     const std::uint32_t links = s.islands.link_begin[i + 1] - s.islands.link_begin[i];
-    if (links >= kColouredIsland && s.reports[i].solver != IslandSolver::kExact &&
-        s.reports[i].joints == 0) {
+    const IslandReport& report = s.reports[i];
+    const bool coloured =
+        links >= kColouredIsland && report.solver != IslandSolver::kExact && !report.exact_joints;
+    if (coloured)
       colour_manifolds(std::span(s.islands.links).subspan(s.islands.link_begin[i], links),
                        s.colours, &s.colouring_scratch, &s.colouring);
+    if (coloured && report.joints == 0)
       s.team_islands.push_back(static_cast<std::uint32_t>(i));
-    } else {
+    else
       s.single_islands.push_back(static_cast<std::uint32_t>(i));
-    }
     s.island_colour_begin.push_back(static_cast<std::uint32_t>(s.colouring.colour_count()));
   }
 
