@@ -198,6 +198,78 @@ template <class Fn>
 double sweep_colours(StepScratch& s, std::uint32_t first, std::uint32_t last, bool backward,
                      bool solo, Fn&& fn, bool reduce = true);
 
+// The contacts of a coloured island (its colours [first, last) in StepScratch::colouring), visited
+// colour by colour: the colours' packs where the step sweeps them (contact_packs.h), else their
+// manifolds' rows in the same order (the same bits). By the whole team, or by one thread (`solo`).
+struct ColouredContacts {
+  StepScratch& s;
+  std::uint32_t first, last;
+  bool solo;
+
+  void warm_start(bool keep_last_substep, double kinematic_time) {
+    sweep_packs(
+        s, first, last, false, solo,
+        [&](ContactPack& pack) {
+          tumble::warm_start(pack, s.bodies, keep_last_substep, kinematic_time);
+          return 0.0;
+        },
+        [&](const ManifoldRows& manifold) {
+          tumble::warm_start(s.rows, s.cold_rows, std::span(manifold.ids, manifold.count), s.bodies,
+                             keep_last_substep, kinematic_time);
+          return 0.0;
+        },
+        false);
+  }
+  void refresh_separations(double kinematic_time) {
+    sweep_packs(
+        s, first, last, false, solo,
+        [&](ContactPack& pack) {
+          update_separations(pack, s.bodies, kinematic_time);
+          return 0.0;
+        },
+        [&](const ManifoldRows& manifold) {
+          update_separations(s.rows, std::span(manifold.ids, manifold.count), s.bodies,
+                             kinematic_time);
+          return 0.0;
+        },
+        false);
+  }
+  // The largest velocity change, on every thread.
+  double sweep(const SolverSettings& settings, const Softness* soft, double h, bool backward) {
+    return sweep_packs(
+        s, first, last, backward, solo,
+        [&](ContactPack& pack) { return solve_pack(pack, kAllLanes, s.bodies, settings, soft, h); },
+        [&](const ManifoldRows& manifold) {
+          return solve_manifold(s.rows, manifold, s.blocks, s.bodies, settings, soft, h);
+        });
+  }
+  // The packs give the rows their impulses (for restitution and the pair records); returns the
+  // normal residual, on every thread.
+  double store_impulses(double h, double kinematic_time) {
+    return sweep_packs(
+        s, first, last, false, solo,
+        [&](const ContactPack& pack) {
+          tumble::store_impulses(pack, s.rows, s.cold_rows);
+          double lane_residuals[kWideLanes];
+          pack_residuals(pack, s.bodies, h, lane_residuals, kinematic_time);
+          return *std::max_element(std::begin(lane_residuals), std::end(lane_residuals));
+        },
+        [&](const ManifoldRows& manifold) {
+          return normal_residual(s.rows, std::span(manifold.ids, manifold.count), s.bodies, h,
+                                 kinematic_time);
+        });
+  }
+  void apply_restitution(const SolverSettings& settings) {
+    sweep_colours(
+        s, first, last, false, solo,
+        [&](std::span<const std::uint32_t> ids) {
+          tumble::apply_restitution(s.rows, s.cold_rows, ids, s.blocks, s.bodies, settings);
+          return 0.0;
+        },
+        false);
+  }
+};
+
 // advance_with's parts for one island on one thread (any island: exact, soft, pgs), or, for an
 // island of several joint components (`team`), on the whole team: every thread calls every
 // member; each solves its share of the components' joints (components share no moving body, and
@@ -324,17 +396,7 @@ class SerialIsland {
   }
   void refresh_separations() {
     if (lead() && coloured_contacts_) {
-      visit_contacts(
-          false,
-          [&](ContactPack& pack) {
-            update_separations(pack, bodies_, kinematic_time());
-            return 0.0;
-          },
-          [&](const ManifoldRows& manifold) {
-            update_separations(rows_, std::span(manifold.ids, manifold.count), bodies_,
-                               kinematic_time());
-            return 0.0;
-          });
+      coloured().refresh_separations(kinematic_time());
     } else if (lead()) {
       update_separations(rows_, c_.rows, bodies_, kinematic_time());
     }
@@ -362,17 +424,7 @@ class SerialIsland {
     }
     if (team_) c_.scratch.barrier.wait();
     if (lead() && coloured_contacts_) {
-      visit_contacts(
-          false,
-          [&](ContactPack& pack) {
-            tumble::warm_start(pack, bodies_, keep_last_substep, kinematic_time());
-            return 0.0;
-          },
-          [&](const ManifoldRows& manifold) {
-            tumble::warm_start(rows_, cold_, std::span(manifold.ids, manifold.count), bodies_,
-                               keep_last_substep, kinematic_time());
-            return 0.0;
-          });
+      coloured().warm_start(keep_last_substep, kinematic_time());
     } else if (lead()) {
       tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep, kinematic_time());
     }
@@ -421,15 +473,7 @@ class SerialIsland {
     if (c_.rows.empty()) return change;
     double contacts = 0;
     if (lead() && coloured_contacts_) {
-      contacts = visit_contacts(
-          backward,
-          [&](ContactPack& pack) {
-            return solve_pack(pack, kAllLanes, bodies_, c_.settings.solver, soft, h);
-          },
-          [&](const ManifoldRows& manifold) {
-            return solve_manifold(rows_, manifold, c_.scratch.blocks, bodies_, c_.settings.solver,
-                                  soft, h);
-          });
+      contacts = coloured().sweep(c_.settings.solver, soft, h, backward);
     } else if (lead()) {
       contacts = solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver,
                                 soft, h, backward);
@@ -537,19 +581,7 @@ class SerialIsland {
   void finish(
       double h, Move move = [] {}) {
     if (lead() && coloured_contacts_) {
-      // The packs give the rows their impulses, for the residual and restitution.
-      report_->residual = visit_contacts(
-          false,
-          [&](const ContactPack& pack) {
-            store_impulses(pack, rows_, cold_);
-            double lane_residuals[kWideLanes];
-            pack_residuals(pack, bodies_, h, lane_residuals, kinematic_time());
-            return *std::max_element(std::begin(lane_residuals), std::end(lane_residuals));
-          },
-          [&](const ManifoldRows& manifold) {
-            return normal_residual(rows_, std::span(manifold.ids, manifold.count), bodies_, h,
-                                   kinematic_time());
-          });
+      report_->residual = coloured().store_impulses(h, kinematic_time());
     } else if (lead()) {
       report_->residual = normal_residual(rows_, c_.rows, bodies_, h, kinematic_time());
     }
@@ -558,19 +590,12 @@ class SerialIsland {
     if (lead()) apply_restitution();
   }
   void apply_restitution() {
-    if (!coloured_contacts_) {
-      tumble::apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_,
-                                c_.settings.solver);
+    if (coloured_contacts_) {
+      coloured().apply_restitution(c_.settings.solver);
       return;
     }
-    sweep_colours(
-        c_.scratch, c_.first_colour, c_.last_colour, false, true,
-        [&](std::span<const std::uint32_t> ids) {
-          tumble::apply_restitution(rows_, cold_, ids, c_.scratch.blocks, bodies_,
-                                    c_.settings.solver);
-          return 0.0;
-        },
-        false);
+    tumble::apply_restitution(rows_, cold_, c_.rows, c_.scratch.blocks, bodies_,
+                              c_.settings.solver);
   }
 
  private:
@@ -637,13 +662,10 @@ class SerialIsland {
     if (contacts_through_tree_) target.h = 0;
     return target;
   }
-  // A coloured island's contacts (IslandContext::first_colour), visited colour by colour on the
-  // lead thread: its packs where the step sweeps them, else its manifolds in the same order (the
-  // same bits: visit_colours).
-  template <class PackFn, class ManifoldFn>
-  double visit_contacts(bool backward, PackFn&& pack_fn, ManifoldFn&& manifold_fn) {
-    return sweep_packs(c_.scratch, c_.first_colour, c_.last_colour, backward, true, pack_fn,
-                       manifold_fn);
+  // A coloured island's contacts (IslandContext::first_colour): the lead thread's alone, in the
+  // colours' order.
+  ColouredContacts coloured() const {
+    return {c_.scratch, c_.first_colour, c_.last_colour, true};
   }
   // Whether this thread does the island's serial parts (the contacts, in order).
   bool lead() const {
@@ -1078,66 +1100,21 @@ class TeamIsland {
   }
   double kinematic_time() const { return s_.kinematic_contacts ? moved_for_ : 0.0; }
   // The packs solve; the rows take their impulses at the end, for the residual and restitution.
-  void refresh_separations() {
-    sweep_packs(
-        s_, first_, last_, false, solo_,
-        [&](ContactPack& pack) {
-          update_separations(pack, s_.bodies, kinematic_time());
-          return 0.0;
-        },
-        [&](const ManifoldRows& manifold) {
-          update_separations(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies,
-                             kinematic_time());
-          return 0.0;
-        },
-        false);
-  }
+  void refresh_separations() { contacts().refresh_separations(kinematic_time()); }
   void warm_start(bool keep_last_substep) {
-    sweep_packs(
-        s_, first_, last_, false, solo_,
-        [&](ContactPack& pack) {
-          tumble::warm_start(pack, s_.bodies, keep_last_substep, kinematic_time());
-          return 0.0;
-        },
-        [&](const ManifoldRows& manifold) {
-          tumble::warm_start(s_.rows, s_.cold_rows, std::span(manifold.ids, manifold.count),
-                             s_.bodies, keep_last_substep, kinematic_time());
-          return 0.0;
-        },
-        false);
+    contacts().warm_start(keep_last_substep, kinematic_time());
   }
   double sweep(const Softness* soft, double h, bool backward) {
     ++iterations_;
-    return sweep_packs(
-        s_, first_, last_, backward, solo_,
-        [&](ContactPack& pack) {
-          return solve_pack(pack, kAllLanes, s_.bodies, c_.settings.solver, soft, h);
-        },
-        [&](const ManifoldRows& manifold) {
-          return solve_manifold(s_.rows, manifold, s_.blocks, s_.bodies, c_.settings.solver, soft,
-                                h);
-        });
+    return contacts().sweep(c_.settings.solver, soft, h, backward);
   }
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
     // One pass over the packs for both: a large island's packs come from memory each pass.
-    const double residual = sweep_packs(
-        s_, first_, last_, false, solo_,
-        [&](const ContactPack& pack) {
-          store_impulses(pack, s_.rows, s_.cold_rows);
-          double lane_residuals[kWideLanes];
-          pack_residuals(pack, s_.bodies, h, lane_residuals, kinematic_time());
-          return *std::max_element(std::begin(lane_residuals), std::end(lane_residuals));
-        },
-        [&](const ManifoldRows& manifold) {
-          return normal_residual(s_.rows, std::span(manifold.ids, manifold.count), s_.bodies, h,
-                                 kinematic_time());
-        });
+    const double residual = contacts().store_impulses(h, kinematic_time());
     move();
-    each_manifold([&](std::span<const std::uint32_t> ids) {
-      apply_restitution(s_.rows, s_.cold_rows, ids, s_.blocks, s_.bodies, c_.settings.solver);
-    });
+    contacts().apply_restitution(c_.settings.solver);
 #pragma omp atomic
     report_->gyroscopic_limit_hits += hits_;
     if (solo_ || omp_get_thread_num() == 0) {
@@ -1147,15 +1124,8 @@ class TeamIsland {
   }
 
  private:
-  template <class Fn>
-  void each_manifold(Fn&& fn) {
-    sweep_colours(
-        s_, first_, last_, false, solo_,
-        [&](std::span<const std::uint32_t> ids) {
-          fn(ids);
-          return 0.0;
-        },
-        false);
+  ColouredContacts contacts() const {
+    return {s_, first_, last_, solo_};
   }
   const IslandContext& c_;
   StepScratch& s_;
