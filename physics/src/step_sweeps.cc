@@ -143,7 +143,9 @@ void World::group_for_sweeps() {
   stats_.manifolds = static_cast<std::uint32_t>(contacts_.size());
   stats_.contact_points = static_cast<std::uint32_t>(s.rows.size());
   stats_.islands = static_cast<std::uint32_t>(islands);
-  stats_.coloured_islands = static_cast<std::uint32_t>(s.team_islands.size());
+  stats_.coloured_islands = 0;
+  for (std::size_t i = 0; i < islands; ++i)
+    stats_.coloured_islands += s.island_colour_begin[i + 1] > s.island_colour_begin[i] ? 1 : 0;
   stats_.colours = static_cast<std::uint32_t>(s.colouring.colour_count());
   for (std::size_t c = 0; c < s.colouring.colour_count(); ++c)
     if (s.colouring.serial[c])

@@ -89,8 +89,9 @@ struct StepStats {
   std::uint64_t step = 0;  // steps taken so far, this one included
   std::uint32_t pairs = 0, manifolds = 0, contact_points = 0;
   std::uint32_t islands = 0, exact_islands = 0, iterative_islands = 0;
-  // Large islands split over the team by graph colouring: how many, their colours in all, and
-  // the manifolds left to the serial overflow colour.
+  // Large islands split over the team by graph colouring (and large jointed islands, whose
+  // contacts are swept colour by colour on one thread): how many, their colours in all, and the
+  // manifolds left to the serial overflow colour.
   std::uint32_t coloured_islands = 0, colours = 0, overflow_manifolds = 0;
   // Coloured islands solved by one thread beside the others, colour by colour, the same bits:
   // too small to give each thread of the team 32 manifolds (each colour costs the team a barrier).
