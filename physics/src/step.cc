@@ -295,7 +295,6 @@ class SerialIsland {
         !trees_.empty() && std::any_of(c.rows.begin(), c.rows.end(), [&](std::uint32_t id) {
           return trees_[0].holds(c.scratch.rows[id].a) || trees_[0].holds(c.scratch.rows[id].b);
         });
-    coloured_contacts_ = c.last_colour > c.first_colour;
     // Only the trees' own rows: their solve is exact, and a second sweep would find it so (unless
     // one holds stiffness: JointTree::stiffened).
     one_sweep_solves_ = !trees_.empty() && c.rows.empty() &&
@@ -395,7 +394,7 @@ class SerialIsland {
     joint_terms_current_ = false;
   }
   void refresh_separations() {
-    if (lead() && coloured_contacts_) {
+    if (lead() && coloured_contacts()) {
       coloured().refresh_separations(kinematic_time());
     } else if (lead()) {
       update_separations(rows_, c_.rows, bodies_, kinematic_time());
@@ -423,7 +422,7 @@ class SerialIsland {
       }
     }
     if (team_) c_.scratch.barrier.wait();
-    if (lead() && coloured_contacts_) {
+    if (lead() && coloured_contacts()) {
       coloured().warm_start(keep_last_substep, kinematic_time());
     } else if (lead()) {
       tumble::warm_start(rows_, cold_, c_.rows, bodies_, keep_last_substep, kinematic_time());
@@ -472,7 +471,7 @@ class SerialIsland {
     if (one_sweep_solves_ && !any_stiff) return 0;
     if (c_.rows.empty()) return change;
     double contacts = 0;
-    if (lead() && coloured_contacts_) {
+    if (lead() && coloured_contacts()) {
       contacts = coloured().sweep(c_.settings.solver, soft, h, backward);
     } else if (lead()) {
       contacts = solve_contacts(rows_, c_.rows, c_.scratch.blocks, bodies_, c_.settings.solver,
@@ -580,7 +579,7 @@ class SerialIsland {
   template <class Move = void (*)()>
   void finish(
       double h, Move move = [] {}) {
-    if (lead() && coloured_contacts_) {
+    if (lead() && coloured_contacts()) {
       report_->residual = coloured().store_impulses(h, kinematic_time());
     } else if (lead()) {
       report_->residual = normal_residual(rows_, c_.rows, bodies_, h, kinematic_time());
@@ -590,7 +589,7 @@ class SerialIsland {
     if (lead()) apply_restitution();
   }
   void apply_restitution() {
-    if (coloured_contacts_) {
+    if (coloured_contacts()) {
       coloured().apply_restitution(c_.settings.solver);
       return;
     }
@@ -662,6 +661,10 @@ class SerialIsland {
     if (contacts_through_tree_) target.h = 0;
     return target;
   }
+  // Whether its contacts are visited colour by colour (IslandContext::first_colour).
+  bool coloured_contacts() const {
+    return c_.last_colour > c_.first_colour;
+  }
   // A coloured island's contacts (IslandContext::first_colour): the lead thread's alone, in the
   // colours' order.
   ColouredContacts coloured() const {
@@ -725,7 +728,6 @@ class SerialIsland {
   std::span<JointTree> trees_;  // the components' joints solved directly (joint_tree.h), if so
   bool one_sweep_solves_ = false;
   bool contacts_through_tree_ = false;  // a contact acts on a body of the island's trees
-  bool coloured_contacts_ = false;      // its contacts are visited colour by colour
   bool joint_terms_current_ = false;
   std::uint64_t reductions_ = 0;
   double moved_for_ = 0;  // s: the moves so far this step

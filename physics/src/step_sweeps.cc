@@ -83,6 +83,7 @@ void World::group_for_sweeps() {
     const IslandReport& report = s.reports[i];
     const bool coloured =
         links >= kColouredIsland && report.solver != IslandSolver::kExact && !report.exact_joints;
+    stats_.coloured_islands += coloured ? 1 : 0;
     if (coloured)
       colour_manifolds(std::span(s.islands.links).subspan(s.islands.link_begin[i], links),
                        s.colours, &s.colouring_scratch, &s.colouring);
@@ -143,9 +144,6 @@ void World::group_for_sweeps() {
   stats_.manifolds = static_cast<std::uint32_t>(contacts_.size());
   stats_.contact_points = static_cast<std::uint32_t>(s.rows.size());
   stats_.islands = static_cast<std::uint32_t>(islands);
-  stats_.coloured_islands = 0;
-  for (std::size_t i = 0; i < islands; ++i)
-    stats_.coloured_islands += s.island_colour_begin[i + 1] > s.island_colour_begin[i] ? 1 : 0;
   stats_.colours = static_cast<std::uint32_t>(s.colouring.colour_count());
   for (std::size_t c = 0; c < s.colouring.colour_count(); ++c)
     if (s.colouring.serial[c])
