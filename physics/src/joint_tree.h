@@ -69,8 +69,8 @@ class JointTree {
   // barely turned); the first pass after a move must refactor. With `velocity_substep` > 0 (and
   // no motor in the tree: its row is a velocity row alone), the pass's factors may serve the
   // velocity sweeps too, where no body takes stiffness for a substep of that length (their
-  // systems are then the same: the same rows and masses; the passes after it move the bodies by a
-  // millionth of this one's correction): settle_velocity_factors says after the last pass.
+  // systems are then the same: the same rows and masses; the passes after it correct about the
+  // square of this one's correction): settle_velocity_factors says after the last pass.
   // With `bounds`, a refactoring pass holds the limits and cones the poses are past by more than
   // `bound_slack` (position_equations). Returns the largest error it corrected (its targets'
   // largest, m or rad; infinity where the solve gave no finite answer and nothing moved): a Newton
@@ -78,6 +78,9 @@ class JointTree {
   double solve_positions(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                          std::span<Pose> poses, bool refactor, double velocity_substep = 0,
                          bool bounds = true, double bound_slack = 0);
+  // Whether the last refactoring pass's factors are to serve the velocity sweeps (pending the
+  // settle after the passes).
+  bool velocity_factors_pending() const { return share_pending_; }
   // After a move's position passes: whether the factors of the pass given velocity_substep h serve
   // the velocity sweeps (no body takes stiffness at the poses the passes left). Where some body
   // does, and `keep_stiffness`, the stiffness worked out here is the next velocity factoring's

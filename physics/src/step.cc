@@ -169,7 +169,14 @@ void team_integrate_positions(const IslandContext& c, double h, bool solo) {
 // (joint_tree.h), the first two passes are Newton steps and the last reuses the second's rows (on
 // a chain of 20 dropped from the horizontal: 7e-6 m at worst, 1.8e-7 m refactoring every pass,
 // for a fifth less time); the first also holds the limits and cones the poses are past (the
-// second's rows are the velocity sweeps' too, which hold no bound).
+// second's rows are the velocity sweeps' too, which hold no bound). Where the first held none and
+// corrected less than kNewtonAfter (the curvature targets leave a swinging chain ~1e-6 m open
+// after a move), its rows are the sweeps' and the second is a chord step through them: it leaves
+// what a Newton step would (3e-16 m against 2e-11 corrected on chain:100), the sweeps' rows are
+// one pass old (turned by ~1e-5 rad, which the next move's passes close), and a factoring a
+// substep is saved (chain:100, 4.86 M -> 4.28 M instructions a step). Not where the last sweeps
+// stiffened the tree: its factors are not the sweeps' there, and a chord step through a heavy
+// chain's ill-conditioned rows contracts less (1:1000, 5e-12 m -> 4e-9).
 constexpr int kJointPositionPasses = 3;
 constexpr int kJointRefactoredPasses = 2;
 static_assert(kJointRefactoredPasses >= 1, "the first pass after a move refactors");
@@ -373,14 +380,19 @@ class SerialIsland {
           if (pass >= kJointRefactoredPasses && corrected < kSettledJointError) break;
           const bool later_newton =
               pass == kJointRefactoredPasses && contacts_through_tree_ && corrected > kNewtonAfter;
-          const bool newton = pass < kJointRefactoredPasses || later_newton;
+          JointTree& tree = trees_[component];
+          const bool first_shares = !contacts_through_tree_ && !tree.stiffened();
+          const bool chord_second = pass == 1 && first_shares && corrected < kNewtonAfter &&
+                                    tree.velocity_factors_pending();
+          const bool newton = (pass < kJointRefactoredPasses && !chord_second) || later_newton;
           const bool later_bounds = pass == 1 && contacts_through_tree_;
           // The last refactored pass (and a later Newton one) factors the velocity sweeps'
           // system too (joint_tree.h).
-          corrected = trees_[component].solve_positions(
-              c_.scratch.joint_rows, bodies_, c_.scratch.poses, newton,
-              pass == kJointRefactoredPasses - 1 || later_newton ? h : 0.0,
-              pass == 0 || later_bounds, later_bounds ? kLaterBoundSlack : 0.0);
+          const bool for_sweeps =
+              pass == kJointRefactoredPasses - 1 || later_newton || (pass == 0 && first_shares);
+          corrected = tree.solve_positions(c_.scratch.joint_rows, bodies_, c_.scratch.poses, newton,
+                                           for_sweeps ? h : 0.0, pass == 0 || later_bounds,
+                                           later_bounds ? kLaterBoundSlack : 0.0);
           continue;
         }
         for (std::uint32_t j : joints_of(component))
