@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <span>
 
 #include "contact_solver.h"
@@ -11,6 +12,7 @@
 #include "joint_state.h"
 #include "physics/math.h"
 #include "rotation.h"
+#include "rough_atan2.h"
 
 namespace tumble::joint_detail {
 
@@ -153,6 +155,20 @@ inline double hinge_angle(const Joint& joint, const Quat& qa, const Quat& qb) {
   return std::atan2(axis.dot(ref_a.cross(ref_b)), ref_a.dot(ref_b));
 }
 
+// A ball's twist (free_coordinate) as the sine and cosine its atan2 takes; false where it has
+// none (the axes opposite). `mean`: the sum of the axes, about which the twist turns.
+inline bool twist_sine_cosine(const Joint& joint, const Quat& qa, const Quat& qb, double* sine,
+                              double* cosine, Vec3* mean) {
+  const Vec3 axis_a = qa * joint.axis_a, axis_b = qb * joint.axis_b;
+  *mean = axis_a + axis_b;
+  if (!(mean->norm() > 1e-6)) return false;
+  const Quat swing = Quat::FromTwoVectors(axis_b, axis_a);
+  const Vec3 ref_a = qa * joint.reference_a, ref_b = swing * (qb * joint.reference_b);
+  *sine = axis_a.dot(ref_a.cross(ref_b));
+  *cosine = ref_a.dot(ref_b);
+  return true;
+}
+
 inline FreeCoordinate free_coordinate(const Joint& joint, const Pose& pose_a, const Pose& pose_b,
                                       bool world_b) {
   FreeCoordinate c;
@@ -172,13 +188,11 @@ inline FreeCoordinate free_coordinate(const Joint& joint, const Pose& pose_a, co
     case JointKind::kBall: {
       // The twist: b's reference turned back by the swing that takes b's axis onto a's, measured
       // about a's axis; its rate about the axes' mean (the twist's axis halfway through the swing).
-      const Vec3 axis_a = qa * joint.axis_a, axis_b = qb * joint.axis_b;
-      const Vec3 mean = axis_a + axis_b;
-      if (!(mean.norm() > 1e-6)) return c;
-      const Quat swing = Quat::FromTwoVectors(axis_b, axis_a);
-      const Vec3 ref_a = qa * joint.reference_a, ref_b = swing * (qb * joint.reference_b);
+      double sine = 0, cosine = 0;
+      Vec3 mean;
+      if (!twist_sine_cosine(joint, qa, qb, &sine, &cosine, &mean)) return c;
       c.exists = true;
-      c.position = std::atan2(axis_a.dot(ref_a.cross(ref_b)), ref_a.dot(ref_b));
+      c.position = std::atan2(sine, cosine);
       const Vec3 twist_axis = mean.normalized();
       c.row.angular_a = -twist_axis;
       c.row.angular_b = twist_axis;
@@ -231,6 +245,40 @@ inline Swing swing_of(const Joint& joint, const Quat& qa, const Quat& qb) {
   s.row.angular_a = -n / sine;
   s.row.angular_b = n / sine;
   return s;
+}
+
+// The free coordinate's angle of a hinge or ball to within 1.2e-5 rad (rough_atan2), for decisions
+// clearly away from a limit; NaN for other joints, or where free_coordinate has none.
+inline double rough_coordinate_angle(const Joint& joint, const Quat& qa, const Quat& qb) {
+  if (joint.kind == JointKind::kHinge) {
+    const Vec3 axis = qa * joint.axis_a;
+    const Vec3 ref_a = qa * joint.reference_a, ref_b = qb * joint.reference_b;
+    return rough_atan2(axis.dot(ref_a.cross(ref_b)), ref_a.dot(ref_b));
+  }
+  double sine = 0, cosine = 0;
+  Vec3 mean;
+  if (joint.kind != JointKind::kBall || !twist_sine_cosine(joint, qa, qb, &sine, &cosine, &mean))
+    return std::numeric_limits<double>::quiet_NaN();
+  return rough_atan2(sine, cosine);
+}
+
+// Whether the free coordinate is clearly within the limit widened by `slack` on both sides (by
+// more than the rough angle's margin): then it is not past it by more than the slack (nor past it
+// at all with no slack), as the exact angle would say. False where that takes the exact angle.
+inline bool clearly_within_limit(const Joint& joint, const Quat& qa, const Quat& qb, double slack) {
+  if (joint.limit.lower == joint.limit.upper) return false;  // locked: held wherever it is
+  const double angle = rough_coordinate_angle(joint, qa, qb);
+  return angle >= joint.limit.lower - slack + kRoughAngleMargin &&
+         angle <= joint.limit.upper + slack - kRoughAngleMargin;
+}
+
+// Whether a ball's lean is clearly within its cone widened by `slack` (swing_of's angle, rough):
+// also where it has no lean (swing_of: exists false), which no cone bounds.
+inline bool clearly_within_cone(const Joint& joint, const Quat& qa, const Quat& qb, double slack) {
+  const Vec3 axis_a = qa * joint.axis_a, axis_b = qb * joint.axis_b;
+  const double sine = axis_a.cross(axis_b).norm();
+  if (!(sine > 1e-9)) return true;
+  return rough_atan2(sine, axis_a.dot(axis_b)) <= joint.max_swing + slack - kRoughAngleMargin;
 }
 
 // What a joint's rows do as a distance joint with neither spring nor range: a rigid rod.

@@ -381,12 +381,14 @@ double joint_error(const Joint& joint, const Pose& pose_a, const Pose& pose_b) {
   const Quat qb = world_b ? Quat::Identity() : pose_b.orientation;
   const Anchors anchors = anchors_of(joint, pose_a, pose_b, world_b);
   const Vec3 d = anchors.pb - anchors.pa;
+  // (A bound the poses are clearly within adds nothing: no exact angle; rough_atan2.h.)
   double bounds = 0;
-  if (joint.limit.enabled) {
+  if (joint.limit.enabled && !clearly_within_limit(joint, pose_a.orientation, qb, 0)) {
     const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
     if (c.exists) bounds = limit_violation(joint, c.position);
   }
-  if (joint.kind == JointKind::kBall && joint.max_swing < std::numbers::pi) {
+  if (joint.kind == JointKind::kBall && joint.max_swing < std::numbers::pi &&
+      !clearly_within_cone(joint, pose_a.orientation, qb, 0)) {
     const Swing swing = swing_of(joint, pose_a.orientation, qb);
     if (swing.exists) bounds = std::max(bounds, swing.angle - joint.max_swing);
   }
@@ -617,7 +619,10 @@ void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses,
     e.target[i] = -past;
   };
   if (choose) *which = 0;
-  if (has_cone(joint) && (choose || (*which & kConeRow))) {
+  // Choosing, a bound the poses are clearly short of (rough_atan2.h) is not past it: no exact
+  // angle, no row.
+  if (has_cone(joint) && (choose || (*which & kConeRow)) &&
+      !(choose && clearly_within_cone(joint, pose_a.orientation, pose_b.orientation, slack))) {
     const Swing swing = swing_of(joint, pose_a.orientation, pose_b.orientation);
     const double over = swing.exists ? swing.angle - joint.max_swing : 0.0;
     if (!choose || (swing.exists && over > slack && e.rows < 6)) {
@@ -625,7 +630,8 @@ void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses,
       if (choose) *which |= kConeRow;
     }
   }
-  if (joint.limit.enabled && (choose || (*which & kLimitRow))) {
+  if (joint.limit.enabled && (choose || (*which & kLimitRow)) &&
+      !(choose && clearly_within_limit(joint, pose_a.orientation, pose_b.orientation, slack))) {
     const FreeCoordinate c = free_coordinate(joint, pose_a, pose_b, world_b);
     const bool locked = joint.limit.lower == joint.limit.upper;
     double past = 0;  // signed as the coordinate
