@@ -109,5 +109,43 @@ TEST(RoughAngles, ClearlyWithinIsNeverWrong) {
   EXPECT_GT(unclear, 1000);
 }
 
+// The rough free coordinates beside the exact ones over random relative turns: a hinge's angle
+// and a ball's twist, within the arctangent's bound (apart on the circle: at the cut, +-pi, the
+// two may fall on opposite sides).
+TEST(RoughAngles, RoughCoordinatesAreWithinTheBoundOfTheExactOnes) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  Joint ball;
+  ball.kind = JointKind::kBall;
+  ball.axis_a = Vec3(1, 2, 2) / 3;
+  ball.axis_b = Vec3(0, 0.6, 0.8);
+  ball.reference_a = Vec3(2, -1, 0).normalized();
+  ball.reference_b = Vec3(1, 0, 0);
+  Joint hinge = ball;
+  hinge.kind = JointKind::kHinge;
+  auto apart = [](double x, double y) {
+    const double d = std::abs(x - y);
+    return std::min(d, 2 * kPi - d);
+  };
+  double worst_twist = 0, worst_hinge = 0;
+  for (int trial = 0; trial < 100000; ++trial) {
+    const Quat qa = Quat(unit(random), unit(random), unit(random), unit(random)).normalized();
+    const Quat qb = Quat(unit(random), unit(random), unit(random), unit(random)).normalized();
+    const Pose pa{Vec3::Zero(), qa}, pb{Vec3::Zero(), qb};
+    const joint_detail::FreeCoordinate twist = joint_detail::free_coordinate(ball, pa, pb, false);
+    const double rough_twist = joint_detail::rough_coordinate_angle(ball, qa, qb);
+    ASSERT_EQ(twist.exists, !std::isnan(rough_twist));
+    if (twist.exists) worst_twist = std::max(worst_twist, apart(rough_twist, twist.position));
+    worst_hinge = std::max(worst_hinge, apart(joint_detail::rough_coordinate_angle(hinge, qa, qb),
+                                              joint_detail::hinge_angle(hinge, qa, qb)));
+  }
+  EXPECT_LT(worst_twist, 1.2e-5);
+  EXPECT_LT(worst_hinge, 1.2e-5);
+  Joint slider = hinge;
+  slider.kind = JointKind::kSlider;
+  EXPECT_TRUE(
+      std::isnan(joint_detail::rough_coordinate_angle(slider, Quat::Identity(), Quat::Identity())));
+}
+
 }  // namespace
 }  // namespace tumble

@@ -265,6 +265,9 @@ inline double rough_coordinate_angle(const Joint& joint, const Quat& qa, const Q
 // Whether the free coordinate is clearly within the limit widened by `slack` on both sides (by
 // more than the rough angle's margin): then it is not past it by more than the slack (nor past it
 // at all with no slack), as the exact angle would say. False where that takes the exact angle.
+// (Angle limits lie within [-pi, pi] (joint.cc): an angle within the margin of the arctangent's
+// cut at +-pi, where the rough and the exact one may fall on opposite sides, is never clearly
+// within one.)
 inline bool clearly_within_limit(const Joint& joint, const Quat& qa, const Quat& qb, double slack) {
   if (joint.limit.lower == joint.limit.upper) return false;  // locked: held wherever it is
   const double angle = rough_coordinate_angle(joint, qa, qb);
