@@ -148,11 +148,20 @@ struct FreeCoordinate {
   AxialRow row;
 };
 
-// b's turn about the axis from a, measured between the reference directions.
-inline double hinge_angle(const Joint& joint, const Quat& qa, const Quat& qb) {
+// A hinge's angle (hinge_angle) as the sine and cosine its atan2 takes.
+inline void hinge_sine_cosine(const Joint& joint, const Quat& qa, const Quat& qb, double* sine,
+                              double* cosine) {
   const Vec3 axis = qa * joint.axis_a;
   const Vec3 ref_a = qa * joint.reference_a, ref_b = qb * joint.reference_b;
-  return std::atan2(axis.dot(ref_a.cross(ref_b)), ref_a.dot(ref_b));
+  *sine = axis.dot(ref_a.cross(ref_b));
+  *cosine = ref_a.dot(ref_b);
+}
+
+// b's turn about the axis from a, measured between the reference directions.
+inline double hinge_angle(const Joint& joint, const Quat& qa, const Quat& qb) {
+  double sine = 0, cosine = 0;
+  hinge_sine_cosine(joint, qa, qb, &sine, &cosine);
+  return std::atan2(sine, cosine);
 }
 
 // A ball's twist (free_coordinate) as the sine and cosine its atan2 takes; false where it has
@@ -250,14 +259,12 @@ inline Swing swing_of(const Joint& joint, const Quat& qa, const Quat& qb) {
 // The free coordinate's angle of a hinge or ball to within 1.2e-5 rad (rough_atan2), for decisions
 // clearly away from a limit; NaN for other joints, or where free_coordinate has none.
 inline double rough_coordinate_angle(const Joint& joint, const Quat& qa, const Quat& qb) {
-  if (joint.kind == JointKind::kHinge) {
-    const Vec3 axis = qa * joint.axis_a;
-    const Vec3 ref_a = qa * joint.reference_a, ref_b = qb * joint.reference_b;
-    return rough_atan2(axis.dot(ref_a.cross(ref_b)), ref_a.dot(ref_b));
-  }
   double sine = 0, cosine = 0;
   Vec3 mean;
-  if (joint.kind != JointKind::kBall || !twist_sine_cosine(joint, qa, qb, &sine, &cosine, &mean))
+  if (joint.kind == JointKind::kHinge)
+    hinge_sine_cosine(joint, qa, qb, &sine, &cosine);
+  else if (joint.kind != JointKind::kBall ||
+           !twist_sine_cosine(joint, qa, qb, &sine, &cosine, &mean))
     return std::numeric_limits<double>::quiet_NaN();
   return rough_atan2(sine, cosine);
 }

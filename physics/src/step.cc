@@ -174,7 +174,7 @@ void team_integrate_positions(const IslandContext& c, double h, bool solo) {
 // after a move), its rows are the sweeps' and the second is a chord step through them: it leaves
 // what a Newton step would (3e-16 m against 2e-11 corrected on chain:100), the sweeps' rows are
 // one pass old (turned by ~1e-5 rad, which the next move's passes close), and a factoring a
-// substep is saved (chain:100, 4.86 M -> 4.28 M instructions a step). Not where the last sweeps
+// substep is saved (chain:100, 4.86 M -> 4.42 M instructions a step). Not where the last sweeps
 // stiffened the tree: its factors are not the sweeps' there, and a chord step through a heavy
 // chain's ill-conditioned rows contracts less (1:1000, 5e-12 m -> 4e-9).
 constexpr int kJointPositionPasses = 3;
@@ -382,8 +382,9 @@ class SerialIsland {
               pass == kJointRefactoredPasses && contacts_through_tree_ && corrected > kNewtonAfter;
           JointTree& tree = trees_[component];
           const bool first_shares = !contacts_through_tree_ && !tree.stiffened();
-          const bool chord_second = pass == 1 && first_shares && corrected < kNewtonAfter &&
-                                    tree.velocity_factors_pending();
+          // (Pending after the first pass only where it was given the substep: first_shares.)
+          const bool chord_second =
+              pass == 1 && corrected < kNewtonAfter && tree.velocity_factors_pending();
           const bool newton = (pass < kJointRefactoredPasses && !chord_second) || later_newton;
           const bool later_bounds = pass == 1 && contacts_through_tree_;
           // The last refactored pass (and a later Newton one) factors the velocity sweeps'
