@@ -379,10 +379,10 @@ int main(int argc, char** argv) {
       const Vec3 to = from + rays[i].max_distance * rays[i].direction.normalized();
       const btVector3 a(from.x(), from.y(), from.z()), b(to.x(), to.y(), to.z());
       btCollisionWorld::ClosestRayResultCallback closest(a, b);
-      // A mesh's triangles hold rays on their fronts only, as ours do. Not for the plane: Bullet
-      // meets a btStaticPlaneShape through two triangles wound downwards, which the filter drops
-      // (every ray that missed the boxes then missed the ground, 80% of them).
-      if (mesh) closest.m_flags |= btTriangleRaycastCallback::kF_FilterBackfaces;
+      // Triangles hold rays on their fronts only, as a mesh's and a heightfield's do in ours. Not
+      // for the plane: Bullet meets a btStaticPlaneShape through two triangles wound downwards,
+      // which the filter drops (every ray that missed the boxes then missed the ground, 80%).
+      if (terrain) closest.m_flags |= btTriangleRaycastCallback::kF_FilterBackfaces;
       bullet.rayTest(a, b, closest);
       bullet_distance[i] =
           closest.hasHit() ? closest.m_closestHitFraction * rays[i].max_distance : INFINITY;
