@@ -185,6 +185,39 @@ TEST(RayCasts, TheTreeFindsWhatEveryBodyTestedFindsAndOnAnyThreadCount) {
   }
 }
 
+TEST(RayCasts, BodiesAsLargeAsTheCrowdFindWhatEveryBodyTestedFinds) {
+  // A slab under the crowd and a wall through it, each as wide as the crowd, and a box half as
+  // wide: the tree gives bodies of a quarter of everything's extent a child of its root, apart
+  // from the small ones (query_index.h). Their hits and the crowd's are still the nearest.
+  Crowd crowd;
+  make_crowd(&crowd, 200, 13);
+  crowd.ids.push_back(add(&crowd.world, BoxDef{Vec3(12, 12, 0.5)}, Vec3(0, 0, -11)));
+  crowd.ids.push_back(add(&crowd.world, BoxDef{Vec3(0.2, 12, 6)}, Vec3(3, 0, 0),
+                          Quat(Eigen::AngleAxisd(0.3, Vec3::UnitZ()))));
+  crowd.ids.push_back(add(&crowd.world, BoxDef{Vec3(6, 2, 2)}, Vec3(-4, 5, 4)));
+  const std::vector<RayCast> rays = random_rays(2000, 17);
+  std::vector<RayHit> hits(rays.size());
+  ASSERT_TRUE(crowd.world.cast_rays(rays, hits).is_ok());
+  int found = 0, on_large = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    std::vector<RayHit> all;
+    ASSERT_TRUE(crowd.world.cast_ray_all(rays[i], 1000, &all).ok());
+    if (all.empty()) {
+      EXPECT_FALSE(hits[i].hit()) << i;
+      continue;
+    }
+    ++found;
+    ASSERT_TRUE(hits[i].hit()) << i;
+    EXPECT_EQ(hits[i].body, all[0].body) << i;
+    EXPECT_EQ(hits[i].distance, all[0].distance) << i;
+    for (std::size_t large = crowd.ids.size() - 3; large < crowd.ids.size(); ++large)
+      on_large += hits[i].body == crowd.ids[large];
+  }
+  // Hits on the large bodies and on the small ones both.
+  EXPECT_GT(on_large, 100);
+  EXPECT_GT(found - on_large, 100);
+}
+
 TEST(RayCasts, BruteForceOverEveryBodyAgrees) {
   // The brute force above shares the tree's walk; this one does not: every body is removed but
   // one, in turn, and the ray cast against that one alone.

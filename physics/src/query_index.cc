@@ -19,8 +19,31 @@ void QueryIndex::build(std::span<const Entry> entries) {
       unbounded_.push_back(entry.slot);
   }
   if (entries_.empty()) return;
-  nodes_.reserve(2 * entries_.size() / kLeafSize + 2);
-  build_node(0, static_cast<std::uint32_t>(entries_.size()));
+  nodes_.reserve(2 * entries_.size() / kLeafSize + 3);
+  // A body as large as the world's bodies together (a terrain under them) would share a leaf with
+  // the few small ones at its centre, and every node above that leaf would take its size: every
+  // ray entered them all. Such bodies get a child of the root to themselves, the rest the other.
+  Aabb all;
+  for (const Entry& entry : entries_) {
+    all.grow(entry.bounds.min);
+    all.grow(entry.bounds.max);
+  }
+  const double giant = kGiantFraction * all.extent().maxCoeff();
+  const auto small_end = std::stable_partition(
+      entries_.begin(), entries_.end(),
+      [&](const Entry& e) { return !(e.bounds.extent().maxCoeff() >= giant); });
+  const auto small = static_cast<std::uint32_t>(small_end - entries_.begin());
+  const auto count = static_cast<std::uint32_t>(entries_.size());
+  if (small == 0 || small == count) {
+    build_node(0, count);
+  } else {
+    nodes_.push_back({});
+    nodes_[0].bounds = all;
+    nodes_[0].count = 0;
+    build_node(0, small);  // 1
+    const std::uint32_t giants = build_node(small, count);
+    nodes_[0].first = giants;
+  }
   build_wide();
 }
 

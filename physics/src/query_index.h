@@ -4,7 +4,8 @@
 // change of bodies makes it stale. A ray walks a copy of it with every other level dropped (four
 // children a node, met at once: the mesh's tree does the same, docs/COLLISION.md), nearer children
 // first, and skips boxes it enters beyond the nearest hit so far. Bodies without bounds
-// (half-spaces) are kept aside and tried by every ray.
+// (half-spaces) are kept aside and tried by every ray; bodies about as large as all the others
+// together (a terrain under them) have a child of the root to themselves (build).
 #pragma once
 
 #include <algorithm>
@@ -81,6 +82,8 @@ class QueryIndex {
   void visit_nodes(Meets&& meets, Visit&& visit) const;
 
   static constexpr int kLeafSize = 4;
+  // Bodies at least this fraction of all the bodies' extent get a child of the root (build).
+  static constexpr double kGiantFraction = 0.25;
   struct Node {
     Aabb bounds;
     std::uint32_t first = 0;  // leaf: its first entry; inner: its second child (the first is next)
