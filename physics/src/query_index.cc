@@ -29,9 +29,9 @@ void QueryIndex::build(std::span<const Entry> entries) {
     all.grow(entry.bounds.max);
   }
   const double giant = kGiantFraction * all.extent().maxCoeff();
-  const auto small_end = std::stable_partition(
-      entries_.begin(), entries_.end(),
-      [&](const Entry& e) { return !(e.bounds.extent().maxCoeff() >= giant); });
+  const auto small_end =
+      std::stable_partition(entries_.begin(), entries_.end(),
+                            [&](const Entry& e) { return e.bounds.extent().maxCoeff() < giant; });
   const auto small = static_cast<std::uint32_t>(small_end - entries_.begin());
   const auto count = static_cast<std::uint32_t>(entries_.size());
   if (small == 0 || small == count) {
@@ -40,9 +40,8 @@ void QueryIndex::build(std::span<const Entry> entries) {
     nodes_.push_back({});
     nodes_[0].bounds = all;
     nodes_[0].count = 0;
-    build_node(0, small);  // 1
-    const std::uint32_t giants = build_node(small, count);
-    nodes_[0].first = giants;
+    build_node(0, small);  // the root's first child: the next node, as build_node places it
+    nodes_[0].first = build_node(small, count);
   }
   build_wide();
 }
