@@ -8,92 +8,16 @@
 #include <string>
 #include <vector>
 
+#include "box_pairs.h"
 #include "physics/collision.h"
 #include "test_support.h"
 
 namespace tumble {
 namespace {
 
+using testing::BoxPair;
+using testing::make_box_pair;
 using testing::Random;
-
-struct BoxPair {
-  Vec3 ha, hb;
-  Pose pa, pb;
-  const char* kind;
-};
-
-Quat small_rotation(Random& rng) {
-  const double angle = std::pow(10.0, rng.uniform(-12, -3));
-  return Quat(Eigen::AngleAxisd(angle, rng.direction()));
-}
-
-BoxPair make_pair(Random& rng, int index) {
-  BoxPair p;
-  p.ha = rng.vector(0.1, 2.0);
-  p.hb = rng.vector(0.1, 2.0);
-  p.pa.orientation = rng.rotation();
-  p.pb.orientation = rng.rotation();
-  const double reach = (p.ha.norm() + p.hb.norm());
-  switch (index % 7) {
-    case 0:  // generic: anywhere from deep overlap to clearly apart
-      p.kind = "generic";
-      p.pb.position = rng.direction() * rng.uniform(0, 1.1 * reach);
-      break;
-    case 1: {  // B's face flush on A's top face, turned about the shared normal
-      p.kind = "face-touch";
-      p.pa.orientation = Quat::Identity();
-      p.pb.orientation = Quat(Eigen::AngleAxisd(rng.uniform(0, M_PI), Vec3::UnitZ()));
-      p.pb.position = Vec3(rng.uniform(-p.ha.x(), p.ha.x()), rng.uniform(-p.ha.y(), p.ha.y()),
-                           p.ha.z() + p.hb.z());
-      break;
-    }
-    case 2: {  // edges parallel: both turned about x by 45 degrees plus a multiple of 90
-      p.kind = "parallel-edges";
-      const Quat q(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX()));
-      p.pa.orientation = Quat::Identity();
-      p.pb.orientation = q * Quat(Eigen::AngleAxisd(M_PI / 2 * rng.integer(0, 3), Vec3::UnitX()));
-      p.pb.position =
-          Vec3(rng.uniform(-0.5, 0.5), 0, 0) +
-          Vec3(0, 0, 1) * (p.ha.z() + std::sqrt(0.5) * (p.hb.y() + p.hb.z()) - rng.uniform(0, 0.2));
-      break;
-    }
-    case 3: {  // nearly aligned: identity perturbed by 1e-12 .. 1e-3 rad
-      p.kind = "near-degenerate";
-      p.pa.orientation = small_rotation(rng);
-      p.pb.orientation = small_rotation(rng);
-      p.pb.position =
-          Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), p.ha.z() + p.hb.z() - rng.uniform(0, 0.3));
-      break;
-    }
-    case 4: {  // tiny penetration, 1e-12 .. 1e-6 m, on a random face
-      p.kind = "tiny-depth";
-      p.pa.orientation = Quat::Identity();
-      p.pb.orientation = Quat(Eigen::AngleAxisd(rng.uniform(0, M_PI), Vec3::UnitZ()));
-      p.pb.position = Vec3(rng.uniform(-0.3, 0.3) * p.ha.x(), rng.uniform(-0.3, 0.3) * p.ha.y(),
-                           p.ha.z() + p.hb.z() - std::pow(10.0, rng.uniform(-12, -6)));
-      break;
-    }
-    case 5: {  // size ratio up to 1:1000, the small box anywhere near the big one's surface
-      p.kind = "size-ratio";
-      p.ha = rng.vector(0.5, 1.0);
-      p.hb = rng.vector(0.0005, 0.005);
-      p.pb.position = p.pa.orientation * rng.vector(-1.0, 1.0).cwiseProduct(p.ha);
-      p.pb.position += p.pa.orientation * Vec3(0, 0, p.ha.z() * rng.uniform(0.99, 1.01));
-      break;
-    }
-    default: {  // far from the origin
-      p.kind = "far";
-      p.pb.position = rng.direction() * rng.uniform(0, 1.1 * reach);
-      break;
-    }
-  }
-  if (index % 7 == 6 || index % 5 == 0) {
-    const Vec3 far = Vec3(1e5, -1e5, 1e5);
-    p.pa.position += far;
-    p.pb.position += far;
-  }
-  return p;
-}
 
 struct Tally {
   int checked = 0, overlapping = 0, separated = 0, normal_checked = 0;
@@ -104,7 +28,7 @@ void check_pairs(NarrowPhaseMethod method, int count, Tally* tally) {
   CollisionSettings settings;
   settings.method = method;
   for (int i = 0; i < count; ++i) {
-    const BoxPair p = make_pair(rng, i);
+    const BoxPair p = make_box_pair(rng, i);
     const Shape a = Shape::create(BoxDef{p.ha}).value();
     const Shape b = Shape::create(BoxDef{p.hb}).value();
     const testing::ReferenceSat ref = testing::reference_box_sat(p.ha, p.pa, p.hb, p.pb);

@@ -185,6 +185,7 @@ ConvexPolyhedron make_box_polyhedron(const Vec3& h) {
     if (key.first < key.second)
       box.edges.push_back({key.first, key.second, left, directed.at({key.second, key.first})});
   box.volume = 8 * h.x() * h.y() * h.z();
+  box.box = true;
   return box;
 }
 

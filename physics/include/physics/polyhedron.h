@@ -29,6 +29,9 @@ struct ConvexPolyhedron {
   std::vector<Edge> edges;
   Vec3 centroid = Vec3::Zero();  // of the solid
   double volume = 0;
+  // Made by make_box_polyhedron, whose layout the separating-axis test reads (sat.cc): vertex i
+  // at (+-h.x, +-h.y, +-h.z), + where bit 0, 1, 2 of i is set; faces -x, +x, -y, +y, -z, +z.
+  bool box = false;
 
   // Index of the vertex farthest along `direction` (ties: the lowest index).
   std::uint32_t support_index(const Vec3& direction) const {
