@@ -5,8 +5,10 @@
 // with copies that do not say they are boxes (the general path).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "box_pairs.h"
