@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -143,6 +144,26 @@ TEST(BoxSat, TheBoxPathsGiveTheGeneralTestsBitsWhereCoordinatesTie) {
     expect_same_answers(p, rotation_a, rotation_b, "tied pair " + std::to_string(i), &tally);
   }
   EXPECT_GT(tally.edge_axes, 5000) << tally.edge_axes;
+}
+
+// Boxes all but concentric, turned every way: each pair of crossing edges and its opposite
+// separate by nearly the same amount (twice the centres' offset along their axis, 1e-17 to
+// 1e-8 m), so rounding decides which is the first largest, and the box path must measure the
+// same pairs in the same order to name the same one.
+TEST(BoxSat, TheBoxPathsGiveTheGeneralTestsBitsForAlmostConcentricBoxes) {
+  Random rng(11);
+  Tally tally;
+  for (int i = 0; i < 20000 && !::testing::Test::HasFailure(); ++i) {
+    BoxPair p = make_box_pair(rng, 0);
+    p.pa.position = Vec3::Zero();
+    p.pb.position = rng.direction() * std::pow(10.0, rng.uniform(-17, -8));
+    // Every other pair nearly aligned (edges 1e-12 to 1e-3 rad from parallel), where an axis's
+    // normalisation magnifies the separations' rounding.
+    if (i % 2 == 1) p.pb.orientation = p.pa.orientation * testing::small_rotation(rng);
+    expect_same_answers(p, p.pa.orientation.toRotationMatrix(), p.pb.orientation.toRotationMatrix(),
+                        "concentric pair " + std::to_string(i), &tally);
+  }
+  EXPECT_GT(tally.edge_axes, 15000) << tally.edge_axes;
 }
 
 }  // namespace
