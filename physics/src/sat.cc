@@ -66,8 +66,11 @@ void measure_edge_pair(const ConvexPolyhedron& pa, std::uint32_t i, std::uint32_
 // are unit axes too.
 struct BoxEdgeLayout {
   struct Edge {
-    int axis, arc_sign;                   // the arc: arc_sign times unit axis `axis`
-    int right_axis, right_sign, product;  // the right face's normal; the two faces' signs' product
+    int axis;        // the arc: a sign times unit axis `axis`
+    int right_axis;  // the right face's normal: a sign times this unit axis
+    // The signs the general test's products carry: the two faces' normals' (adc bdc), the arc's
+    // and the right face's normal's (cba bdc).
+    int faces_sign, arc_right_sign;
   };
   std::array<Edge, 12> edges;
 };
@@ -89,10 +92,10 @@ const BoxEdgeLayout& box_edge_layout() {
       const Vec3 arc = right.cross(left);
       BoxEdgeLayout::Edge& edge = result.edges[i];
       edge.axis = unit_axis(arc);
-      edge.arc_sign = arc[edge.axis] > 0 ? 1 : -1;
       edge.right_axis = unit_axis(right);
-      edge.right_sign = right[edge.right_axis] > 0 ? 1 : -1;
-      edge.product = edge.right_sign * (left[unit_axis(left)] > 0 ? 1 : -1);
+      const int right_sign = right[edge.right_axis] > 0 ? 1 : -1;
+      edge.faces_sign = right_sign * (left[unit_axis(left)] > 0 ? 1 : -1);
+      edge.arc_right_sign = right_sign * (arc[edge.axis] > 0 ? 1 : -1);
     }
     return result;
   }();
@@ -149,11 +152,11 @@ EdgeQuery query_box_edges(const PlacedPolyhedron& a, const PlacedPolyhedron& b) 
   for (std::uint32_t i = 0; i < 12; ++i) {
     const BoxEdgeLayout::Edge& e = layout.edges[i];
     const int m = e.axis;
-    // The general test: cba dba < 0, adc bdc < 0 and cba bdc > 0, where cba = arc_sign w1[m],
-    // dba = arc_sign w2[m], adc and bdc the faces' signs times arc's coordinates.
-    std::uint32_t crossing = first[m] & (e.product > 0 ? turn_negative[m] : turn_positive[m]);
-    crossing &= e.arc_sign * e.right_sign > 0 ? cross_positive[m][e.right_axis]
-                                              : cross_negative[m][e.right_axis];
+    // The general test: cba dba < 0, adc bdc < 0 and cba bdc > 0, where cba and dba are the
+    // arc's sign times w1[m] and w2[m], adc and bdc the faces' signs times arc's coordinates.
+    std::uint32_t crossing = first[m] & (e.faces_sign > 0 ? turn_negative[m] : turn_positive[m]);
+    crossing &=
+        e.arc_right_sign > 0 ? cross_positive[m][e.right_axis] : cross_negative[m][e.right_axis];
     for (; crossing != 0; crossing &= crossing - 1) {
       const std::uint32_t j = static_cast<std::uint32_t>(std::countr_zero(crossing));
       measure_edge_pair(pa, i, j, b_vertices[pb.edges[j].tail], b_vertices[pb.edges[j].head],
