@@ -156,12 +156,13 @@ void report(const char* title, const std::vector<PairSpec>& pairs,
   }
 }
 
-// Capsule-box pairs where the capsule's core stays outside the box (a capsule resting on or
-// against a box; a core inside it goes to EPA either way): the closed form (segment.h) against
-// GJK on the same box as a hull. Reference: the core's squared distance from the box is convex
-// along the core, so a ternary search over the core's parameter finds it to rounding
-// (test_support.h).
-void report_capsule_box(int count, Random& rng) {
+// Capsule-box pairs, the closed forms (segment.h) against GJK and EPA on the same box as a hull.
+// Where the capsule's core stays outside the box (a capsule resting on or against a box), the
+// reference is the core's squared distance from the box, convex along the core, so that a ternary
+// search over the core's parameter finds it to rounding (test_support.h). Where the core has
+// entered the box (a terrain's edge pressed into a box resting on it is one), the error is how far
+// from touching the capsule is once moved back by the depth along the normal, by the same search.
+void report_capsule_box(int count, bool core_inside, Random& rng) {
   struct CapsulePair {
     double radius, half_height;
     Vec3 half;
@@ -174,8 +175,8 @@ void report_capsule_box(int count, Random& rng) {
     p.radius = rng.uniform(0.03, 0.3);
     p.half_height = rng.uniform(0.05, 0.6);
     p.half = rng.vector(0.1, 1.0);
-    p.capsule = {rng.direction() * rng.uniform(0, p.half.norm() + p.half_height + p.radius),
-                 rng.rotation()};
+    const double reach = core_inside ? p.half.minCoeff() : p.half.norm() + p.half_height + p.radius;
+    p.capsule = {rng.direction() * rng.uniform(0, reach), rng.rotation()};
     p.box = {Vec3::Zero(), rng.rotation()};
     const Mat3 to_box = p.box.orientation.toRotationMatrix().transpose();
     const Vec3 axis = p.capsule.orientation * Vec3(0, 0, p.half_height);
@@ -183,7 +184,8 @@ void report_capsule_box(int count, Random& rng) {
                core_q = to_box * (p.capsule.position + axis);
     const double distance =
         std::sqrt(testing::segment_box_squared_distance_by_search(core_p, core_q, p.half));
-    if (distance < 1e-3 || distance >= p.radius) continue;  // core inside, or not touching
+    // (Touching with the core outside, or the core inside.)
+    if (core_inside ? distance > 0 : distance < 1e-3 || distance >= p.radius) continue;
     p.depth = p.radius - distance;
     pairs.push_back(p);
   }
@@ -193,12 +195,15 @@ void report_capsule_box(int count, Random& rng) {
     boxes.push_back(Shape::create(BoxDef{p.half}).value());
     hulls.push_back(Shape::create(HullDef{testing::box_corners(p.half)}).value());
   }
-  std::printf("\nCapsule-box (core outside the box): %zu touching pairs, one thread\n",
-              pairs.size());
-  std::printf("| method | us/query | failures | depth error p99 / max |\n|---|---|---|---|\n");
+  std::printf("\nCapsule-box (core %s the box): %zu touching pairs, one thread\n",
+              core_inside ? "inside" : "outside", pairs.size());
+  std::printf("| method | us/query | failures | %s p99 / max |\n|---|---|---|---|\n",
+              core_inside ? "gap once moved back (of the radius)" : "depth error");
   for (const auto& [name, others] :
        {std::pair{"Tumble capsule-box, closed form + manifold", &boxes},
-        std::pair{"Tumble capsule-hull (the box as a hull: GJK) + manifold", &hulls}}) {
+        std::pair{core_inside ? "Tumble capsule-hull (the box as a hull: GJK, EPA) + manifold"
+                              : "Tumble capsule-hull (the box as a hull: GJK) + manifold",
+                  &hulls}}) {
     std::vector<ContactManifold> out(pairs.size());
     std::vector<double> times;
     for (int pass = 0; pass < 3; ++pass) {
@@ -216,7 +221,17 @@ void report_capsule_box(int count, Random& rng) {
         ++failures;
         continue;
       }
-      depth_error.push_back(std::abs(out[i].depth - pairs[i].depth) / pairs[i].radius);
+      if (!core_inside) {
+        depth_error.push_back(std::abs(out[i].depth - pairs[i].depth) / pairs[i].radius);
+        continue;
+      }
+      const CapsulePair& p = pairs[i];
+      const Vec3 moved = p.capsule.position - out[i].depth * out[i].normal;
+      const Mat3 to_box = p.box.orientation.toRotationMatrix().transpose();
+      const Vec3 axis = p.capsule.orientation * Vec3(0, 0, p.half_height);
+      const double distance = std::sqrt(testing::segment_box_squared_distance_by_search(
+          to_box * (moved - axis), to_box * (moved + axis), p.half));
+      depth_error.push_back(std::abs(distance - p.radius) / p.radius);
     }
     std::printf("| %s | %.3f | %d | %.1e / %.1e |\n", name, times[1] / pairs.size() * 1e6, failures,
                 percentile(depth_error, 0.99), percentile(depth_error, 1.0));
@@ -302,6 +317,7 @@ int main(int argc, char** argv) {
 #endif
   report("Box-box", boxes, box_ref, methods);
   report("Hull-hull (8-64 points)", hulls, hull_ref, methods);
-  report_capsule_box(box_count, rng);
+  report_capsule_box(box_count, false, rng);
+  report_capsule_box(box_count / 10, true, rng);
   return 0;
 }

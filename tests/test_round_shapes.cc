@@ -1,6 +1,8 @@
 // Spheres, capsules and the ground half-space against analytic answers.
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include "physics/collision.h"
 #include "test_support.h"
 
@@ -13,6 +15,11 @@ Shape make(const ShapeDef& def) {
 
 Pose at(const Vec3& p, const Quat& q = Quat::Identity()) {
   return {p, q};
+}
+
+// A box, and the same box as a hull: GJK and EPA where the box takes the closed forms.
+std::pair<Shape, Shape> box_and_equal_hull(const Vec3& half) {
+  return {make(BoxDef{half}), make(HullDef{testing::box_corners(half)})};
 }
 
 TEST(RoundShapes, SphereSphere) {
@@ -90,8 +97,7 @@ TEST(RoundShapes, CapsuleLyingOnBoxGivesTwoPoints) {
 // A capsule against a box (the closed form) and against the same box as a hull (GJK): one answer.
 TEST(RoundShapes, CapsuleAgainstHullMatchesCapsuleAgainstEqualBox) {
   const Vec3 half(0.6, 0.3, 0.2);
-  const Shape hull = make(HullDef{testing::box_corners(half)});
-  const Shape box = make(BoxDef{half});
+  const auto [box, hull] = box_and_equal_hull(half);
   const Shape capsule = make(CapsuleDef{0.1, 0.25});
   CollisionSettings settings;
   settings.margin = 0.05;
@@ -114,7 +120,7 @@ TEST(RoundShapes, CapsuleAgainstHullMatchesCapsuleAgainstEqualBox) {
   EXPECT_GT(touching, 400);
 }
 
-TEST(RoundShapes, CapsuleCoreInsideBoxUsesEpa) {
+TEST(RoundShapes, CapsuleCoreInsideBoxLeavesThroughTheTopFace) {
   const Shape capsule = make(CapsuleDef{0.1, 0.5});
   const Shape box = make(BoxDef{Vec3(1, 1, 1)});
   // Standing upright, its lower core end 0.3 m inside the top face.
@@ -123,6 +129,49 @@ TEST(RoundShapes, CapsuleCoreInsideBoxUsesEpa) {
   ASSERT_GE(m.count, 1);
   EXPECT_NEAR(m.depth, 0.3 + 0.1, 1e-12);
   EXPECT_TRUE(m.normal.isApprox(-Vec3::UnitZ(), 1e-12));
+}
+
+// A capsule whose core has entered a box leaves it the shortest way: as deep as EPA finds it on the
+// same box as a hull, and moved back by that depth along the normal it just touches. More than
+// half of these leave across an edge of the box (a normal off its axes), the rest through a face.
+TEST(RoundShapes, CapsuleCoreInsideBoxLeavesTheShortestWay) {
+  const Vec3 half(0.6, 0.3, 0.2);
+  const auto [box, hull] = box_and_equal_hull(half);
+  const Shape capsule = make(CapsuleDef{0.05, 0.3});
+  CollisionSettings settings;
+  settings.margin = 0.01;
+  testing::Random rng(11);
+  int across_edges = 0, inside = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Pose body = at(rng.vector(-1, 1), i % 2 == 0 ? Quat::Identity() : rng.rotation());
+    const Vec3 local = rng.vector(-1, 1).cwiseProduct(half);
+    const Pose capsule_pose = at(body.position + body.orientation * local, rng.rotation());
+    ContactManifold mb, mh;
+    collide(capsule, capsule_pose, box, body, settings, &mb);
+    collide(capsule, capsule_pose, hull, body, settings, &mh);
+    ASSERT_GE(mb.count, 1) << i;
+    ASSERT_GE(mh.count, 1) << i;
+    // (Cores only: a capsule whose core stays outside is the closest points' case.)
+    if (mb.depth <= capsule.radius() + 1e-9) continue;
+    ++inside;
+    ASSERT_NEAR(mb.depth, mh.depth, 1e-9) << i;
+    const Pose moved = at(capsule_pose.position - mb.depth * mb.normal, capsule_pose.orientation);
+    ContactManifold after;
+    collide(capsule, moved, box, body, settings, &after);
+    ASSERT_GE(after.count, 1) << i;
+    // (A core lying along a face within 1e-3 takes the face's normal, a turn of at most 1.4 mrad
+    // from the shortest way, and two points: moved along it, it is left that much inside.)
+    ASSERT_NEAR(after.depth, 0, 1e-9 + (mb.count == 2 ? 1e-6 * mb.depth : 0.0)) << i;
+    // The point on the box is on its surface (and on the capsule's, a radius from its core).
+    for (int k = 0; k < mb.count; ++k) {
+      const Vec3 on_box = body.orientation.conjugate() * (mb.points[k].point_b - body.position);
+      ASSERT_NEAR((on_box.cwiseAbs() - half).maxCoeff(), 0, 1e-9) << i;
+    }
+    const Vec3 normal_in_box = body.orientation.conjugate() * mb.normal;
+    if (normal_in_box.cwiseAbs().maxCoeff() < 1 - 1e-9) ++across_edges;
+  }
+  EXPECT_GT(inside, 2000);
+  EXPECT_GT(across_edges, inside / 10);
 }
 
 TEST(RoundShapes, ParallelCapsulesTouchAlongTheirOverlap) {

@@ -1,7 +1,7 @@
 // Spheres and capsules: a point or a segment (the core) swept by a radius. Against each other the
 // answer is closed-form (closest points of the cores); against a polytope the core's distance comes
-// from GJK (closed-form against a box), and a core that has entered the polytope from EPA (segment)
-// or the face planes (point).
+// from GJK, and a core that has entered the polytope from EPA (segment) or the face planes (point);
+// against a box both are closed-form (segment.h).
 #include "epa.h"
 #include "manifold.h"
 #include "narrow_phase.h"
@@ -140,6 +140,12 @@ std::uint32_t collide_round_polyhedron(const Vec3& p, const Vec3& q, double radi
     const Vec3 on_box = core_point.cwiseMax(-*box_half_extents).cwiseMin(*box_half_extents);
     normal = direction_or(core_point, on_box, Vec3::UnitZ(), &core_depth);
     core_depth = -core_depth;
+  } else if (box_half_extents != nullptr) {
+    // Into a box: the shortest way out in closed form too (segment.h).
+    const SegmentBoxPenetration out = segment_box_penetration(p, q, *box_half_extents, tolerance);
+    normal = out.normal;
+    core_depth = out.depth;
+    core_point = out.deepest;
   } else {
     const SegmentSupport core{p, q};
     const PolyhedronSupport support_b{&poly};
