@@ -185,5 +185,37 @@ TEST(SegmentBox, ClosestMatchesAConvexSearch) {
   EXPECT_GT(meeting, 1000);
 }
 
+// The shortest way out of a box for a segment that entered it, in closed form: through a face, and
+// across an edge, against the answers worked by hand; and a non-finite segment still names an axis
+// (the answer is not a number, and nothing is read or written out of bounds).
+TEST(SegmentBox, PenetrationThroughAFaceAndAcrossAnEdge) {
+  const Vec3 half(1, 1, 1);
+  // Poking 0.5 m down into the top face: out upwards, its lower end deepest.
+  const SegmentBoxPenetration face =
+      segment_box_penetration(Vec3(0.2, 0.1, 0.5), Vec3(0.2, 0.1, 2), half, 1e-12);
+  EXPECT_NEAR(face.depth, 0.5, 1e-15);
+  EXPECT_EQ(face.normal, Vec3(0, 0, -1));
+  EXPECT_EQ(face.deepest, Vec3(0.2, 0.1, 0.5));
+  // Across the edge x = z = 1 at 45 degrees, through the corner 0.1 / sqrt(2) deep: each face
+  // would take 0.4 m.
+  const SegmentBoxPenetration edge =
+      segment_box_penetration(Vec3(0.6, 0, 1.3), Vec3(1.3, 0, 0.6), half, 1e-12);
+  EXPECT_NEAR(edge.depth, 0.1 / std::sqrt(2.0), 1e-15);
+  EXPECT_TRUE(edge.normal.isApprox(Vec3(-1, 0, -1).normalized(), 1e-15));
+  EXPECT_TRUE(edge.deepest.isApprox(Vec3(0.95, 0, 0.95), 1e-15));
+  // Lying 1 cm inside the top face along x: crossed with the y axis it gives the face's own
+  // normal and overlap, and the face keeps the tie (its deeper end: the first of two as deep).
+  const SegmentBoxPenetration flat =
+      segment_box_penetration(Vec3(-0.5, 0.3, 0.99), Vec3(0.5, 0.3, 0.99), half, 1e-12);
+  EXPECT_EQ(flat.normal, Vec3(0, 0, -1));
+  EXPECT_NEAR(flat.depth, 0.01, 1e-15);
+  EXPECT_EQ(flat.deepest, Vec3(-0.5, 0.3, 0.99));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const SegmentBoxPenetration lost =
+      segment_box_penetration(Vec3(nan, 0, 0), Vec3(1, 2, 3), half, 0);
+  EXPECT_TRUE(std::isnan(lost.depth));
+  EXPECT_EQ(lost.normal.squaredNorm(), 1.0);
+}
+
 }  // namespace
 }  // namespace tumble

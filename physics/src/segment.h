@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "physics/math.h"
 
@@ -124,11 +123,15 @@ struct SegmentBoxPenetration {
 inline SegmentBoxPenetration segment_box_penetration(const Vec3& p, const Vec3& q, const Vec3& half,
                                                      double bias) {
   const Vec3 centre = 0.5 * (p + q), reach = 0.5 * (q - p);
-  SegmentBoxPenetration best{Vec3::Zero(), std::numeric_limits<double>::infinity(), p};
-  int best_axis = -1;  // 0-2: the box's axis; 3-5: the crossing with axis k - 3
+  const auto face_overlap = [&](int k) {
+    return half[k] + std::abs(reach[k]) - std::abs(centre[k]);
+  };
+  // (From axis 0 rather than from infinity: a non-finite segment still names an axis.)
+  SegmentBoxPenetration best{Vec3::Zero(), face_overlap(0), p};
+  int best_axis = 0;  // 0-2: the box's axis; 3-5: the crossing with axis k - 3
   Vec3 best_unit = Vec3::Zero();
-  for (int k = 0; k < 3; ++k) {
-    const double overlap = half[k] + std::abs(reach[k]) - std::abs(centre[k]);
+  for (int k = 1; k < 3; ++k) {
+    const double overlap = face_overlap(k);
     if (overlap < best.depth) {
       best.depth = overlap;
       best_axis = k;
