@@ -111,9 +111,9 @@ inline SegmentBoxClosest closest_segment_box(const Vec3& p, const Vec3& q, const
 // The segment and the box are apart exactly along some face normal of their Minkowski difference,
 // and those are the box's three axes and the segment's direction crossed with each of them (the
 // faces a box edge sweeps along the segment): the least overlap over these six axes is the depth,
-// exact where EPA approaches it by iteration (van den Bergen, "Collision Detection in Interactive
-// 3D Environments", 2003, 4.3: the separating axes of two polytopes). A crossing wins only by
-// more than `bias` (m), so that a segment across a face keeps the face's normal, not an edge's
+// exact where EPA approaches it by iteration. (They are the axes of the separating-axis test of a
+// segment and a box, Ericson, "Real-Time Collision Detection", 2005, 5.3.3.) A crossing wins only
+// by more than `bias` (m), so that a segment across a face keeps the face's normal, not an edge's
 // that ties with it to rounding.
 struct SegmentBoxPenetration {
   Vec3 normal;
