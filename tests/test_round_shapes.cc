@@ -1,6 +1,7 @@
 // Spheres, capsules and the ground half-space against analytic answers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <utility>
 
 #include "physics/collision.h"
@@ -172,6 +173,36 @@ TEST(RoundShapes, CapsuleCoreInsideBoxLeavesTheShortestWay) {
   }
   EXPECT_GT(inside, 2000);
   EXPECT_GT(across_edges, inside / 10);
+}
+
+// The same at a millimetre, a kilometre, and with a core a thousand times the box's size (a long
+// rod through a small block) or a thousandth of it: EPA's depth on the equal hull to 1e-10 of the
+// larger of the two.
+TEST(RoundShapes, CapsuleCoreInsideBoxLeavesTheShortestWayAtAnyScale) {
+  for (const auto& [scale, ratio] : {std::pair{1e-3, 1.0}, {1e3, 1.0}, {1.0, 1e3}, {1.0, 1e-3}}) {
+    const Vec3 half = scale * Vec3(0.6, 0.3, 0.2);
+    const auto [box, hull] = box_and_equal_hull(half);
+    const Shape capsule = make(CapsuleDef{0.05 * scale, 0.3 * scale * ratio});
+    CollisionSettings settings;
+    settings.margin = 0.01 * scale;
+    testing::Random rng(13);
+    int inside = 0;
+    for (int i = 0; i < 1000; ++i) {
+      const Pose body = at(scale * rng.vector(-1, 1), rng.rotation());
+      const Vec3 local = rng.vector(-1, 1).cwiseProduct(half);
+      const Pose capsule_pose = at(body.position + body.orientation * local, rng.rotation());
+      ContactManifold mb, mh;
+      collide(capsule, capsule_pose, box, body, settings, &mb);
+      collide(capsule, capsule_pose, hull, body, settings, &mh);
+      ASSERT_GE(mb.count, 1) << scale << " " << ratio << " " << i;
+      ASSERT_GE(mh.count, 1) << scale << " " << ratio << " " << i;
+      if (mb.depth <= capsule.radius()) continue;
+      ++inside;
+      ASSERT_NEAR(mb.depth, mh.depth, 1e-10 * scale * std::max(1.0, ratio))
+          << scale << " " << ratio << " " << i;
+    }
+    EXPECT_GT(inside, 500) << scale << " " << ratio;
+  }
 }
 
 TEST(RoundShapes, ParallelCapsulesTouchAlongTheirOverlap) {
