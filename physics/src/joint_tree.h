@@ -198,13 +198,16 @@ class JointTree {
   // SHAKE's next iterate of the curvature targets in kept_targets_ (solve_velocities), into
   // second_targets_: the kept targets solved (the solution left in the joints' and bodies'
   // results; the bodies' velocities as they were) and the targets taken again from the
-  // velocities found. How far they moved: relative to the kept ones, and times the substep.
+  // velocities found. How far they moved: relative to the kept ones, and times the substep. Once
+  // the relative move is past `refused_above` (the iterate will not be taken), the joints left
+  // are not visited: the ratio returned is then past it too, and second_targets_ incomplete.
   struct Retake {
     double ratio = 0, move = 0;
   };
   template <class Rates>
   Retake take_targets_again(std::span<const JointRow> rows, std::span<SolverBody> bodies,
-                            std::span<const Pose> poses, const JointTarget& target, Rates rates_of);
+                            std::span<const Pose> poses, const JointTarget& target, Rates rates_of,
+                            double refused_above);
   // Sets each body's stiffness (TreeBody) for a substep of h (joint_tree.cc: why and how much);
   // whether any body has some.
   bool set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
