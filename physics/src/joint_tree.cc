@@ -804,7 +804,7 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
   };
   // The move only grows joint by joint, and a correctly rounded quotient with it: past the bound
   // part way, it is past it at the end, and the caller refuses the iterate either way. A chain of
-  // 100 links refuses 96% of its second takes (their targets were a tenth of its step).
+  // 100 links refuses 96% of its second takes, and now visits a quarter of its joints a take.
   for (std::size_t k = 0; k < joints && !(relative() > refused_above); ++k) {
     second_targets_[k] =
         velocity_targets(rows[joints_[k].row], bodies, poses, target, index_->turns.data());
