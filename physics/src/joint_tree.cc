@@ -794,7 +794,21 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
     body.v = tree_bodies_[k].result.head<3>();
     body.w = tree_bodies_[k].result.tail<3>();
   }
-  set_turns(rows, bodies, target.h);
+  // The turns set_turns would give, body by body as the joints visited need them: a refused take
+  // visits a quarter of a chain's joints.
+  std::vector<Quat>& turns = index_->turns;
+  if (turns.size() < index_->node_of_body.size()) turns.resize(index_->node_of_body.size());
+  turned_.assign(tree_bodies, 0);
+  const auto turn = [&](std::uint32_t body) {
+    if (body == kWorldAnchor) return;
+    const std::uint32_t node = index_->node_of_body[body];
+    if (node == kNone) {
+      turns[body] = Quat::Identity();
+    } else if (!turned_[node]) {
+      turned_[node] = 1;
+      turns[body] = rotation_quaternion(target.h * bodies[body].w);
+    }
+  };
   double first = 0, change = 0;
   for (std::size_t k = 0; k < joints; ++k)
     first = std::max(first, kept_targets_[k].lpNorm<Eigen::Infinity>());
@@ -806,8 +820,10 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
   // part way, it is past it at the end, and the caller refuses the iterate either way. A chain of
   // 100 links refuses 96% of its second takes, and now visits a quarter of its joints a take.
   for (std::size_t k = 0; k < joints && !(relative() > refused_above); ++k) {
-    second_targets_[k] =
-        velocity_targets(rows[joints_[k].row], bodies, poses, target, index_->turns.data());
+    const JointRow& row = rows[joints_[k].row];
+    turn(row.a);
+    turn(row.b);
+    second_targets_[k] = velocity_targets(row, bodies, poses, target, turns.data());
     change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
   }
   for (std::size_t k = 0; k < tree_bodies; ++k) {

@@ -244,6 +244,7 @@ class JointTree {
   std::vector<Eigen::Matrix<double, 6, 1>> kept_targets_;
   // The targets of SHAKE's second iterate, and the bodies' velocities it starts from.
   std::vector<Eigen::Matrix<double, 6, 1>> second_targets_, held_velocities_;
+  std::vector<std::uint8_t> turned_;  // by tree body: its turn set for the take under way
   bool velocities_factored_ = false;  // since the last move
   bool stiffened_ = false;
   // settle_velocity_factors: a pass's factors that may serve the sweeps, and the bodies'
