@@ -794,21 +794,8 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
     body.v = tree_bodies_[k].result.head<3>();
     body.w = tree_bodies_[k].result.tail<3>();
   }
-  // The turns set_turns would give, body by body as the joints visited need them: a refused take
-  // visits a quarter of a chain's joints.
-  std::vector<Quat>& turns = index_->turns;
-  if (turns.size() < index_->node_of_body.size()) turns.resize(index_->node_of_body.size());
-  turned_.assign(tree_bodies, 0);
-  const auto turn = [&](std::uint32_t body) {
-    if (body == kWorldAnchor) return;
-    const std::uint32_t node = index_->node_of_body[body];
-    if (node == kNone) {
-      turns[body] = Quat::Identity();
-    } else if (!turned_[node]) {
-      turned_[node] = 1;
-      turns[body] = rotation_quaternion(target.h * bodies[body].w);
-    }
-  };
+  // The turns only of the joints visited: a refused take visits a quarter of a chain's joints.
+  start_turns();
   double first = 0, change = 0;
   for (std::size_t k = 0; k < joints; ++k)
     first = std::max(first, kept_targets_[k].lpNorm<Eigen::Infinity>());
@@ -821,9 +808,8 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
   // 100 links refuses 96% of its second takes, and now visits a quarter of its joints a take.
   for (std::size_t k = 0; k < joints && !(relative() > refused_above); ++k) {
     const JointRow& row = rows[joints_[k].row];
-    turn(row.a);
-    turn(row.b);
-    second_targets_[k] = velocity_targets(row, bodies, poses, target, turns.data());
+    turn_bodies_of(row, bodies, target.h);
+    second_targets_[k] = velocity_targets(row, bodies, poses, target, index_->turns.data());
     change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
   }
   for (std::size_t k = 0; k < tree_bodies; ++k) {
@@ -893,17 +879,29 @@ void JointTree::settle_velocity_factors(std::span<const JointRow> rows,
 
 void JointTree::set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                           double h) {
-  // Every joint's bodies: the tree's turn with their velocities; a static body or the world
-  // (kWorldAnchor: none stored) not at all.
+  start_turns();
+  for (const TreeJoint& joint : joints_)
+    turn_bodies_of(rows[joint.row], bodies, h);
+}
+
+void JointTree::start_turns() {
   std::vector<Quat>& turns = index_->turns;
   if (turns.size() < index_->node_of_body.size()) turns.resize(index_->node_of_body.size());
-  for (const TreeJoint& joint : joints_) {
-    const JointRow& row = rows[joint.row];
-    turns[row.a] = Quat::Identity();
-    if (row.b != kWorldAnchor) turns[row.b] = Quat::Identity();
+  turned_.assign(tree_bodies_.size(), 0);
+}
+
+void JointTree::turn_bodies_of(const JointRow& row, std::span<const SolverBody> bodies, double h) {
+  // The tree's turn with its velocity; a static body identity; the world (kWorldAnchor) none.
+  for (const std::uint32_t body : {row.a, row.b}) {
+    if (body == kWorldAnchor) continue;
+    const std::uint32_t node = index_->node_of_body[body];
+    if (node == kNone) {
+      index_->turns[body] = Quat::Identity();
+    } else if (!turned_[node]) {
+      turned_[node] = 1;
+      index_->turns[body] = rotation_quaternion(h * bodies[body].w);
+    }
   }
-  for (const TreeBody& body : tree_bodies_)
-    turns[body.index] = rotation_quaternion(h * bodies[body.index].w);
 }
 
 bool JointTree::solution_finite() const {

@@ -193,6 +193,10 @@ class JointTree {
   // identity for a static body) in the index's turns, by solver index: the targets' arithmetic,
   // once a body rather than once a joint end.
   void set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies, double h);
+  // set_turns a joint at a time: start_turns, then turn_bodies_of each joint whose turns are read
+  // (a body shared by two joints is turned once).
+  void start_turns();
+  void turn_bodies_of(const JointRow& row, std::span<const SolverBody> bodies, double h);
   // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
   void set_velocity_base(std::span<const SolverBody> bodies);
   // SHAKE's next iterate of the curvature targets in kept_targets_ (solve_velocities), into
