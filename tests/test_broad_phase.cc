@@ -48,13 +48,21 @@ Scene make_scene(const std::string& kind, Random& rng, int n) {
     } else if (kind == "wide") {  // 1 mm to 100 m, log-uniform
       centre = rng.vector(0, 200);
       half = Vec3::Constant(0.5 * std::pow(10.0, rng.uniform(-3, 2)));
+    } else if (kind == "terrain") {  // small boxes on a few static slabs, each alone on its level
+      centre = rng.vector(0, 20);
+      half = rng.vector(0.2, 0.6);
+      if (i < 3) {
+        centre = Vec3(10, 10, 2.0 * i);
+        half = Vec3(15.0 * (i + 1), 15.0 * (i + 1), 0.5 * (i + 1));
+      }
     } else {  // "borders": boxes snapped so their faces sit on multiples of their size
       half = Vec3::Constant(0.5);
       centre =
           Vec3(rng.integer(0, 15), rng.integer(0, 15), rng.integer(0, 15)) + Vec3::Constant(0.5);
       if (i % 2) centre += Vec3(0.5, 0, 0);  // faces exactly touching neighbours
     }
-    add_box(s, centre + offset, half, i % 5 != 0);  // every fifth body static
+    // Every fifth body static, and the terrain's slabs.
+    add_box(s, centre + offset, half, i % 5 != 0 && !(kind == "terrain" && i < 3));
   }
   // A ground half-space (unbounded, static), a dead slot, and a second unbounded dynamic body.
   s.bounds.push_back(Aabb::infinite());
@@ -290,7 +298,8 @@ TEST_P(BroadPhaseScenes, LoggedRestingChangesRelistThoseBodiesAlone) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BroadPhaseScenes,
-                         ::testing::Values("uniform", "clustered", "wide", "borders", "far"));
+                         ::testing::Values("uniform", "clustered", "wide", "borders", "far",
+                                           "terrain"));
 
 TEST(BroadPhase, WorldNeverPairsStaticBodiesAndFindsContacts) {
   World world;
