@@ -163,6 +163,7 @@ struct StepScratch {
   std::vector<ContactPairRecord> found_records;
   std::vector<std::uint32_t> found_previous;  // the record of the last step, or kNoRecord
   std::vector<std::uint8_t> found_flags;      // kPairTouches, kPairKeptFeature
+  std::vector<std::uint8_t> unjoined;         // 1: a joint keeps the pair apart
   std::vector<std::uint32_t> kept_index;      // where a touching pair goes in `contacts`
   std::vector<double> manifold_depth;         // each manifold's depth, for the step's deepest
   std::vector<std::uint32_t> previous_pair;

@@ -785,6 +785,10 @@ void World::find_contacts(double dt) {
   const double gravity = settings_.gravity.norm();
   const int threads = thread_count(settings_.threads);
   match_pair_records(pairs_, s.pairs, s.found_previous);
+  if (!unjoined_pairs_.empty()) {
+    resize_reusing(s.unjoined, pairs_.size());
+    mark_unjoined(pairs_, s.unjoined);
+  }
   // Pairs with terrain or a compound get room for several manifolds, numbered in pair order.
   if (many_manifold_bodies_ > 0) {
     resize_reusing(s.many_slot, pairs_.size());
@@ -827,7 +831,7 @@ void World::find_contacts(double dt) {
         s.found_flags[i] = 0;
         // Bodies a joint holds together do not collide unless it says so, nor bodies their
         // collision filters keep apart.
-        if (!unjoined_pairs_.empty() && unjoined(pairs_[i].a, pairs_[i].b)) return 0u;
+        if (!unjoined_pairs_.empty() && s.unjoined[i] != 0) return 0u;
         if (filters_used_ && !a.filter.collides_with(b.filter)) return 0u;
         // A kinematic body meets the dynamic ones only: nothing moves it.
         if (!kinematic_.empty() && a.inverse_mass == 0 && b.inverse_mass == 0) return 0u;

@@ -268,9 +268,17 @@ void World::restore_joint_indexes() {
   std::sort(unjoined_pairs_.begin(), unjoined_pairs_.end());
 }
 
-bool World::unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const {
-  return std::binary_search(unjoined_pairs_.begin(), unjoined_pairs_.end(),
-                            pair_key(slot_a, slot_b));
+void World::mark_unjoined(std::span<const BodyPair> pairs, std::span<std::uint8_t> out) const {
+  // One walk of both sorted lists: pair_key orders pairs as the broad phase does (a < b, by a
+  // then b). A binary search a pair cost the ragdolls' step 1% of its instructions, and its
+  // branches were mispredicted a third of the time.
+  std::size_t u = 0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const std::uint64_t key = pair_key(pairs[i].a, pairs[i].b);
+    while (u < unjoined_pairs_.size() && unjoined_pairs_[u] < key)
+      ++u;
+    out[i] = u < unjoined_pairs_.size() && unjoined_pairs_[u] == key ? 1 : 0;
+  }
 }
 
 std::uint32_t World::wake_jointed() {

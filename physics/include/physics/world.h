@@ -279,7 +279,8 @@ class World {
   void wake_joint(const Joint& joint);  // its sleeping bodies
   // joint_count_, joints_of_body_ and unjoined_pairs_ from joints_ (a restored state).
   void restore_joint_indexes();
-  bool unjoined(std::uint32_t slot_a, std::uint32_t slot_b) const;
+  // out[i] = 1 where a joint keeps pairs[i] apart (pairs sorted, as the broad phase gives them).
+  void mark_unjoined(std::span<const BodyPair> pairs, std::span<std::uint8_t> out) const;
   // Sleepers joined to moving bodies wake with their islands; returns how many woke.
   std::uint32_t wake_jointed();
   // The sleepers a static body's joints hold wake (it moved).
