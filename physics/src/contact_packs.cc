@@ -560,8 +560,10 @@ double solve_pack(ContactPack& pack, const WideMask& lanes, std::span<SolverBody
   if (any(one_by_one)) {
     // Only as many points as those lanes have (single points are the usual reason).
     int points = 0;
+    // (A lane's mask is all ones or zeros: the points of the lanes in it, without a branch on
+    // which lanes they are, which a pile's packs made a coin toss.)
     for (int k = 0; k < kWideLanes; ++k)
-      if (one_by_one[k]) points = std::max(points, static_cast<int>(pack.points[k]));
+      points = std::max(points, static_cast<int>(pack.points[k]) & static_cast<int>(one_by_one[k]));
     for (int p = 0; p < points; ++p)
       change = wide_max(change, solve_normal(pack, pack.point[p],
                                              one_by_one & pack.point[p].present, targets[p], pair));
