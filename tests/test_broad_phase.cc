@@ -48,6 +48,9 @@ Scene make_scene(const std::string& kind, Random& rng, int n) {
     } else if (kind == "wide") {  // 1 mm to 100 m, log-uniform
       centre = rng.vector(0, 200);
       half = Vec3::Constant(0.5 * std::pow(10.0, rng.uniform(-3, 2)));
+    } else if (kind == "heap") {  // a quarter heaped in a 2 m cube: cells of a hundred boxes
+      centre = i % 4 == 0 ? rng.vector(0, 2) : rng.vector(0, 20);
+      half = rng.vector(0.2, 0.6);
     } else if (kind == "terrain") {  // small boxes on a few static slabs, each alone on its level
       centre = rng.vector(0, 20);
       half = rng.vector(0.2, 0.6);
@@ -299,7 +302,7 @@ TEST_P(BroadPhaseScenes, LoggedRestingChangesRelistThoseBodiesAlone) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BroadPhaseScenes,
                          ::testing::Values("uniform", "clustered", "wide", "borders", "far",
-                                           "terrain"));
+                                           "terrain", "heap"));
 
 TEST(BroadPhase, WorldNeverPairsStaticBodiesAndFindsContacts) {
   World world;

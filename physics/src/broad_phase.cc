@@ -23,6 +23,8 @@ constexpr std::int8_t kMeetsEveryone = -2;
 // level 0 (with cells exactly the median, half of a uniform scene went a level up and looked up
 // every cell it covers there).
 constexpr double kCellPerMedianExtent = 2.0;
+// Entries of a crowded cell tested against one entry at a time (find_pairs).
+constexpr int kGathered = 32;
 
 std::uint32_t cell_key(int level, std::int64_t x, std::int64_t y, std::int64_t z) {
   // SplitMix64 finaliser over the packed cell: equal cells give equal keys; a collision between
@@ -454,12 +456,22 @@ bool HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
       for (std::int64_t j = i; j < end; ++j) {
         const Aabb& box = entry_bounds_[j];
         const std::uint32_t a = moving_entries_[j].body();
-        for (std::int64_t k = j + 1; k < end; ++k) {
-          if (!box.overlaps(entry_bounds_[k])) continue;
-          const std::uint32_t b = moving_entries_[k].body();
-          // Bodies of different levels meet in the coarser level's lookup below (here only
-          // through a collision of keys).
-          if (level_[a] == level_[b]) emit(a, b, level_[a], key, out);
+        // The entries whose boxes overlap j's, gathered a block at a time without a branch on
+        // each test: in a crowded cell one test in seven overlaps, a branch the predictor loses.
+        for (std::int64_t from = j + 1; from < end; from += kGathered) {
+          const std::int64_t to = std::min(end, from + kGathered);
+          std::int64_t hits[kGathered];
+          int count = 0;
+          for (std::int64_t k = from; k < to; ++k) {
+            hits[count] = k;
+            count += box.overlaps(entry_bounds_[k]) ? 1 : 0;
+          }
+          for (int h = 0; h < count; ++h) {
+            const std::uint32_t b = moving_entries_[hits[h]].body();
+            // Bodies of different levels meet in the coarser level's lookup below (here only
+            // through a collision of keys).
+            if (level_[a] == level_[b]) emit(a, b, level_[a], key, out);
+          }
         }
       }
     }
