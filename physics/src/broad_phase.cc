@@ -151,6 +151,9 @@ struct CellRange {
   CellRange(const Aabb& box, double cell)
       : lo((box.min / cell).array().floor()), hi((box.max / cell).array().floor()) {}
   double count() const { return (hi - lo + 1).prod(); }
+  // Whether a level's `bodies` resting bodies are cheaper met one by one than these cells looked
+  // up (also where the count is too large to be a number of cells).
+  bool rather_each_of(std::size_t bodies) const { return !(count() < static_cast<double>(bodies)); }
   template <class Fn>
   void each(Fn&& fn) const {
     for (auto x = static_cast<std::int64_t>(lo.x()); x <= static_cast<std::int64_t>(hi.x()); ++x)
@@ -489,8 +492,7 @@ bool HashGrid::find_pairs(const BroadPhaseInput& input, std::vector<BodyPair>* p
       for (std::uint64_t levels = resting_occupied_; levels != 0; levels &= levels - 1) {
         const int level = std::countr_zero(levels);
         const auto& on_level = resting_on_level_[level];
-        if (CellRange(bounds[i], base_ * level_scale(level)).count() >=
-            static_cast<double>(on_level.size())) {
+        if (CellRange(bounds[i], base_ * level_scale(level)).rather_each_of(on_level.size())) {
           for (std::uint32_t r : on_level)
             meet(i, r, out);
         } else {
@@ -541,7 +543,7 @@ void HashGrid::resting_near(const Aabb& box, std::vector<std::uint32_t>* out) co
     const int level = std::countr_zero(levels);
     const auto& on_level = resting_on_level_[level];
     const CellRange cells(box, base_ * level_scale(level));
-    if (!(cells.count() <= static_cast<double>(on_level.size()))) {
+    if (cells.rather_each_of(on_level.size())) {
       out->insert(out->end(), on_level.begin(), on_level.end());
       continue;
     }
