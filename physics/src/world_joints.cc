@@ -275,6 +275,8 @@ void World::mark_unjoined(std::span<const BodyPair> pairs, std::span<std::uint8_
   std::size_t u = 0;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const std::uint64_t key = pair_key(pairs[i].a, pairs[i].b);
+    // The walk misses joined pairs if the list is out of order.
+    TUMBLE_ASSERT(i == 0 || pair_key(pairs[i - 1].a, pairs[i - 1].b) < key);
     while (u < unjoined_pairs_.size() && unjoined_pairs_[u] < key)
       ++u;
     out[i] = u < unjoined_pairs_.size() && unjoined_pairs_[u] == key ? 1 : 0;
