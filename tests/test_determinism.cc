@@ -242,13 +242,14 @@ TEST(Threads, StageTimesSayWhatRanOnTheTeam) {
 // pair's speculative reach measured from the two velocities together: world.cc; and when a body
 // that stays near where it was counts as quiet for sleeping however fast it rocks: step.cc; and the
 // default scene without reuse when the gyroscopic Newton step solved its 3 x 3 system by Cramer's
-// rule rather than a pivoted LU: integrate.cc, its last bits.)
+// rule rather than a pivoted LU: integrate.cc, its last bits; and the default scene when symmetric
+// tops took their free rotation's closed form instead of the midpoint rule: integrate.cc.)
 TEST(Determinism, PinnedStateHashes) {
   SceneDef default_scene = parse_scene(default_scene_json()).value();
   SceneDef pile = pile_scene(1000);
   for (int threads : {1, 2, 4}) {
     SCOPED_TRACE(std::to_string(threads) + " threads");
-    EXPECT_EQ(run_with_threads(default_scene, threads, 300).hash, 0x1af7c5e86bc9a625ull)
+    EXPECT_EQ(run_with_threads(default_scene, threads, 300).hash, 0xa130839c33be5fd1ull)
         << "default scene";
     EXPECT_EQ(run_with_threads(pile, threads, 150).hash, 0xfa15c5fa9c43a99cull) << "pile of 1000";
   }
@@ -256,7 +257,7 @@ TEST(Determinism, PinnedStateHashes) {
   // kept their features, pinned on its own.
   default_scene.world.solver.manifold_reuse = 0;
   pile.world.solver.manifold_reuse = 0;
-  EXPECT_EQ(run_with_threads(default_scene, 2, 300).hash, 0x650ca24d1000dcc7ull)
+  EXPECT_EQ(run_with_threads(default_scene, 2, 300).hash, 0xfc34fd36c20aa7a8ull)
       << "default scene, no reuse";
   EXPECT_EQ(run_with_threads(pile, 2, 150).hash, 0x08166f42b48d92a5ull) << "pile, no reuse";
 }
@@ -297,13 +298,15 @@ TEST(Determinism, RagdollHeapOnTheTeamSameBitsForAnyThreadCount) {
 // when their sweeps held joints that share a component or an island with contacts at rate zero;
 // exact's when contacts on jointed bodies joined its LCP: they had been left to auto's; the
 // direct solve's when the second position pass after a move became a chord step through the
-// first's factors, where those serve the velocity sweeps: step.cc.)
+// first's factors, where those serve the velocity sweeps: step.cc; every one when symmetric tops
+// (the ragdolls' capsules, the chain's square bars) took their free rotation's closed form:
+// integrate.cc.)
 TEST(Determinism, PinnedJointSceneHashes) {
   const std::pair<SolverKind, std::uint64_t> ragdolls[] = {
-      {SolverKind::kAuto, 0x05abded6dca12dedull},
-      {SolverKind::kSoft, 0xc2f63904fe9f38ecull},
-      {SolverKind::kPgs, 0x37fac2aa87901190ull},
-      {SolverKind::kExact, 0xd581b458c9a767ceull}};
+      {SolverKind::kAuto, 0xbe512091ecff837dull},
+      {SolverKind::kSoft, 0xccacc597e3e61e0eull},
+      {SolverKind::kPgs, 0x12501c0fb8ce5208ull},
+      {SolverKind::kExact, 0xb74de25abc201b10ull}};
   for (const auto& [kind, pinned] : ragdolls) {
     SceneDef scene = ragdolls_scene(4);
     scene.world.solver.kind = kind;
@@ -311,7 +314,7 @@ TEST(Determinism, PinnedJointSceneHashes) {
     for (int threads : {1, 2})
       EXPECT_EQ(run_with_threads(scene, threads, 120).hash, pinned) << "ragdolls:4";
   }
-  EXPECT_EQ(run_with_threads(chain_scene(20, 1000), 1, 120).hash, 0xf714d646b9a79474ull)
+  EXPECT_EQ(run_with_threads(chain_scene(20, 1000), 1, 120).hash, 0xe24bbbba099bd032ull)
       << "chain:20:1000";
 }
 

@@ -1,3 +1,4 @@
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <string>
 
@@ -114,9 +115,48 @@ Result<Body> make_body(const BodyDef& def) {
       return Status::error("shape: its inertia tensor is singular");
     const Mat3 spherical = Mat3::Identity() * (props.inertia.trace() / 3);
     body.spherical_inertia = (props.inertia - spherical).norm() <= 1e-12 * props.inertia.norm();
+    body.refresh_symmetric_top();
   }
   body.update_world_inertia();
   return body;
+}
+
+void Body::refresh_symmetric_top() {
+  symmetric_axis.setZero();
+  symmetric_spin_ratio = 0;
+  if (!is_dynamic() || spherical_inertia || !inertia_body.allFinite()) return;
+  // Moments within this fraction of the largest count as equal: the torque the difference would
+  // give is that fraction of the gyroscopic torque, far below the step's own error.
+  const auto equal = [&](double a, double b, double largest) {
+    return std::abs(a - b) <= 1e-12 * largest;
+  };
+  const auto set = [&](const Vec3& axis, double along, double across) {
+    if (!(across > 0)) return;
+    symmetric_axis = axis.normalized();
+    symmetric_spin_ratio = (across - along) / across;
+  };
+  const Vec3 d = inertia_body.diagonal();
+  if (inertia_body.isDiagonal(0)) {
+    // The principal axes are the body's own (boxes, capsules, cylinders as made): the axis exact.
+    const double largest = d.maxCoeff();
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      if (equal(d[i], d[j], largest) && !equal(d[k], d[i], largest)) {
+        set(Vec3::Unit(k), d[k], 0.5 * (d[i] + d[j]));
+        return;
+      }
+    }
+    return;
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> solver(inertia_body);
+  if (solver.info() != Eigen::Success) return;
+  const Vec3 moments = solver.eigenvalues();  // ascending
+  const double largest = moments[2];
+  if (equal(moments[0], moments[1], largest) && !equal(moments[1], moments[2], largest)) {
+    set(solver.eigenvectors().col(2), moments[2], 0.5 * (moments[0] + moments[1]));
+  } else if (equal(moments[1], moments[2], largest) && !equal(moments[0], moments[1], largest)) {
+    set(solver.eigenvectors().col(0), moments[0], 0.5 * (moments[1] + moments[2]));
+  }
 }
 
 Result<MassProperties> body_mass_properties(const BodyDef& def) {

@@ -35,6 +35,14 @@ struct Body {
   CollisionFilter filter;
   // The inertia is a multiple of the identity (sphere, cube): no gyroscopic torque.
   bool spherical_inertia = false;
+  // A symmetric top (two principal moments equal, as a capsule's, a cylinder's or a square
+  // bar's): its axis of symmetry in body axes, and (I_across - I_along) / I_across, the rate its
+  // angular velocity turns about that axis per rad/s of spin along it. Its free rotation then has
+  // a closed form (integrate.cc). A zero axis: no such top (or a sphere). Worked out from the
+  // inertia (refresh_symmetric_top), not stored in a saved state.
+  Vec3 symmetric_axis = Vec3::Zero();
+  double symmetric_spin_ratio = 0;
+  void refresh_symmetric_top();
   // Sleeping: how long the body has stayed near where its quiet time began (s; 0 starts it anew),
   // that pose (the sleep anchor), whether it sleeps, and the island it fell asleep with (its
   // lowest slot), which wakes as one.

@@ -97,6 +97,21 @@ bool integrate_velocity(const Body& body, const Quat& orientation, const Vec3& g
     turn_about_w();
     return true;
   }
+  if (body.symmetric_spin_ratio != 0) {
+    // A symmetric top in closed form: w = L / I_across + spin a, with the spin about the axis a
+    // constant and L fixed, turns as a turn of w_momentum = L / I_across about L followed (in body
+    // axes first) by a turn of spin about a (Landau and Lifshitz, Mechanics, sec. 33). Exact for
+    // any step, so energy and world momentum stay, and no Newton or pieces: a fast spinner costs
+    // what a slow one does.
+    const Vec3 axis = orientation * body.symmetric_axis;
+    const double spin = body.symmetric_spin_ratio * axis.dot(state->w);
+    const Vec3 w_momentum = state->w - spin * axis;
+    const Quat precession = rotation_quaternion(h * w_momentum);
+    state->free_turn = precession * rotation_quaternion((h * spin) * axis);
+    state->w = w_momentum + spin * (precession * axis);
+    state->w_free = state->w;
+    return true;
+  }
   const Vec3 w_start = orientation.conjugate() * state->w;
   // Newton converges from the old velocity only while the body turns little in the solve; a fast
   // spinner (300 rad/s at dt 1/60 turns 5 rad a step) is advanced in pieces of at most

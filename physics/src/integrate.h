@@ -1,4 +1,5 @@
-// Time integration of one body: symplectic Euler with an implicit-midpoint gyroscopic step.
+// Time integration of one body: symplectic Euler with an implicit-midpoint gyroscopic step (a
+// symmetric top's free rotation in closed form).
 #pragma once
 
 #include "body_state.h"
@@ -14,9 +15,10 @@ constexpr double kGyroscopicMaxTurn = 0.5;
 constexpr int kGyroscopicMaxPieces = 1024;
 
 // Velocities over h: gravity (scaled by the body's gravity_scale), its held force and torque and
-// its damping (implicit: v / (1 + c h)), then the free rotation of Euler's equations in body axes by the
-// implicit midpoint rule, which keeps kinetic energy and |L| of a free body exactly (both are
-// quadratic invariants, Hairer-Lubich-Wanner ch. IV). Returns false when Newton hit its bound
+// its damping (implicit: v / (1 + c h)), then the free rotation of Euler's equations in body axes
+// by the implicit midpoint rule, which keeps kinetic energy and |L| of a free body exactly (both
+// are quadratic invariants, Hairer-Lubich-Wanner ch. IV); a symmetric top (Body::symmetric_axis)
+// takes its exact free rotation instead, and never fails. Returns false when Newton hit its bound
 // or the spin needs more pieces than allowed; the body then keeps its body-frame angular
 // velocity for the step (energy and |L| still exact), and the step counts it. Either way it
 // prepares state->free_turn and w_free for integrate_position.

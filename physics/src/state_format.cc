@@ -318,6 +318,7 @@ Status take_body(Reader& r, Body* b) {
   b->friction = r.take<double>("friction");
   b->restitution = r.take<double>("restitution");
   b->spherical_inertia = take_flag(r, "spherical_inertia");
+  b->refresh_symmetric_top();  // from the inertia; a wrong one is refused with the whole state
   b->sleep_timer = r.take<double>("sleep_timer");
   b->sleep_anchor_position = r.vec3("sleep_anchor_position");
   b->sleep_anchor_orientation = r.quat("sleep_anchor_orientation");
