@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "scene_runner.h"
@@ -157,8 +158,8 @@ TEST(Spin, SymmetricTopFollowsItsClosedForm) {
   const Quat slant(Eigen::AngleAxisd(0.9, Vec3(1, -1, 0.3).normalized()));
   for (int k = 0; k < 6; ++k)
     for (double z : {-0.3, 0.3})
-      hexagon.points.push_back(slant *
-                               Vec3(0.2 * std::cos(k * M_PI / 3), 0.2 * std::sin(k * M_PI / 3), z));
+      hexagon.points.push_back(slant * Vec3(0.2 * std::cos(k * std::numbers::pi / 3),
+                                            0.2 * std::sin(k * std::numbers::pi / 3), z));
   prism.shape = hexagon;
   for (const BodyDef* shape : {&capsule, &prism}) {
     for (const double rate : {5.0, 1e5}) {
