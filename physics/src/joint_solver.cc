@@ -460,7 +460,7 @@ struct JointTargets {
 template <class Out>
 void equations_of(Out& e, const JointRow& row, std::span<const SolverBody> bodies,
                   std::span<const Pose> poses, const JointTarget* velocities,
-                  const Quat* turns = nullptr) {
+                  const Quat* turns = nullptr, const Anchors* known_anchors = nullptr) {
   constexpr bool kRows = std::is_same_v<Out, JointEquations>;
   JointEquations::Vector& target = e.target;
   const Joint& joint = row.joint;
@@ -469,7 +469,8 @@ void equations_of(Out& e, const JointRow& row, std::span<const SolverBody> bodie
   const SolverBody& b = world_b ? kWorldBody : bodies[row.b];
   const Pose& pose_a = poses[row.a];
   const Pose pose_b = world_b ? Pose{} : poses[row.b];
-  const Anchors anchors = anchors_of(joint, pose_a, pose_b, world_b);
+  const Anchors anchors =
+      known_anchors != nullptr ? *known_anchors : anchors_of(joint, pose_a, pose_b, world_b);
   const double h = velocities != nullptr ? velocities->h : 0;
   const double most = velocities != nullptr ? velocities->most_speed : 0;
   const Vec3 rate = (b.v + b.w.cross(anchors.rb)) - (a.v + a.w.cross(anchors.ra));
@@ -562,9 +563,10 @@ void equations_of(Out& e, const JointRow& row, std::span<const SolverBody> bodie
 }  // namespace
 
 void velocity_equations(JointEquations* e, const JointRow& row, std::span<const SolverBody> bodies,
-                        std::span<const Pose> poses, const JointTarget& target) {
+                        std::span<const Pose> poses, const JointTarget& target,
+                        const Anchors* anchors) {
   clear_equations(e);
-  equations_of(*e, row, bodies, poses, &target);
+  equations_of(*e, row, bodies, poses, &target, nullptr, anchors);
   if (row.motor_in_tree && e->rows == 5) {
     // The motor's row: the free coordinate's rate is its speed.
     const bool world_b = row.b == kWorldAnchor;
@@ -580,9 +582,9 @@ void velocity_equations(JointEquations* e, const JointRow& row, std::span<const 
 
 JointEquations::Vector velocity_targets(const JointRow& row, std::span<const SolverBody> bodies,
                                         std::span<const Pose> poses, const JointTarget& target,
-                                        const Quat* turns) {
+                                        const Quat* turns, const Anchors* anchors) {
   JointTargets e;
-  equations_of(e, row, bodies, poses, &target, turns);
+  equations_of(e, row, bodies, poses, &target, turns, anchors);
   if (row.motor_in_tree && e.rows == 5) {
     const bool world_b = row.b == kWorldAnchor;
     if (free_coordinate(row.joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b).exists)

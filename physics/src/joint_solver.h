@@ -15,6 +15,9 @@
 #include "physics/math.h"
 
 namespace tumble {
+namespace joint_detail {
+struct Anchors;  // joint_geometry.h
+}
 
 // A joint as the step solves it: its bodies by solver index (kWorldAnchor: the world) and a
 // copy of what it needs, impulses included (stored back to the world's joint after the solve).
@@ -78,15 +81,17 @@ struct JointEquations {
   Eigen::Matrix<double, 6, 1> target = Eigen::Matrix<double, 6, 1>::Zero();
 };
 // For velocities, with the sweep's target (a move ahead: the rates that end it on the joint).
+// `anchors`, where given, the joint's anchors at these poses (JointPoseTerms: the same bits).
 void velocity_equations(JointEquations* equations, const JointRow& row,
                         std::span<const SolverBody> bodies, std::span<const Pose> poses,
-                        const JointTarget& target);
+                        const JointTarget& target, const joint_detail::Anchors* anchors = nullptr);
 // Their targets alone (velocity_equations' target), without building the rows; `turns`, where
 // given, each body's rotation_quaternion(target.h w) by solver index (the same answer, without
 // a sine and cosine a joint end).
 JointEquations::Vector velocity_targets(const JointRow& row, std::span<const SolverBody> bodies,
                                         std::span<const Pose> poses, const JointTarget& target,
-                                        const Quat* turns = nullptr);
+                                        const Quat* turns = nullptr,
+                                        const joint_detail::Anchors* anchors = nullptr);
 // Whether the equations' last row is the joint's motor (JointRow::motor_in_tree).
 bool motor_row(const JointRow& row, const JointEquations& equations);
 // For positions: target = minus the error. With `bounds`, the joint's cone and limit that the

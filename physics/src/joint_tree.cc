@@ -307,7 +307,8 @@ constexpr int kMostTakes = 6;
 
 bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
-                                        std::span<const Pose> poses, double h) {
+                                        std::span<const Pose> poses, double h,
+                                        std::span<const JointPoseTerms> terms) {
   for (TreeBody& body : tree_bodies_) {
     body.linear_stiffness.setZero();
     body.angular_stiffness.setZero();
@@ -321,7 +322,8 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     const bool world_b = row.b == kWorldAnchor;
     const Pose pose_b = world_b ? Pose{} : poses[row.b];
     const joint_detail::Anchors anchors =
-        joint_detail::anchors_of(joint, poses[row.a], pose_b, world_b);
+        terms.empty() ? joint_detail::anchors_of(joint, poses[row.a], pose_b, world_b)
+                      : terms[tree_joint.row].anchors;
     // The force on b (a takes the opposite).
     Vec3 force_on_b = Vec3::Zero();
     Mat3 linear = Mat3::Zero();
@@ -657,16 +659,19 @@ void JointTree::substitute() {
 }
 
 double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBody> bodies,
-                                   std::span<const Pose> poses, const JointTarget& target) {
+                                   std::span<const Pose> poses, const JointTarget& target,
+                                   std::span<const JointPoseTerms> terms) {
   if (joints_.empty()) return 0;
   // The poses stay put between moves: one factoring serves every sweep until the next.
   if (!velocities_factored_) {
-    stiffened_ = stiffness_kept_ || set_geometric_stiffness(rows, bodies, poses, target.substep);
+    stiffened_ =
+        stiffness_kept_ || set_geometric_stiffness(rows, bodies, poses, target.substep, terms);
     stiffness_kept_ = false;
     factor(bodies, true, [&](std::size_t k, JointEquations* equations) {
       JointTarget plain = target;
       plain.h = 0;
-      velocity_equations(equations, rows[joints_[k].row], bodies, poses, plain);
+      const std::uint32_t row = joints_[k].row;
+      velocity_equations(equations, rows[row], bodies, poses, plain, &terms[row].anchors);
     });
     velocities_factored_ = true;
   }
@@ -694,24 +699,26 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   auto rates_of = [&](std::size_t k, const std::vector<Vec6>& targets) {
     Vec6 rates = target.h > 0 ? targets[k] : Vec6(Vec6::Zero());
     const JointRow& row = rows[joints_[k].row];
-    if (motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
+    if (has_motors_ && motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
     return rates;
   };
   bool solved = false;
   if (target.h > 0 && !targets_taken_) {
     JointTarget plain = target;
     plain.h = 0;
-    solve_velocities(rows, bodies, poses, plain);
+    solve_velocities(rows, bodies, poses, plain, terms);
     kept_targets_.resize(joints_.size());
     set_turns(rows, bodies, target.h);
-    for (std::size_t k = 0; k < joints_.size(); ++k)
-      kept_targets_[k] =
-          velocity_targets(rows[joints_[k].row], bodies, poses, target, index_->turns.data());
+    for (std::size_t k = 0; k < joints_.size(); ++k) {
+      const std::uint32_t row = joints_[k].row;
+      kept_targets_[k] = velocity_targets(rows[row], bodies, poses, target, index_->turns.data(),
+                                          &terms[row].anchors);
+    }
     // Where an iterate is not taken, the solve of the targets kept (from the same velocities) is
     // this sweep's.
     double last = kConvergedTakes;
     for (int take = 2; target.conserving; ++take) {
-      const Retake retake = take_targets_again(rows, bodies, poses, target, rates_of, last);
+      const Retake retake = take_targets_again(rows, bodies, poses, target, rates_of, last, terms);
       if (!(retake.ratio <= last)) {
         // Not contracting: the takes so far stand (after the second, the bound is reported).
         if (take > 2) ++take_limit_hits_;
@@ -752,7 +759,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   // excess taken back from the bodies) and it goes on as a Gauss-Seidel row, the others solved
   // again without it.
   bool saturated = false;
-  for (std::size_t k = 0; k < joints_.size(); ++k) {
+  for (std::size_t k = 0; has_motors_ && k < joints_.size(); ++k) {
     JointRow& row = rows[joints_[k].row];
     if (!motor_row(row, equations_[k])) continue;
     const double most = row.joint.motor.max_force * target.substep;
@@ -771,7 +778,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   if (saturated) {
     velocities_factored_ = false;
     targets_taken_ = false;
-    change = std::max(change, solve_velocities(rows, bodies, poses, target));
+    change = std::max(change, solve_velocities(rows, bodies, poses, target, terms));
   }
   return change;
 }
@@ -781,7 +788,8 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
                                                 std::span<SolverBody> bodies,
                                                 std::span<const Pose> poses,
                                                 const JointTarget& target, Rates rates_of,
-                                                double refused_above) {
+                                                double refused_above,
+                                                std::span<const JointPoseTerms> terms) {
   const std::size_t joints = joints_.size(), tree_bodies = tree_bodies_.size();
   held_velocities_.resize(tree_bodies);
   second_targets_.resize(joints);
@@ -809,7 +817,8 @@ JointTree::Retake JointTree::take_targets_again(std::span<const JointRow> rows,
   for (std::size_t k = 0; k < joints && !(relative() > refused_above); ++k) {
     const JointRow& row = rows[joints_[k].row];
     turn_bodies_of(row, bodies, target.h);
-    second_targets_[k] = velocity_targets(row, bodies, poses, target, index_->turns.data());
+    second_targets_[k] = velocity_targets(row, bodies, poses, target, index_->turns.data(),
+                                          &terms[joints_[k].row].anchors);
     change = std::max(change, (second_targets_[k] - kept_targets_[k]).lpNorm<Eigen::Infinity>());
   }
   for (std::size_t k = 0; k < tree_bodies; ++k) {

@@ -23,6 +23,7 @@
 
 #include "contact_solver.h"
 #include "joint_solver.h"
+#include "joint_terms.h"
 
 namespace tumble {
 
@@ -61,8 +62,11 @@ class JointTree {
   void forget_velocity_factors() { velocities_factored_ = false; }
   // Velocities that hold every joint's rows at the sweep's targets (JointTarget); the impulses
   // are added to the joints' warm start. Returns the largest velocity change it made.
+  // `terms`: the island's joints' terms at these poses (prepare_joint_terms), by row, whose
+  // anchors it reads rather than working them out again.
   double solve_velocities(std::span<JointRow> rows, std::span<SolverBody> bodies,
-                          std::span<const Pose> poses, const JointTarget& target);
+                          std::span<const Pose> poses, const JointTarget& target,
+                          std::span<const JointPoseTerms> terms);
   // Moves the bodies onto every joint's rows, to first order (one Newton step; velocities
   // untouched): a position pass. Without `refactor`, with the rows of the pass before (a chord
   // step: the passes after the first correct errors a million times smaller, through rows that
@@ -211,11 +215,13 @@ class JointTree {
   template <class Rates>
   Retake take_targets_again(std::span<const JointRow> rows, std::span<SolverBody> bodies,
                             std::span<const Pose> poses, const JointTarget& target, Rates rates_of,
-                            double refused_above);
+                            double refused_above, std::span<const JointPoseTerms> terms);
   // Sets each body's stiffness (TreeBody) for a substep of h (joint_tree.cc: why and how much);
   // whether any body has some.
+  // With `terms` (by row; empty where they are not at these poses), their anchors are read.
   bool set_geometric_stiffness(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
-                               std::span<const Pose> poses, double h);
+                               std::span<const Pose> poses, double h,
+                               std::span<const JointPoseTerms> terms = {});
 
   // What a forest is built from: each joint's row, its bodies, and whether it holds rows and
   // each body moves.

@@ -468,9 +468,9 @@ class SerialIsland {
                              : solve_joint(row, bodies_, c_.scratch.poses, visit, terms));
         }
         if (direct)
-          change = std::max(
-              change, trees_[component].solve_velocities(c_.scratch.joint_rows, bodies_,
-                                                         c_.scratch.poses, tree_target(target)));
+          change = std::max(change, trees_[component].solve_velocities(
+                                        c_.scratch.joint_rows, bodies_, c_.scratch.poses,
+                                        tree_target(target), c_.scratch.joint_terms));
       }
     }
     // Each thread's trees' stiffness goes with its change: past the barrier another may already
@@ -544,8 +544,9 @@ class SerialIsland {
         change =
             std::max(change, solve_joint_drives(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses,
                                                 target, c_.scratch.joint_terms[j], false));
-      change = std::max(change, tree.solve_velocities(c_.scratch.joint_rows, bodies_,
-                                                      c_.scratch.poses, tree_target(target)));
+      change =
+          std::max(change, tree.solve_velocities(c_.scratch.joint_rows, bodies_, c_.scratch.poses,
+                                                 tree_target(target), c_.scratch.joint_terms));
       // The first visit's change leaves out the tree's first solve of the substep (its targets'
       // base), so it is never taken as converged.
       if ((one_sweep_solves_ && !tree.stiffened()) ||
