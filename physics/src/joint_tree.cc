@@ -319,11 +319,14 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     const JointRow& row = rows[tree_joint.row];
     const Joint& joint = row.joint;
     if (!(joint.impulse_time > 0)) continue;
-    const bool world_b = row.b == kWorldAnchor;
-    const Pose pose_b = world_b ? Pose{} : poses[row.b];
-    const joint_detail::Anchors anchors =
-        terms.empty() ? joint_detail::anchors_of(joint, poses[row.a], pose_b, world_b)
-                      : terms[tree_joint.row].anchors;
+    joint_detail::Anchors worked_out;
+    if (terms.empty()) {
+      const bool world_b = row.b == kWorldAnchor;
+      worked_out =
+          joint_detail::anchors_of(joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b);
+    }
+    const joint_detail::Anchors& anchors =
+        terms.empty() ? worked_out : terms[tree_joint.row].anchors;
     // The force on b (a takes the opposite).
     Vec3 force_on_b = Vec3::Zero();
     Mat3 linear = Mat3::Zero();
