@@ -270,8 +270,11 @@ bool JointTree::number_forest(std::span<const JointRow> rows, std::span<const So
 
 void JointTree::finish_build(std::span<const JointRow> rows, std::span<const SolverBody> bodies) {
   has_motors_ = false;
-  for (const TreeJoint& joint : joints_)
+  loads_unknown_ = false;
+  for (const TreeJoint& joint : joints_) {
     has_motors_ = has_motors_ || rows[joint.row].joint.motor.enabled;
+    loads_unknown_ = loads_unknown_ || !(rows[joint.row].joint.impulse_time > 0);
+  }
   for (TreeBody& body : tree_bodies_)
     body.inertia = bodies[body.index].inverse_inertia.inverse();
   velocities_factored_ = false;
@@ -283,19 +286,29 @@ void JointTree::finish_build(std::span<const JointRow> rows, std::span<const Sol
 // A chain's tension turns its links back into line, a stiffness (the constraint forces' change
 // with the links' turn: the geometric stiffness) that the velocity solve meets only through the
 // next substep's rows: explicitly. Under a heavy end the light links' transverse modes pass the
-// explicit limit (a 0.2 m, 0.5 kg link under a 500 kg end rings at ~440 rad/s: 1.8 rad a 1/240
-// s substep) and the chain tears. As Andrews, Teichmann and Kry (2017, "Geometric stiffness for
-// real-time constrained multibody dynamics", Eurographics) do, the stiffness times h^2 is added to
-// the bodies' mass in the velocity solve: implicit, so those modes are damped rather than
-// amplified. Implicit Euler also damps the slow modes (a pendulum's swing is this stiffness), by
-// (omega h)^2 a substep, so only the part of a body's stiffness beyond the explicit scheme's
-// comfortable reach (omega h above kResolvedTurn) is added: a pendulum or a chain of like links
-// gets none and keeps its energy, a light link under a heavy load gets nearly all of it.
+// explicit limit (a 0.2 m, 0.5 kg bar under a 500 kg end, turning about its centre between its
+// two joints, rings at ~770 rad/s: 3.2 rad a 1/240 s substep) and the chain tears. As Andrews,
+// Teichmann and Kry (2017, "Geometric stiffness for real-time constrained multibody dynamics",
+// Eurographics) do, the stiffness times h^2 is added to the bodies' mass in the velocity solve:
+// implicit, so those modes are damped rather than amplified. Implicit Euler also damps the slow
+// modes (a pendulum's swing is this stiffness), by (omega h)^2 a substep, so only the part of a
+// body's stiffness beyond the explicit scheme's comfortable reach (omega h above kResolvedShift or
+// kResolvedTurn) is added: a pendulum or a chain of like links gets none and keeps its energy, a
+// light link under a heavy load gets nearly all of it.
 //
 // The stiffness of a force f on a body at the lever r (for a unit turn about any axis across r):
 // |f| |r| (1 - r r^T / |r|^2), and a rod's (a distance joint's) on its ends' positions,
 // |f| / length (1 - n n^T); the forces are the joints' impulses over the time they took.
-constexpr double kResolvedTurn = 0.5;  // omega h, rad
+//
+// omega is each body's own, its neighbours held; a chain's fastest modes move neighbours against
+// each other (a zig-zag) and ring faster than that, so the reach is below the explicit limit
+// (omega h = 2) by a margin, measured: ropes of beads on rods (distance joints) tore with shifts
+// resolved to 0.85 (ten 2 cm beads 10 cm apart under a 10^4 times heavier end, dt 1/120) and held
+// at 0.7; turns, against the inertias below, held every chain of the joints' tests to 1.6 and a
+// matrix of 810 chains (beads of 5 mm to 5 cm and square bars, links of 0.1 to 0.5 m, 10 to 40 of
+// them, ends 10 to 10^6 times heavier, dt 1/30 to 1/120) alike from 0.7 to 1.4.
+constexpr double kResolvedShift = 0.5;  // omega h, rad
+constexpr double kResolvedTurn = 1.0;   // omega h, rad
 // How far SHAKE's second iterate of the curvature targets may move them (relative to the first)
 // and still be taken (solve_velocities: measured choices there).
 constexpr double kConvergedTakes = 0.03;
@@ -313,6 +326,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     body.linear_stiffness.setZero();
     body.angular_stiffness.setZero();
     body.longest_lever.setZero();
+    body.levers = 0;
   }
   const double h2 = h * h;
   for (const TreeJoint& tree_joint : joints_) {
@@ -349,6 +363,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
       if (joint.kind == JointKind::kDistance) body_node.linear_stiffness += linear;
       const double arm = r.norm();
       if (arm > body_node.longest_lever.norm()) body_node.longest_lever = r;
+      if (body_node.levers < 2) ++body_node.levers;
       // Only the pull along the lever turns the body back into line (a chain's tension); a force
       // across it (a load held out sideways) has no stiffness of this kind to speak of.
       const double pull = arm > 1e-12 ? force.dot(r) / arm : 0.0;
@@ -357,18 +372,18 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
             h2 * pull / arm * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
     }
   }
-  // Only the part beyond kResolvedTurn: scaled by 1 - rho0 / rho, where rho = (omega h)^2 of the
-  // body's stiffest turn or shift (and rho0 = kResolvedTurn^2); continuous in the load.
-  const double resolved = kResolvedTurn * kResolvedTurn;
+  // Only the part beyond the reach: scaled by 1 - rho0 / rho, where rho = (omega h)^2 of the
+  // body's stiffest turn or shift (and rho0 = kResolvedTurn^2 or kResolvedShift^2); continuous in
+  // the load.
   bool any = false;
   // rho: the largest eigenvalue of W^1/2 K W^1/2 (W the inverse mass or inertia, M its inverse).
   // rho < r exactly when r M - K is positive definite (the same congruence): three leading minors,
   // a few dozen operations, where the eigenvalues cost a hundred times that. Tested with r a
   // millionth short, so that a body it passes is one whose rho the eigenvalues would find below
   // r too (their error is near rounding): the same stiffness, zero, and the same bits.
-  const double surely_resolved = resolved * (1 - 1e-6);
-  auto keep_excess = [&](Mat3& stiffness, const Mat3& mass, auto inverse_of_mass) {
-    const Mat3 margin = surely_resolved * mass - stiffness;
+  auto keep_excess = [&](Mat3& stiffness, const Mat3& mass, auto inverse_of_mass, double reach) {
+    const double resolved = reach * reach;
+    const Mat3 margin = resolved * (1 - 1e-6) * mass - stiffness;
     const double minor2 = margin(0, 0) * margin(1, 1) - margin(0, 1) * margin(1, 0);
     if (margin(0, 0) > 0 && minor2 > 0 && margin.determinant() > 0) {
       stiffness.setZero();
@@ -392,16 +407,21 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
   for (TreeBody& node : tree_bodies_) {
     const SolverBody& body = bodies[node.index];
     if (!node.linear_stiffness.isZero(0))
-      keep_excess(node.linear_stiffness, Mat3(Mat3::Identity() / body.inverse_mass),
-                  [&] { return Mat3(body.inverse_mass * Mat3::Identity()); });
+      keep_excess(
+          node.linear_stiffness, Mat3(Mat3::Identity() / body.inverse_mass),
+          [&] { return Mat3(body.inverse_mass * Mat3::Identity()); }, kResolvedShift);
     if (node.angular_stiffness.isZero(0)) continue;
-    // A turn moves the anchors, and the joints move the body with them: against its longest
-    // lever r the turn's inertia is at least I + m (|r|^2 - r r^T) (a pendulum's bob turns about
-    // its pivot, not its centre).
-    const Vec3& r = node.longest_lever;
+    // Held by one joint, a body turns about that joint's anchor, not its centre (a pendulum's bob;
+    // the joint moves it with the anchor): inertia I + m (|r|^2 - r r^T), r its lever. Held by
+    // several, it can turn about its centre, each anchor carrying a neighbour along (a bead on a
+    // string between two others): inertia I. A bead of 5 mm between anchors 5 cm away turns about
+    // its centre with a 250th of the inertia about an anchor, 16 times as fast; taken about its
+    // longest lever, its stiffness went unseen and chains of such beads tore within a second.
+    const Vec3 r = node.levers >= 2 ? Vec3(Vec3::Zero()) : node.longest_lever;
     const Mat3 turning =
         node.inertia + (r.squaredNorm() * Mat3::Identity() - r * r.transpose()) / body.inverse_mass;
-    keep_excess(node.angular_stiffness, turning, [&] { return Mat3(turning.inverse()); });
+    keep_excess(
+        node.angular_stiffness, turning, [&] { return Mat3(turning.inverse()); }, kResolvedTurn);
   }
   return any;
 }
@@ -667,15 +687,20 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   if (joints_.empty()) return 0;
   // The poses stay put between moves: one factoring serves every sweep until the next.
   if (!velocities_factored_) {
-    stiffened_ =
-        stiffness_kept_ || set_geometric_stiffness(rows, bodies, poses, target.substep, terms);
-    stiffness_kept_ = false;
-    factor(bodies, true, [&](std::size_t k, JointEquations* equations) {
+    const auto equations_of_row = [&](std::size_t k, JointEquations* equations) {
       JointTarget plain = target;
       plain.h = 0;
       const std::uint32_t row = joints_[k].row;
       velocity_equations(equations, rows[row], bodies, poses, plain, &terms[row].anchors);
-    });
+    };
+    if (loads_unknown_) {
+      learn_loads(rows, bodies, equations_of_row);
+      stiffness_kept_ = false;
+    }
+    stiffened_ =
+        stiffness_kept_ || set_geometric_stiffness(rows, bodies, poses, target.substep, terms);
+    stiffness_kept_ = false;
+    factor(bodies, true, equations_of_row);
     velocities_factored_ = true;
   }
   // The targets of a move ahead (the turns' curvature) depend on the velocities: SHAKE's
@@ -784,6 +809,39 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
     change = std::max(change, solve_velocities(rows, bodies, poses, target, terms));
   }
   return change;
+}
+
+// The geometric stiffness reads each joint's load from its impulse, and a joint not yet solved has
+// none: a chain made taut under a heavy end, its links small beads (a bead's turn between its two
+// anchors rings thousands of times faster than the chain swings), met its first substep with no
+// stiffness, and a push on its end in that substep tore it (a 5 mm bead chain under a 10^4 times
+// heavier end opened 1 m within three steps; pushed a step later, it held to 1e-12 m). So a tree
+// with such a joint first solves without stiffness, holding every joint at rate zero: the
+// impulses that hold the bodies as they are, the loads its stiffness is then worked out from.
+template <class VelocityEquations>
+void JointTree::learn_loads(std::span<JointRow> rows, std::span<SolverBody> bodies,
+                            VelocityEquations velocity_equations) {
+  loads_unknown_ = false;
+  for (TreeBody& body : tree_bodies_) {
+    body.linear_stiffness.setZero();
+    body.angular_stiffness.setZero();
+  }
+  factor(bodies, true, velocity_equations);
+  set_velocity_base(bodies);
+  solve(true, [&](std::size_t k) {
+    Vec6 rates = Vec6::Zero();
+    const JointRow& row = rows[joints_[k].row];
+    if (has_motors_ && motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
+    return rates;
+  });
+  if (!solution_finite()) return;
+  for (std::size_t k = 0; k < joints_.size(); ++k)
+    add_equation_impulses(rows[joints_[k].row], equations_[k], -joints_[k].rhs);
+  for (const TreeBody& tree_body : tree_bodies_) {
+    SolverBody& body = bodies[tree_body.index];
+    body.v = tree_body.result.head<3>();
+    body.w = tree_body.result.tail<3>();
+  }
 }
 
 template <class Rates>

@@ -136,6 +136,7 @@ class JointTree {
     // mass in the velocity solve.
     Mat3 linear_stiffness = Mat3::Zero(), angular_stiffness = Mat3::Zero();
     Vec3 longest_lever = Vec3::Zero();  // from the body's centre to its farthest joint anchor
+    std::uint8_t levers = 0;            // its joints the stiffness met, counted to 2
     // The inverse of the mass the last factoring used (with stiffness: `stiff`; else the
     // body's inverse mass and inertia).
     bool stiff = false;
@@ -203,6 +204,11 @@ class JointTree {
   void turn_bodies_of(const JointRow& row, std::span<const SolverBody> bodies, double h);
   // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
   void set_velocity_base(std::span<const SolverBody> bodies);
+  // The joints' impulses of a solve without stiffness, at rate zero (motors at their speed),
+  // added to the joints' rows and the bodies' velocities: loads for set_geometric_stiffness.
+  template <class VelocityEquations>
+  void learn_loads(std::span<JointRow> rows, std::span<SolverBody> bodies,
+                   VelocityEquations velocity_equations);
   // SHAKE's next iterate of the curvature targets in kept_targets_ (solve_velocities), into
   // second_targets_: the kept targets solved (the solution left in the joints' and bodies'
   // results; the bodies' velocities as they were) and the targets taken again from the
@@ -261,6 +267,9 @@ class JointTree {
   // stiffness worked out for the next velocity factoring.
   bool share_pending_ = false, stiffness_kept_ = false;
   bool has_motors_ = false;     // a joint with a motor: its row joins the velocity system
+  // A joint the step has not yet solved (just made: no impulse to tell its load): the first
+  // velocity factoring learns the loads first (solve_velocities).
+  bool loads_unknown_ = false;
   bool targets_taken_ = false;  // since the last move
   std::uint32_t take_limit_hits_ = 0;
   // For building: each node's neighbours and the visit.
