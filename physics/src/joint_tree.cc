@@ -305,8 +305,9 @@ void JointTree::finish_build(std::span<const JointRow> rows, std::span<const Sol
 // (omega h = 2) by a margin, measured: ropes of beads on rods (distance joints) tore with shifts
 // resolved to 0.85 (ten 2 cm beads 10 cm apart under a 10^4 times heavier end, dt 1/120) and held
 // at 0.7; turns, against the inertias below, held every chain of the joints' tests to 1.6 and a
-// matrix of 810 chains (beads of 5 mm to 5 cm and square bars, links of 0.1 to 0.5 m, 10 to 40 of
-// them, ends 10 to 10^6 times heavier, dt 1/30 to 1/120) alike from 0.7 to 1.4.
+// matrix of 810 chains (bench/hanging_chains.cc: beads of 5 mm to 5 cm and square bars, links of
+// 0.1 to 0.5 m, 10 to 40 of them, ends 10 to 10^6 times heavier, dt 1/30 to 1/120) alike from 0.7
+// to 1.4.
 constexpr double kResolvedShift = 0.5;  // omega h, rad
 constexpr double kResolvedTurn = 1.0;   // omega h, rad
 // How far SHAKE's second iterate of the curvature targets may move them (relative to the first)
@@ -326,7 +327,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     body.linear_stiffness.setZero();
     body.angular_stiffness.setZero();
     body.longest_lever.setZero();
-    body.levers = 0;
+    body.longest_arm = body.second_arm = 0;
   }
   const double h2 = h * h;
   for (const TreeJoint& tree_joint : joints_) {
@@ -362,8 +363,13 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
       TreeBody& body_node = tree_bodies_[index_->node_of_body[body]];
       if (joint.kind == JointKind::kDistance) body_node.linear_stiffness += linear;
       const double arm = r.norm();
-      if (arm > body_node.longest_lever.norm()) body_node.longest_lever = r;
-      if (body_node.levers < 2) ++body_node.levers;
+      if (arm > body_node.longest_arm) {
+        body_node.second_arm = body_node.longest_arm;
+        body_node.longest_arm = arm;
+        body_node.longest_lever = r;
+      } else {
+        body_node.second_arm = std::max(body_node.second_arm, arm);
+      }
       // Only the pull along the lever turns the body back into line (a chain's tension); a force
       // across it (a load held out sideways) has no stiffness of this kind to speak of.
       const double pull = arm > 1e-12 ? force.dot(r) / arm : 0.0;
@@ -413,11 +419,16 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     if (node.angular_stiffness.isZero(0)) continue;
     // Held by one joint, a body turns about that joint's anchor, not its centre (a pendulum's bob;
     // the joint moves it with the anchor): inertia I + m (|r|^2 - r r^T), r its lever. Held by
-    // several, it can turn about its centre, each anchor carrying a neighbour along (a bead on a
-    // string between two others): inertia I. A bead of 5 mm between anchors 5 cm away turns about
-    // its centre with a 250th of the inertia about an anchor, 16 times as fast; taken about its
+    // two far anchors, it can turn about its centre, each anchor carrying a neighbour along (a
+    // bead on a string between two others, turning against its neighbours in a zig-zag): inertia
+    // I. Between the two, about a point along its longest lever as far out as the second-longest
+    // lever falls short of it (a ball hinged at its centre to the next and by a long arm to the
+    // last turns about the arm's anchor). A bead of 5 mm between anchors 5 cm away turns about its
+    // centre with a 250th of the inertia about an anchor, 16 times as fast; taken about its
     // longest lever, its stiffness went unseen and chains of such beads tore within a second.
-    const Vec3 r = node.levers >= 2 ? Vec3(Vec3::Zero()) : node.longest_lever;
+    const Vec3 r = node.longest_arm > 0
+                       ? Vec3((1 - node.second_arm / node.longest_arm) * node.longest_lever)
+                       : node.longest_lever;
     const Mat3 turning =
         node.inertia + (r.squaredNorm() * Mat3::Identity() - r * r.transpose()) / body.inverse_mass;
     keep_excess(

@@ -136,7 +136,7 @@ class JointTree {
     // mass in the velocity solve.
     Mat3 linear_stiffness = Mat3::Zero(), angular_stiffness = Mat3::Zero();
     Vec3 longest_lever = Vec3::Zero();  // from the body's centre to its farthest joint anchor
-    std::uint8_t levers = 0;            // its joints the stiffness met, counted to 2
+    double longest_arm = 0, second_arm = 0;  // the two longest levers' lengths
     // The inverse of the mass the last factoring used (with stiffness: `stiff`; else the
     // body's inverse mass and inertia).
     bool stiff = false;
