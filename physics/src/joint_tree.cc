@@ -783,17 +783,7 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
   // A degenerate joint (its rows dependent) leaves a pivot without an inverse: nothing is
   // applied, and the Gauss-Seidel position passes and next sweeps carry on.
   if (!solution_finite()) return 0;
-  double change = 0;
-  for (std::size_t k = 0; k < joints_.size(); ++k)
-    add_equation_impulses(rows[joints_[k].row], equations_[k], -joints_[k].rhs);
-  for (const TreeBody& tree_body : tree_bodies_) {
-    SolverBody& body = bodies[tree_body.index];
-    const Vec3 v = tree_body.result.head<3>(), w = tree_body.result.tail<3>();
-    change = std::max(
-        {change, (v - body.v).lpNorm<Eigen::Infinity>(), (w - body.w).lpNorm<Eigen::Infinity>()});
-    body.v = v;
-    body.w = w;
-  }
+  double change = take_solution(rows, bodies);
   // A motor past its force bound leaves the direct solve: its impulse is held at the bound (the
   // excess taken back from the bodies) and it goes on as a Gauss-Seidel row, the others solved
   // again without it.
@@ -845,14 +835,22 @@ void JointTree::learn_loads(std::span<JointRow> rows, std::span<SolverBody> bodi
     if (has_motors_ && motor_row(row, equations_[k])) rates[5] = row.joint.motor.speed;
     return rates;
   });
-  if (!solution_finite()) return;
+  if (solution_finite()) take_solution(rows, bodies);
+}
+
+double JointTree::take_solution(std::span<JointRow> rows, std::span<SolverBody> bodies) {
+  double change = 0;
   for (std::size_t k = 0; k < joints_.size(); ++k)
     add_equation_impulses(rows[joints_[k].row], equations_[k], -joints_[k].rhs);
   for (const TreeBody& tree_body : tree_bodies_) {
     SolverBody& body = bodies[tree_body.index];
-    body.v = tree_body.result.head<3>();
-    body.w = tree_body.result.tail<3>();
+    const Vec3 v = tree_body.result.head<3>(), w = tree_body.result.tail<3>();
+    change = std::max(
+        {change, (v - body.v).lpNorm<Eigen::Infinity>(), (w - body.w).lpNorm<Eigen::Infinity>()});
+    body.v = v;
+    body.w = w;
   }
+  return change;
 }
 
 template <class Rates>
