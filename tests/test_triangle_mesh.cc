@@ -5,6 +5,7 @@
 // bounded work for a huge body; snapshots bit for bit.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -480,6 +481,70 @@ TEST(TriangleMesh, ABoxMeetsEveryTriangleWhoseBoundsItMeets) {
       }
     }
   }
+}
+
+// The walk tests a node's four children in floats, the box rounded outwards: it must meet exactly
+// the children the box's own (double) bounds meet. Boxes touching a child's bound exactly, and
+// boxes one double below or above it (which round to that float to nearest) against a walk that
+// compares in doubles: the same triangles in the same order.
+TEST(TriangleMesh, TheWalkMeetsChildrenExactlyAsTheDoubleBoundsDo) {
+  const TriangleMesh mesh =
+      TriangleMesh::create(mesh_of(field_of(33, 29, 0.3, [&](double x, double y) {
+        return 0.2 * std::sin(1.7 * x) * std::cos(1.3 * y);
+      }))).value();
+  const auto reference = [&](const Aabb& box) {
+    std::vector<std::uint32_t> out;
+    std::vector<std::array<std::uint32_t, 2>> stack{{0, 0}};
+    while (!stack.empty()) {
+      const auto [first, count] = stack.back();
+      stack.pop_back();
+      if (count != 0) {
+        for (std::uint32_t k = first; k < first + count; ++k)
+          out.push_back(mesh.leaf_triangle(k).triangle);
+        continue;
+      }
+      const TriangleMesh::Node& node = mesh.nodes()[first];
+      for (int k = 0; k < 4; ++k) {
+        bool meets = node.count[k] != TriangleMesh::kNoChild;
+        for (int axis = 0; axis < 3; ++axis)
+          meets = meets && double{node.min[axis][k]} <= box.max[axis] &&
+                  box.min[axis] <= double{node.max[axis][k]};
+        if (meets) stack.push_back({node.first[k], node.count[k]});
+      }
+    }
+    return out;
+  };
+  std::vector<std::uint32_t> found;
+  int differing_from_touching = 0;
+  for (std::size_t n = 0; n < mesh.nodes().size(); ++n) {
+    const TriangleMesh::Node& node = mesh.nodes()[n];
+    for (int k = 0; k < 4; ++k) {
+      if (node.count[k] == TriangleMesh::kNoChild) continue;
+      Aabb child;
+      for (int axis = 0; axis < 3; ++axis) {
+        child.min[axis] = node.min[axis][k];
+        child.max[axis] = node.max[axis][k];
+      }
+      for (int axis = 0; axis < 3; ++axis) {
+        for (int side = 0; side < 2; ++side) {
+          // The box beyond the child's bound on this axis, touching it or one double short.
+          const double bound = side == 0 ? child.min[axis] : child.max[axis];
+          const double away = side == 0 ? -HUGE_VAL : HUGE_VAL;
+          for (const double face : {bound, std::nextafter(bound, away)}) {
+            Aabb box = child;
+            box.min[axis] = side == 0 ? face - 0.1 : face;
+            box.max[axis] = side == 0 ? face : face + 0.1;
+            const std::vector<std::uint32_t> expected = reference(box);
+            ASSERT_TRUE(mesh.triangles_meeting(box, &found, mesh.triangle_count()));
+            ASSERT_EQ(found, expected) << n << " " << k << " " << axis << " " << side;
+            differing_from_touching += face != bound && expected != reference(child);
+          }
+        }
+      }
+    }
+  }
+  // One double short of a child, the box misses it: the walks must have told such boxes apart.
+  EXPECT_GT(differing_from_touching, 100);
 }
 
 // 64 boxes dropped on bumpy terrain made a mesh: no centre ever comes nearer the surface under

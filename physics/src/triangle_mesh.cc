@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "four_wide_tree.h"
@@ -250,6 +251,20 @@ TriangleMeshDef mesh_of_height_field(const HeightField& field) {
 bool TriangleMesh::triangles_meeting(const Aabb& box, std::vector<std::uint32_t>* out,
                                      std::size_t limit) const {
   out->clear();
+  // The box rounded outwards to floats: a node's float bound meets the double one exactly where
+  // it meets the rounded one, so the four children are tested in one float vector an axis.
+  using Float4 = float __attribute__((vector_size(16)));
+  std::array<Float4, 3> low, high;
+  for (int axis = 0; axis < 3; ++axis) {
+    const float lo = round_up(box.min[axis]), hi = round_down(box.max[axis]);
+    low[axis] = Float4{lo, lo, lo, lo};
+    high[axis] = Float4{hi, hi, hi, hi};
+  }
+  const auto lanes = [](const std::array<float, 4>& bounds) {
+    Float4 v;
+    std::memcpy(&v, bounds.data(), sizeof v);
+    return v;
+  };
   // Children (nodes and leaves) pushed in order and popped last first: the order in which the
   // binary tree of old was walked (it popped a node's second child first), so the contacts meet
   // the triangles in the same order as before.
@@ -268,12 +283,15 @@ bool TriangleMesh::triangles_meeting(const Aabb& box, std::vector<std::uint32_t>
       }
       continue;
     }
+    // Every child written and the stack moved on only past those the box meets: which of four
+    // children a box meets is a pattern the branch predictor does not learn.
     const Node& node = nodes_[pending.first];
+    const auto meets = (lanes(node.min[0]) <= high[0]) & (low[0] <= lanes(node.max[0])) &
+                       (lanes(node.min[1]) <= high[1]) & (low[1] <= lanes(node.max[1])) &
+                       (lanes(node.min[2]) <= high[2]) & (low[2] <= lanes(node.max[2]));
     for (int k = 0; k < 4; ++k) {
-      bool meets = node.count[k] != kNoChild;
-      for (int axis = 0; axis < 3; ++axis)
-        meets = meets && node.min[axis][k] <= box.max[axis] && box.min[axis] <= node.max[axis][k];
-      if (meets) stack[size++] = {node.first[k], node.count[k]};
+      stack[size] = {node.first[k], node.count[k]};
+      size += (meets[k] != 0) & (node.count[k] != kNoChild);
     }
   }
   return true;
