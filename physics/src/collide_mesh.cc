@@ -57,7 +57,7 @@ struct Crossing {
 };
 
 struct MeshScratch {
-  std::vector<std::uint32_t> triangles;
+  std::vector<TriangleMesh::LeafTriangle> triangles;
   std::vector<Vec3> vertices;  // the body's, in the mesh's frame
   std::vector<FrontFace> faces;
   std::vector<Crossing> crossings;
@@ -120,8 +120,11 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
     return (translation - v[0]).dot(n) > 0;
   };
 
-  for (const std::uint32_t t : s.triangles) {
-    const std::array<Vec3, 3> v = mesh.triangle(t);
+  const std::vector<Vec3>& corners = mesh.def().vertices;
+  for (const TriangleMesh::LeafTriangle& leaf : s.triangles) {
+    const std::uint32_t t = leaf.triangle;
+    const std::array<Vec3, 3> v{corners[leaf.corners[0]], corners[leaf.corners[1]],
+                                corners[leaf.corners[2]]};
     const Vec3 n = mesh.normal(t);
     // Wholly more than the margin in front of the plane (its bounds, grown by the margin, are),
     // the body touches neither the face nor its edges; wholly behind, neither either.
@@ -209,7 +212,8 @@ std::uint32_t collide_mesh(const Shape& a, const Mat3& rotation, const Vec3& tra
   }
   if (contacts.wants_gentle_edges(body)) {
     // A round core over a gentle ridge can lie beyond both triangles' feet (triangle_contacts.h).
-    for (const std::uint32_t t : s.triangles) {
+    for (const TriangleMesh::LeafTriangle& leaf : s.triangles) {
+      const std::uint32_t t = leaf.triangle;
       const std::uint8_t gentle = mesh.gentle_edges(t);
       if (gentle == 0) continue;
       const std::array<Vec3, 3> v = mesh.triangle(t);

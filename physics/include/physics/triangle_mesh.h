@@ -80,6 +80,10 @@ class TriangleMesh {
     std::array<std::uint32_t, 3> corners;
   };
   const LeafTriangle& leaf_triangle(std::size_t k) const { return leaf_triangles_[k]; }
+  // triangles_meeting, each with its corners as the leaves hold them: the contacts' loop over a
+  // body's triangles reads the corners from the records the walk copied rather than fetching
+  // each triangle's indices again from wherever its number puts them.
+  bool triangles_meeting(const Aabb& box, std::vector<LeafTriangle>* out, std::size_t limit) const;
   // Deep enough for any tree create() builds (it splits at the median: the binary tree it is
   // made of is at most log2 of the triangle count + 1 deep, and this one half as deep).
   static constexpr int kMaxDepth = 48;
@@ -95,6 +99,8 @@ class TriangleMesh {
   double feature_size_ = 0;
   void build_adjacency();
   void build_tree();
+  template <class Out, class Take>
+  bool walk_meeting(const Aabb& box, std::vector<Out>* out, std::size_t limit, Take take) const;
 };
 
 // The heightfield's surface as a mesh of the same triangles (the same vertex order and split), for
