@@ -450,6 +450,18 @@ TEST(TriangleMesh, RaysAlongTheAxesAndOnMeshesOfAFewTrianglesMeetWhatBruteForceM
   }
 }
 
+// The numbers of the triangles TriangleMesh::triangles_meeting gives, in its order; false where
+// they did not all fit (none of these boxes meets every triangle).
+bool numbers_meeting(const TriangleMesh& mesh, const Aabb& box,
+                     std::vector<std::uint32_t>* numbers) {
+  std::vector<TriangleMesh::LeafTriangle> leaves;
+  const bool complete = mesh.triangles_meeting(box, &leaves, mesh.triangle_count());
+  numbers->clear();
+  for (const TriangleMesh::LeafTriangle& leaf : leaves)
+    numbers->push_back(leaf.triangle);
+  return complete;
+}
+
 // The triangles a box meets: every triangle whose bounds meet the box, each once.
 TEST(TriangleMesh, ABoxMeetsEveryTriangleWhoseBoundsItMeets) {
   std::mt19937 random(3);
@@ -464,7 +476,7 @@ TEST(TriangleMesh, ABoxMeetsEveryTriangleWhoseBoundsItMeets) {
     const Vec3 half =
         Vec3(0.05, 0.05, 0.05) + 0.3 * Vec3(1 + unit(random), 1 + unit(random), 1 + unit(random));
     const Aabb box{centre - half, centre + half};
-    ASSERT_TRUE(mesh.triangles_meeting(box, &found, mesh.triangle_count()));
+    ASSERT_TRUE(numbers_meeting(mesh, box, &found));
     std::vector<char> seen(mesh.triangle_count(), 0);
     for (std::uint32_t t : found) {
       ASSERT_EQ(seen[t], 0) << t;
@@ -535,7 +547,7 @@ TEST(TriangleMesh, TheWalkMeetsChildrenExactlyAsTheDoubleBoundsDo) {
             box.min[axis] = side == 0 ? face - 0.1 : face;
             box.max[axis] = side == 0 ? face : face + 0.1;
             const std::vector<std::uint32_t> expected = reference(box);
-            ASSERT_TRUE(mesh.triangles_meeting(box, &found, mesh.triangle_count()));
+            ASSERT_TRUE(numbers_meeting(mesh, box, &found));
             ASSERT_EQ(found, expected) << n << " " << k << " " << axis << " " << side;
             differing_from_touching += face != bound && expected != reference(child);
           }

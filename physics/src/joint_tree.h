@@ -204,11 +204,11 @@ class JointTree {
   void turn_bodies_of(const JointRow& row, std::span<const SolverBody> bodies, double h);
   // The base velocities for a velocity solve: the bodies' own, or with stiffness (M+K)^-1 M v.
   void set_velocity_base(std::span<const SolverBody> bodies);
-  // The joints' impulses of a solve without stiffness, at rate zero (motors at their speed),
-  // added to the joints' rows and the bodies' velocities: loads for set_geometric_stiffness.
   // A velocity solve's answer taken: the joints' impulses added to their rows, the bodies'
   // velocities set to the results. Returns the largest velocity change.
   double take_solution(std::span<JointRow> rows, std::span<SolverBody> bodies);
+  // The joints' impulses of a solve without stiffness, at rate zero (motors at their speed),
+  // added to the joints' rows and the bodies' velocities: loads for set_geometric_stiffness.
   template <class VelocityEquations>
   void learn_loads(std::span<JointRow> rows, std::span<SolverBody> bodies,
                    VelocityEquations velocity_equations);

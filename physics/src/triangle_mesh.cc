@@ -248,20 +248,8 @@ TriangleMeshDef mesh_of_height_field(const HeightField& field) {
   return mesh;
 }
 
-bool TriangleMesh::triangles_meeting(const Aabb& box, std::vector<std::uint32_t>* out,
-                                     std::size_t limit) const {
-  return walk_meeting(box, out, limit,
-                      [](const LeafTriangle& leaf) -> std::uint32_t { return leaf.triangle; });
-}
-
 bool TriangleMesh::triangles_meeting(const Aabb& box, std::vector<LeafTriangle>* out,
                                      std::size_t limit) const {
-  return walk_meeting(box, out, limit, [](const LeafTriangle& leaf) { return leaf; });
-}
-
-template <class Out, class Take>
-bool TriangleMesh::walk_meeting(const Aabb& box, std::vector<Out>* out, std::size_t limit,
-                                Take take) const {
   out->clear();
   // The box rounded outwards to floats: a node's float bound meets the double one exactly where
   // it meets the rounded one, so the four children are tested in one float vector an axis.
@@ -291,7 +279,7 @@ bool TriangleMesh::walk_meeting(const Aabb& box, std::vector<Out>* out, std::siz
     if (pending.count != 0) {
       for (std::uint32_t k = pending.first; k < pending.first + pending.count; ++k) {
         if (out->size() == limit) return false;
-        out->push_back(take(leaf_triangles_[k]));
+        out->push_back(leaf_triangles_[k]);
       }
       continue;
     }

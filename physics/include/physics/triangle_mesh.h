@@ -56,9 +56,6 @@ class TriangleMesh {
   Aabb bounds() const { return bounds_; }
   // The longest edge of any triangle, m: the size of the mesh's features.
   double feature_size() const { return feature_size_; }
-  // The triangles whose bounds meet `box`, appended to `out` (cleared first), at most `limit` of
-  // them; false when more were there.
-  bool triangles_meeting(const Aabb& box, std::vector<std::uint32_t>* out, std::size_t limit) const;
 
   // The tree: four children a node, each child's bounds in the node (single precision, rounded
   // outwards), by axis and then child, so that a ray or a box meets all four at once and walks
@@ -80,8 +77,9 @@ class TriangleMesh {
     std::array<std::uint32_t, 3> corners;
   };
   const LeafTriangle& leaf_triangle(std::size_t k) const { return leaf_triangles_[k]; }
-  // triangles_meeting, each with its corners as the leaves hold them: the contacts' loop over a
-  // body's triangles reads the corners from the records the walk copied rather than fetching
+  // The triangles whose bounds meet `box`, appended to `out` (cleared first), at most `limit` of
+  // them; false when more were there. Each comes with its corners as the leaves hold them: the
+  // contacts' loop over a body's triangles reads them from these records rather than fetching
   // each triangle's indices again from wherever its number puts them.
   bool triangles_meeting(const Aabb& box, std::vector<LeafTriangle>* out, std::size_t limit) const;
   // Deep enough for any tree create() builds (it splits at the median: the binary tree it is
@@ -99,8 +97,6 @@ class TriangleMesh {
   double feature_size_ = 0;
   void build_adjacency();
   void build_tree();
-  template <class Out, class Take>
-  bool walk_meeting(const Aabb& box, std::vector<Out>* out, std::size_t limit, Take take) const;
 };
 
 // The heightfield's surface as a mesh of the same triangles (the same vertex order and split), for
