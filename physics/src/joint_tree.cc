@@ -43,6 +43,50 @@ Eigen::Matrix<double, N, N> inverse_of_definite(const Eigen::Matrix<double, N, N
   return inverse;
 }
 
+// A ball joint's 3 x 3 blocks, kept in the top-left corners of 6 x 6 storage (stride 6), worked
+// on in place and inline: through Eigen's general block expressions these were calls of their own
+// that went through copies of the block. Each sum keeps Eigen's order (the column's terms left to
+// right; a cofactor's products as Eigen's inverse forms them), so the bits are the same.
+using Corner3 = Eigen::Block<Eigen::Matrix<double, 6, 6>, 3, 3>;
+using ConstCorner3 = Eigen::Block<const Eigen::Matrix<double, 6, 6>, 3, 3>;
+
+// m's inverse in place (Eigen's closed form for 3 x 3: cofactors over the determinant).
+TUMBLE_INLINE void invert_in_place(Corner3 m) {
+  const auto cofactor = [&](int i1, int j1, int i2, int j2) {
+    return m(i1, j1) * m(i2, j2) - m(i1, j2) * m(i2, j1);
+  };
+  // cofactor_3x3<i, j>: rows i+1, i+2 and columns j+1, j+2 (mod 3).
+  const double c00 = cofactor(1, 1, 2, 2), c10 = cofactor(2, 1, 0, 2), c20 = cofactor(0, 1, 1, 2);
+  const double det = c00 * m(0, 0) + c10 * m(1, 0) + c20 * m(2, 0);
+  const double invdet = 1.0 / det;
+  const double c01 = cofactor(1, 2, 2, 0), c11 = cofactor(2, 2, 0, 0), c21 = cofactor(0, 2, 1, 0);
+  const double c02 = cofactor(1, 0, 2, 1), c12 = cofactor(2, 0, 0, 1), c22 = cofactor(0, 0, 1, 1);
+  m(0, 0) = c00 * invdet;
+  m(0, 1) = c10 * invdet;
+  m(0, 2) = c20 * invdet;
+  m(1, 0) = c01 * invdet;
+  m(1, 1) = c11 * invdet;
+  m(1, 2) = c21 * invdet;
+  m(2, 0) = c02 * invdet;
+  m(2, 1) = c12 * invdet;
+  m(2, 2) = c22 * invdet;
+}
+// out = a b. Eigen sums this product's first two rows in packets, each left to right, and its third
+// alone, where its unrolled reduction adds the last two terms first.
+TUMBLE_INLINE void multiply_into(Corner3 out, ConstCorner3 a, ConstCorner3 b) {
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 2; ++i)
+      out(i, j) = a(i, 0) * b(0, j) + a(i, 1) * b(1, j) + a(i, 2) * b(2, j);
+    out(2, j) = a(2, 0) * b(0, j) + (a(2, 1) * b(1, j) + a(2, 2) * b(2, j));
+  }
+}
+// out -= a^T b (each sum left to right, as Eigen's).
+TUMBLE_INLINE void subtract_transposed_product(Corner3 out, ConstCorner3 a, ConstCorner3 b) {
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      out(i, j) -= a(0, i) * b(0, j) + a(1, i) * b(1, j) + a(2, i) * b(2, j);
+}
+
 }  // namespace
 
 bool JointTree::build(std::span<const std::uint32_t> joints, std::span<const JointRow> rows,
@@ -263,6 +307,9 @@ bool JointTree::number_forest(std::span<const JointRow> rows, std::span<const So
       TreeJoint& joint = joints_[hub_members_[hub.first_member + i]];
       joint.hub = static_cast<std::uint32_t>(&hub - hubs_.data());
       joint.place = i;
+      joint.laters = hub.members - i - 1;
+      joint.first_later = hub.first_member + i + 1;
+      joint.first_later_pair = pair_index(hub, i, i + 1);
     }
   pairs_.resize(pairs);
   return true;
@@ -567,7 +614,7 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
   for (TreeJoint& joint : joints_) {
     with_width(joint.width, [&]<int W>() {
       if constexpr (W == 3)
-        joint.pivot.topLeftCorner<3, 3>() = Mat3(joint.pivot.topLeftCorner<3, 3>()).inverse();
+        invert_in_place(joint.pivot.topLeftCorner<3, 3>());
       else if constexpr (W == 5)
         joint.pivot.topLeftCorner<5, 5>() =
             inverse_of_definite<5>(Eigen::Matrix<double, 5, 5>(joint.pivot.topLeftCorner<5, 5>()));
@@ -581,18 +628,28 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
       HubPair& pair = pairs_[pair_index(hub, i, j)];
       with_widths(joint.width, joints_[hub_members_[hub.first_member + j]].width,
                   [&]<int A, int B>() {
-                    pair.reach.template topLeftCorner<A, B>().noalias() =
-                        joint.pivot.template topLeftCorner<A, A>().lazyProduct(
-                            pair.block.template topLeftCorner<A, B>());
+                    if constexpr (A == 3 && B == 3)
+                      multiply_into(pair.reach.topLeftCorner<3, 3>(),
+                                    std::as_const(joint.pivot).topLeftCorner<3, 3>(),
+                                    std::as_const(pair.block).topLeftCorner<3, 3>());
+                    else
+                      pair.reach.template topLeftCorner<A, B>().noalias() =
+                          joint.pivot.template topLeftCorner<A, A>().lazyProduct(
+                              pair.block.template topLeftCorner<A, B>());
                   });
     }
     for (std::uint32_t j = i + 1; j < hub.members; ++j) {
       const HubPair& with_j = pairs_[pair_index(hub, i, j)];
       TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
       with_widths(joint.width, later.width, [&]<int A, int B>() {
-        later.pivot.template topLeftCorner<B, B>().noalias() -=
-            with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
-                with_j.reach.template topLeftCorner<A, B>());
+        if constexpr (A == 3 && B == 3)
+          subtract_transposed_product(later.pivot.topLeftCorner<3, 3>(),
+                                      with_j.block.topLeftCorner<3, 3>(),
+                                      with_j.reach.topLeftCorner<3, 3>());
+        else
+          later.pivot.template topLeftCorner<B, B>().noalias() -=
+              with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
+                  with_j.reach.template topLeftCorner<A, B>());
       });
       for (std::uint32_t l = j + 1; l < hub.members; ++l) {
         const HubPair& with_l = pairs_[pair_index(hub, i, l)];
@@ -660,11 +717,9 @@ void JointTree::solve(bool from_base, Targets targets) {
 
 void JointTree::substitute() {
   for (const TreeJoint& joint : joints_) {
-    if (joint.hub == kNone) continue;
-    const Hub& hub = hubs_[joint.hub];
-    for (std::uint32_t j = joint.place + 1; j < hub.members; ++j) {
-      TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
-      const HubPair& pair = pairs_[pair_index(hub, joint.place, j)];
+    for (std::uint32_t n = 0; n < joint.laters; ++n) {
+      TreeJoint& later = joints_[hub_members_[joint.first_later + n]];
+      const HubPair& pair = pairs_[joint.first_later_pair + n];
       with_widths(joint.width, later.width, [&]<int A, int B>() {
         later.rhs.template head<B>().noalias() -=
             pair.reach.template topLeftCorner<A, B>().transpose().lazyProduct(
@@ -678,11 +733,9 @@ void JointTree::substitute() {
       const Eigen::Matrix<double, W, 1> scaled =
           joint.pivot.template topLeftCorner<W, W>().lazyProduct(joint.rhs.template head<W>());
       joint.rhs.template head<W>() = scaled;
-      if (joint.hub == kNone) return;
-      const Hub& hub = hubs_[joint.hub];
-      for (std::uint32_t j = joint.place + 1; j < hub.members; ++j) {
-        const TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
-        const HubPair& pair = pairs_[pair_index(hub, joint.place, j)];
+      for (std::uint32_t n = 0; n < joint.laters; ++n) {
+        const TreeJoint& later = joints_[hub_members_[joint.first_later + n]];
+        const HubPair& pair = pairs_[joint.first_later_pair + n];
         with_width(later.width, [&]<int B>() {
           joint.rhs.template head<W>().noalias() -=
               pair.reach.template topLeftCorner<W, B>().lazyProduct(later.rhs.template head<B>());

@@ -157,6 +157,9 @@ class JointTree {
     // Where its later neighbours are: the hub of its parent body, and its place there (kNone:
     // it has none).
     std::uint32_t hub = kNone, place = 0;
+    // Those later neighbours (laters of them) as the substitution walks them: hub_members_ and
+    // pairs_ from these indices on (a hub's pairs of one member with the later ones lie together).
+    std::uint32_t laters = 0, first_later = 0, first_later_pair = 0;
     Mat6 pivot = Mat6::Zero();  // J W J^T over both bodies, less its children's; then inverted
     // W J^T on each body: a unit of each row's impulse as the body's velocity change.
     Mat6 response_a = Mat6::Zero(), response_b = Mat6::Zero();
