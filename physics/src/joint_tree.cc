@@ -45,8 +45,9 @@ Eigen::Matrix<double, N, N> inverse_of_definite(const Eigen::Matrix<double, N, N
 
 // A ball joint's 3 x 3 blocks, kept in the top-left corners of 6 x 6 storage (stride 6), worked
 // on in place and inline: through Eigen's general block expressions these were calls of their own
-// that went through copies of the block. Each sum keeps Eigen's order (the column's terms left to
-// right; a cofactor's products as Eigen's inverse forms them), so the bits are the same.
+// that went through copies of the block. Each sum keeps the order Eigen 3.4 gives it on this
+// storage (found against the pinned joint hashes, Determinism.PinnedJointSceneHashes), so the bits
+// are the same: a cofactor's products as Eigen's inverse forms them, the products' orders below.
 using Corner3 = Eigen::Block<Eigen::Matrix<double, 6, 6>, 3, 3>;
 using ConstCorner3 = Eigen::Block<const Eigen::Matrix<double, 6, 6>, 3, 3>;
 
