@@ -434,17 +434,28 @@ void set_point_rows(JointEquations& e, int first, const Anchors& anchors) {
   e.on_b.block<3, 3>(first, 3) = -skew(anchors.rb);
 }
 void set_rotation_rows(JointEquations& e, int first) {
+  e.on_a.block<3, 3>(first, 0).setZero();
   e.on_a.block<3, 3>(first, 3) = -Mat3::Identity();
+  e.on_b.block<3, 3>(first, 0).setZero();
   e.on_b.block<3, 3>(first, 3) = Mat3::Identity();
 }
 
-void clear_equations(JointEquations* e) {
+// Every writer above writes whole rows, so of the rows past the new count only those the last
+// equations held need clearing (JointEquations keeps them zero): clearing both 6 x 6 matrices
+// outright was a tenth of a chain's position equations.
+int start_equations(JointEquations* e) {
+  const int held = e->rows;
   e->rows = 0;
   e->point_rows = false;
   e->turning_rest = false;
-  e->on_a.setZero();
-  e->on_b.setZero();
   e->target.setZero();
+  return held;
+}
+void finish_equations(JointEquations* e, int held) {
+  for (int i = e->rows; i < held; ++i) {
+    e->on_a.row(i).setZero();
+    e->on_b.row(i).setZero();
+  }
 }
 
 // What equations_of fills without the rows: their count and targets.
@@ -453,10 +464,10 @@ struct JointTargets {
   JointEquations::Vector target = JointEquations::Vector::Zero();
 };
 
-// Both: the rows at the present poses (into a JointEquations, whose rows must be zero; else the
-// targets alone); `velocities` asks for the targets of a sweep (else the targets are minus the
-// errors), with each body's turn over the move (rotation_quaternion(h w)) in `turns` by solver
-// index where given.
+// Both: the rows at the present poses (into a JointEquations between start_equations and
+// finish_equations, each row written whole; else the targets alone); `velocities` asks for the
+// targets of a sweep (else the targets are minus the errors), with each body's turn over the move
+// (rotation_quaternion(h w)) in `turns` by solver index where given.
 template <class Out>
 void equations_of(Out& e, const JointRow& row, std::span<const SolverBody> bodies,
                   std::span<const Pose> poses, const JointTarget* velocities,
@@ -565,7 +576,7 @@ void equations_of(Out& e, const JointRow& row, std::span<const SolverBody> bodie
 void velocity_equations(JointEquations* e, const JointRow& row, std::span<const SolverBody> bodies,
                         std::span<const Pose> poses, const JointTarget& target,
                         const Anchors* anchors) {
-  clear_equations(e);
+  const int held = start_equations(e);
   equations_of(*e, row, bodies, poses, &target, nullptr, anchors);
   if (row.motor_in_tree && e->rows == 5) {
     // The motor's row: the free coordinate's rate is its speed.
@@ -578,6 +589,7 @@ void velocity_equations(JointEquations* e, const JointRow& row, std::span<const 
       e->rows = 6;
     }
   }
+  finish_equations(e, held);
 }
 
 JointEquations::Vector velocity_targets(const JointRow& row, std::span<const SolverBody> bodies,
@@ -653,9 +665,10 @@ void append_bound_rows(Out& e, const JointRow& row, std::span<const Pose> poses,
 
 void position_equations(JointEquations* e, const JointRow& row, std::span<const SolverBody> bodies,
                         std::span<const Pose> poses, std::uint8_t* bounds, double bound_slack) {
-  clear_equations(e);
+  const int held = start_equations(e);
   equations_of(*e, row, bodies, poses, nullptr);
   if (bounds != nullptr) append_bound_rows(*e, row, poses, true, bounds, bound_slack);
+  finish_equations(e, held);
 }
 
 JointEquations::Vector position_targets(const JointRow& row, std::span<const SolverBody> bodies,
