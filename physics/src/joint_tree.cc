@@ -487,20 +487,35 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
 
 namespace {
 
-// Calls f.template operator()<W>() with the fixed width W (3, 5 or 6) of a joint's rows.
-template <class F>
+// Calls f.template operator()<W>() with the fixed width W (3, 5 or 6) of a joint's rows; with
+// `Every` (a tree whose joints all have that width: JointTree::every_width_), that one without
+// asking.
+template <int Every = 0, class F>
 void with_width(int width, F&& f) {
-  if (width == 3)
+  if constexpr (Every != 0)
+    f.template operator()<Every>();
+  else if (width == 3)
     f.template operator()<3>();
   else if (width == 5)
     f.template operator()<5>();
   else
     f.template operator()<6>();
 }
-template <class F>
+template <int Every = 0, class F>
 void with_widths(int first, int second, F&& f) {
-  with_width(first,
-             [&]<int A>() { with_width(second, [&]<int B>() { f.template operator()<A, B>(); }); });
+  with_width<Every>(first, [&]<int A>() {
+    with_width<Every>(second, [&]<int B>() { f.template operator()<A, B>(); });
+  });
+}
+
+// Calls f.template operator()<Every>() with the tree's one width where it has one of 3 (a chain of
+// balls: its solves' loops then ask no joint its width), else with 0 (each joint asked).
+template <class F>
+void with_every_width(int every_width, F&& f) {
+  if (every_width == 3)
+    f.template operator()<3>();
+  else
+    f.template operator()<0>();
 }
 
 // A joint's rows on one of its bodies times x (6 x n): the first A rows of J x. Where the first
@@ -595,77 +610,83 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
       joint.pivot.template topLeftCorner<W, W>() = pivot;
     });
   }
-  // The blocks between joints of a hub: through the hub's body alone.
-  for (const Hub& hub : hubs_) {
-    for (std::uint32_t i = 0; i + 1 < hub.members; ++i) {
-      const std::uint32_t first = hub_members_[hub.first_member + i];
-      const bool first_b = member_side_b_[hub.first_member + i] != 0;
-      for (std::uint32_t j = i + 1; j < hub.members; ++j) {
-        const std::uint32_t second = hub_members_[hub.first_member + j];
-        const bool second_b = member_side_b_[hub.first_member + j] != 0;
-        const Mat6& response = second_b ? joints_[second].response_b : joints_[second].response_a;
-        with_widths(joints_[first].width, joints_[second].width, [&]<int A, int B>() {
-          pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>() =
-              rows_times<A>(equations_[first], first_b, response.template leftCols<B>());
-        });
+  every_width_ = std::all_of(joints_.begin(), joints_.end(),
+                             [](const TreeJoint& joint) { return joint.width == 3; })
+                     ? 3
+                     : 0;
+  with_every_width(every_width_, [&]<int Every>() {
+    // The blocks between joints of a hub: through the hub's body alone.
+    for (const Hub& hub : hubs_) {
+      for (std::uint32_t i = 0; i + 1 < hub.members; ++i) {
+        const std::uint32_t first = hub_members_[hub.first_member + i];
+        const bool first_b = member_side_b_[hub.first_member + i] != 0;
+        for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+          const std::uint32_t second = hub_members_[hub.first_member + j];
+          const bool second_b = member_side_b_[hub.first_member + j] != 0;
+          const Mat6& response = second_b ? joints_[second].response_b : joints_[second].response_a;
+          with_widths<Every>(joints_[first].width, joints_[second].width, [&]<int A, int B>() {
+            pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>() =
+                rows_times<A>(equations_[first], first_b, response.template leftCols<B>());
+          });
+        }
       }
     }
-  }
-  // Each joint eliminated into its later neighbours (each pivot kept as its inverse).
-  for (TreeJoint& joint : joints_) {
-    with_width(joint.width, [&]<int W>() {
-      if constexpr (W == 3)
-        invert_in_place(joint.pivot.topLeftCorner<3, 3>());
-      else if constexpr (W == 5)
-        joint.pivot.topLeftCorner<5, 5>() =
-            inverse_of_definite<5>(Eigen::Matrix<double, 5, 5>(joint.pivot.topLeftCorner<5, 5>()));
-      else
-        joint.pivot = inverse_of_definite<6>(joint.pivot);
-    });
-    if (joint.hub == kNone) continue;
-    const Hub& hub = hubs_[joint.hub];
-    const std::uint32_t i = joint.place;
-    for (std::uint32_t j = i + 1; j < hub.members; ++j) {
-      HubPair& pair = pairs_[pair_index(hub, i, j)];
-      with_widths(joint.width, joints_[hub_members_[hub.first_member + j]].width,
-                  [&]<int A, int B>() {
-                    if constexpr (A == 3 && B == 3)
-                      multiply_into(pair.reach.topLeftCorner<3, 3>(),
-                                    std::as_const(joint.pivot).topLeftCorner<3, 3>(),
-                                    std::as_const(pair.block).topLeftCorner<3, 3>());
-                    else
-                      pair.reach.template topLeftCorner<A, B>().noalias() =
-                          joint.pivot.template topLeftCorner<A, A>().lazyProduct(
-                              pair.block.template topLeftCorner<A, B>());
-                  });
-    }
-    for (std::uint32_t j = i + 1; j < hub.members; ++j) {
-      const HubPair& with_j = pairs_[pair_index(hub, i, j)];
-      TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
-      with_widths(joint.width, later.width, [&]<int A, int B>() {
-        if constexpr (A == 3 && B == 3)
-          subtract_transposed_product(later.pivot.topLeftCorner<3, 3>(),
-                                      with_j.block.topLeftCorner<3, 3>(),
-                                      with_j.reach.topLeftCorner<3, 3>());
+    // Each joint eliminated into its later neighbours (each pivot kept as its inverse).
+    for (TreeJoint& joint : joints_) {
+      with_width<Every>(joint.width, [&]<int W>() {
+        if constexpr (W == 3)
+          invert_in_place(joint.pivot.topLeftCorner<3, 3>());
+        else if constexpr (W == 5)
+          joint.pivot.topLeftCorner<5, 5>() = inverse_of_definite<5>(
+              Eigen::Matrix<double, 5, 5>(joint.pivot.topLeftCorner<5, 5>()));
         else
-          later.pivot.template topLeftCorner<B, B>().noalias() -=
-              with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
-                  with_j.reach.template topLeftCorner<A, B>());
+          joint.pivot = inverse_of_definite<6>(joint.pivot);
       });
-      for (std::uint32_t l = j + 1; l < hub.members; ++l) {
-        const HubPair& with_l = pairs_[pair_index(hub, i, l)];
-        HubPair& between = pairs_[pair_index(hub, j, l)];
-        with_widths(later.width, joints_[hub_members_[hub.first_member + l]].width,
-                    [&]<int B, int C>() {
-                      with_width(joint.width, [&]<int A>() {
-                        between.block.template topLeftCorner<B, C>().noalias() -=
-                            with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
-                                with_l.reach.template topLeftCorner<A, C>());
-                      });
-                    });
+      if (joint.hub == kNone) continue;
+      const Hub& hub = hubs_[joint.hub];
+      const std::uint32_t i = joint.place;
+      for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+        HubPair& pair = pairs_[pair_index(hub, i, j)];
+        with_widths<Every>(joint.width, joints_[hub_members_[hub.first_member + j]].width,
+                           [&]<int A, int B>() {
+                             if constexpr (A == 3 && B == 3)
+                               multiply_into(pair.reach.topLeftCorner<3, 3>(),
+                                             std::as_const(joint.pivot).topLeftCorner<3, 3>(),
+                                             std::as_const(pair.block).topLeftCorner<3, 3>());
+                             else
+                               pair.reach.template topLeftCorner<A, B>().noalias() =
+                                   joint.pivot.template topLeftCorner<A, A>().lazyProduct(
+                                       pair.block.template topLeftCorner<A, B>());
+                           });
+      }
+      for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+        const HubPair& with_j = pairs_[pair_index(hub, i, j)];
+        TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
+        with_widths<Every>(joint.width, later.width, [&]<int A, int B>() {
+          if constexpr (A == 3 && B == 3)
+            subtract_transposed_product(later.pivot.topLeftCorner<3, 3>(),
+                                        with_j.block.topLeftCorner<3, 3>(),
+                                        with_j.reach.topLeftCorner<3, 3>());
+          else
+            later.pivot.template topLeftCorner<B, B>().noalias() -=
+                with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
+                    with_j.reach.template topLeftCorner<A, B>());
+        });
+        for (std::uint32_t l = j + 1; l < hub.members; ++l) {
+          const HubPair& with_l = pairs_[pair_index(hub, i, l)];
+          HubPair& between = pairs_[pair_index(hub, j, l)];
+          with_widths<Every>(
+              later.width, joints_[hub_members_[hub.first_member + l]].width, [&]<int B, int C>() {
+                with_width<Every>(joint.width, [&]<int A>() {
+                  between.block.template topLeftCorner<B, C>().noalias() -=
+                      with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
+                          with_l.reach.template topLeftCorner<A, C>());
+                });
+              });
+        }
       }
     }
-  }
+  });
 }
 
 void JointTree::set_velocity_base(std::span<const SolverBody> bodies) {
@@ -683,45 +704,49 @@ void JointTree::set_velocity_base(std::span<const SolverBody> bodies) {
 
 template <class Targets>
 void JointTree::solve(bool from_base, Targets targets) {
-  for (std::size_t k = 0; k < joints_.size(); ++k) {
-    TreeJoint& joint = joints_[k];
-    joint.rhs = -targets(k);
-    if (!from_base) continue;
-    with_width(joint.width, [&]<int W>() {
-      for (const bool side_b : {false, true}) {
-        const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
-        if (b == kNone) continue;
-        joint.rhs.template head<W>() += rows_times<W>(equations_[k], side_b, tree_bodies_[b].base);
-      }
-    });
-  }
-  substitute();
-  for (TreeBody& body : tree_bodies_) {
-    if (from_base)
-      body.result = body.base;
-    else
-      body.result.setZero();
-  }
-  for (const TreeJoint& joint : joints_) {
-    with_width(joint.width, [&]<int W>() {
-      // Column by column: each a 6-vector multiply-add that the compiler keeps in registers.
-      for (const auto& [b, response] : {std::pair{joint.body_a, &joint.response_a},
-                                        std::pair{joint.body_b, &joint.response_b}}) {
-        if (b == kNone) continue;
-        Vec6& result = tree_bodies_[b].result;
-        for (int c = 0; c < W; ++c)
-          result -= response->col(c) * joint.rhs[c];
-      }
-    });
-  }
+  with_every_width(every_width_, [&]<int Every>() {
+    for (std::size_t k = 0; k < joints_.size(); ++k) {
+      TreeJoint& joint = joints_[k];
+      joint.rhs = -targets(k);
+      if (!from_base) continue;
+      with_width<Every>(joint.width, [&]<int W>() {
+        for (const bool side_b : {false, true}) {
+          const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
+          if (b == kNone) continue;
+          joint.rhs.template head<W>() +=
+              rows_times<W>(equations_[k], side_b, tree_bodies_[b].base);
+        }
+      });
+    }
+    substitute_with<Every>();
+    for (TreeBody& body : tree_bodies_) {
+      if (from_base)
+        body.result = body.base;
+      else
+        body.result.setZero();
+    }
+    for (const TreeJoint& joint : joints_) {
+      with_width<Every>(joint.width, [&]<int W>() {
+        // Column by column: each a 6-vector multiply-add that the compiler keeps in registers.
+        for (const auto& [b, response] : {std::pair{joint.body_a, &joint.response_a},
+                                          std::pair{joint.body_b, &joint.response_b}}) {
+          if (b == kNone) continue;
+          Vec6& result = tree_bodies_[b].result;
+          for (int c = 0; c < W; ++c)
+            result -= response->col(c) * joint.rhs[c];
+        }
+      });
+    }
+  });
 }
 
-void JointTree::substitute() {
+template <int Every>
+void JointTree::substitute_with() {
   for (const TreeJoint& joint : joints_) {
     for (std::uint32_t n = 0; n < joint.laters; ++n) {
       TreeJoint& later = joints_[hub_members_[joint.first_later + n]];
       const HubPair& pair = pairs_[joint.first_later_pair + n];
-      with_widths(joint.width, later.width, [&]<int A, int B>() {
+      with_widths<Every>(joint.width, later.width, [&]<int A, int B>() {
         later.rhs.template head<B>().noalias() -=
             pair.reach.template topLeftCorner<A, B>().transpose().lazyProduct(
                 joint.rhs.template head<A>());
@@ -730,14 +755,14 @@ void JointTree::substitute() {
   }
   for (std::size_t k = joints_.size(); k-- > 0;) {
     TreeJoint& joint = joints_[k];
-    with_width(joint.width, [&]<int W>() {
+    with_width<Every>(joint.width, [&]<int W>() {
       const Eigen::Matrix<double, W, 1> scaled =
           joint.pivot.template topLeftCorner<W, W>().lazyProduct(joint.rhs.template head<W>());
       joint.rhs.template head<W>() = scaled;
       for (std::uint32_t n = 0; n < joint.laters; ++n) {
         const TreeJoint& later = joints_[hub_members_[joint.first_later + n]];
         const HubPair& pair = pairs_[joint.first_later_pair + n];
-        with_width(later.width, [&]<int B>() {
+        with_width<Every>(later.width, [&]<int B>() {
           joint.rhs.template head<W>().noalias() -=
               pair.reach.template topLeftCorner<W, B>().lazyProduct(later.rhs.template head<B>());
         });

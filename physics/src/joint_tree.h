@@ -194,8 +194,9 @@ class JointTree {
   // velocities (or 0) to targets(k), and the bodies' results.
   template <class Targets>
   void solve(bool from_base, Targets targets);
-  // The elimination's forward and back passes over the joints' rhs.
-  void substitute();
+  // The elimination's forward and back passes over the joints' rhs (with_width's `Every`).
+  template <int Every>
+  void substitute_with();
   bool solution_finite() const;
   // Each of the joints' bodies' turn over a move of h at its velocity (rotation_quaternion(h w);
   // identity for a static body) in the index's turns, by solver index: the targets' arithmetic,
@@ -269,6 +270,9 @@ class JointTree {
   std::vector<std::uint8_t> turned_;  // by tree body: its turn set for the take under way
   bool velocities_factored_ = false;  // since the last move
   bool stiffened_ = false;
+  // 3 where every joint of the last factoring has 3 rows (a chain of balls), else 0: the solves
+  // then take that width for every joint without asking (with_width).
+  int every_width_ = 0;
   // settle_velocity_factors: a pass's factors that may serve the sweeps, and the bodies'
   // stiffness worked out for the next velocity factoring.
   bool share_pending_ = false, stiffness_kept_ = false;
