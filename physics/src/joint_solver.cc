@@ -442,7 +442,7 @@ void set_rotation_rows(JointEquations& e, int first) {
 
 // Every writer above writes whole rows, so of the rows past the new count only those the last
 // equations held need clearing (JointEquations keeps them zero): clearing both 6 x 6 matrices
-// outright was a tenth of a chain's position equations.
+// outright was a fifth of a chain's position equations (7.1 M of 33.1 M instructions, callgrind).
 int start_equations(JointEquations* e) {
   const int held = e->rows;
   e->rows = 0;
