@@ -76,6 +76,10 @@ struct JointEquations {
   // linear columns zero (a hinge's axis rows, a cone or a twist limit): JointTree sets it where it
   // factors, and its products skip those columns.
   bool turning_rest = false;
+  // Whether rows 0-2 of on_a and on_b hold a point's linear blocks, -I and I, from the last
+  // writer of those rows: a point's next rows then write its cross blocks alone (half the stores
+  // of a chain's equations; every writer of those rows clears it).
+  bool point_linear_held = false;
   Eigen::Matrix<double, 6, 6> on_a = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 6> on_b = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> target = Eigen::Matrix<double, 6, 1>::Zero();

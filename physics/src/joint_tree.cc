@@ -323,8 +323,15 @@ void JointTree::finish_build(std::span<const JointRow> rows, std::span<const Sol
     has_motors_ = has_motors_ || rows[joint.row].joint.motor.enabled;
     loads_unknown_ = loads_unknown_ || !(rows[joint.row].joint.impulse_time > 0);
   }
-  for (TreeBody& body : tree_bodies_)
-    body.inertia = bodies[body.index].inverse_inertia.inverse();
+  for (TreeBody& body : tree_bodies_) {
+    const Mat3& inverse_inertia = bodies[body.index].inverse_inertia;
+    body.inertia = inverse_inertia.inverse();
+    // (By columns, each the cross product of the other two: a symmetric matrix's adjugate,
+    // finite where it has no inverse.)
+    body.inverse_inertia_adjugate << inverse_inertia.col(1).cross(inverse_inertia.col(2)),
+        inverse_inertia.col(2).cross(inverse_inertia.col(0)),
+        inverse_inertia.col(0).cross(inverse_inertia.col(1));
+  }
   velocities_factored_ = false;
   share_pending_ = false;
   stiffness_kept_ = false;
@@ -371,25 +378,85 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
                                         std::span<const Pose> poses, double h,
                                         std::span<const JointPoseTerms> terms) {
+  const double h2 = h * h;
+  const auto anchors_at = [&](const TreeJoint& tree_joint,
+                              joint_detail::Anchors* worked_out) -> const joint_detail::Anchors& {
+    if (!terms.empty()) return terms[tree_joint.row].anchors;
+    const JointRow& row = rows[tree_joint.row];
+    const bool world_b = row.b == kWorldAnchor;
+    *worked_out =
+        joint_detail::anchors_of(row.joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b);
+    return *worked_out;
+  };
+  const auto node_of = [&](std::uint32_t body) {
+    return body == kWorldAnchor ? kNone : index_->node_of_body[body];
+  };
+  // First a bound on each body's rho (below) from its joints' loads alone, without the matrices
+  // (this pass was 8% of chain:100's step, most of it building them): about three quarters of that
+  // chain's bodies are below the reach by it, and take no stiffness. Each pull's stiffness, W^1/2
+  // K_j W^1/2 with K_j = c [r]x^T [r]x, has the largest eigenvalue c l, l that of [r]x W [r]x^T
+  // (rank two: trace t = |r|^2 tr W - r^T W r, second invariant e2 = |r|^2 r^T adj(W) r, so l = (t
+  // + sqrt(t^2 - 4 e2)) / 2); the body's rho is at most their sum, with W its inverse inertia (its
+  // turning inertia below is at least its inertia). A body whose bound is below the reach, with a
+  // margin far beyond rounding, passes the leading-minors test below: zero, the same bits. Rods
+  // (distance joints) and levers too short to weigh are left to the full test.
   for (TreeBody& body : tree_bodies_) {
     body.linear_stiffness.setZero();
     body.angular_stiffness.setZero();
-    body.longest_lever.setZero();
-    body.longest_arm = body.second_arm = 0;
+    body.rho_bound = 0;
+    body.weighed = false;
   }
-  const double h2 = h * h;
   for (const TreeJoint& tree_joint : joints_) {
     const JointRow& row = rows[tree_joint.row];
     const Joint& joint = row.joint;
     if (!(joint.impulse_time > 0)) continue;
-    joint_detail::Anchors worked_out;
-    if (terms.empty()) {
-      const bool world_b = row.b == kWorldAnchor;
-      worked_out =
-          joint_detail::anchors_of(joint, poses[row.a], world_b ? Pose{} : poses[row.b], world_b);
+    const std::uint32_t node_a = node_of(row.a), node_b = node_of(row.b);
+    if (joint.kind == JointKind::kDistance) {
+      for (const std::uint32_t node : {node_a, node_b})
+        if (node != kNone) tree_bodies_[node].weighed = true;
+      continue;
     }
-    const joint_detail::Anchors& anchors =
-        terms.empty() ? worked_out : terms[tree_joint.row].anchors;
+    if (joint.kind == JointKind::kSlider) continue;  // no force at its anchors
+    joint_detail::Anchors worked_out;
+    const joint_detail::Anchors& anchors = anchors_at(tree_joint, &worked_out);
+    const Vec3 force_on_b = joint.linear_impulse / joint.impulse_time;
+    for (const auto& [node, r, pull] :
+         {std::tuple{node_a, anchors.ra, -force_on_b.dot(anchors.ra)},
+          std::tuple{node_b, anchors.rb, force_on_b.dot(anchors.rb)}}) {
+      if (node == kNone || !(pull > 0)) continue;
+      TreeBody& body = tree_bodies_[node];
+      const double squared_arm = r.squaredNorm();
+      if (!(squared_arm > 1e-20)) {
+        body.weighed = true;
+        continue;
+      }
+      const Mat3& w = bodies[body.index].inverse_inertia;
+      const double trace = squared_arm * w.trace() - r.dot(w * r);
+      const double second = squared_arm * r.dot(body.inverse_inertia_adjugate * r);
+      const double largest = 0.5 * (trace + std::sqrt(std::max(0.0, trace * trace - 4 * second)));
+      body.rho_bound += h2 * pull / squared_arm * largest;
+    }
+  }
+  for (TreeBody& body : tree_bodies_) {
+    // (The reach of turns: kResolvedTurn, squared, short by the minors test's millionth and a
+    // thousandth more.)
+    body.weighed =
+        body.weighed || !(body.rho_bound < kResolvedTurn * kResolvedTurn * (1 - 1e-6) * (1 - 1e-3));
+    if (!body.weighed) continue;
+    body.longest_lever.setZero();
+    body.longest_arm = body.second_arm = 0;
+  }
+  // The bodies not passed: their stiffness in full.
+  for (const TreeJoint& tree_joint : joints_) {
+    const JointRow& row = rows[tree_joint.row];
+    const Joint& joint = row.joint;
+    if (!(joint.impulse_time > 0)) continue;
+    const std::uint32_t node_a = node_of(row.a), node_b = node_of(row.b);
+    if (!(node_a != kNone && tree_bodies_[node_a].weighed) &&
+        !(node_b != kNone && tree_bodies_[node_b].weighed))
+      continue;
+    joint_detail::Anchors worked_out;
+    const joint_detail::Anchors& anchors = anchors_at(tree_joint, &worked_out);
     // The force on b (a takes the opposite).
     Vec3 force_on_b = Vec3::Zero();
     Mat3 linear = Mat3::Zero();
@@ -405,10 +472,10 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     } else if (joint.kind != JointKind::kSlider) {
       force_on_b = joint.linear_impulse / joint.impulse_time;
     }
-    for (const auto& [body, r, force] : {std::tuple{row.a, anchors.ra, Vec3(-force_on_b)},
-                                         std::tuple{row.b, anchors.rb, force_on_b}}) {
-      if (body == kWorldAnchor || index_->node_of_body[body] == kNone) continue;
-      TreeBody& body_node = tree_bodies_[index_->node_of_body[body]];
+    for (const auto& [node, r, force] : {std::tuple{node_a, anchors.ra, Vec3(-force_on_b)},
+                                         std::tuple{node_b, anchors.rb, force_on_b}}) {
+      if (node == kNone || !tree_bodies_[node].weighed) continue;
+      TreeBody& body_node = tree_bodies_[node];
       if (joint.kind == JointKind::kDistance) body_node.linear_stiffness += linear;
       const double arm = r.norm();
       if (arm > body_node.longest_arm) {
@@ -459,6 +526,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
   // A stiffness of nothing keeps nothing (its margin is the mass itself), without the test: most
   // bodies have no rod and many no pull (building their masses cost a tenth of the pass).
   for (TreeBody& node : tree_bodies_) {
+    if (!node.weighed) continue;
     const SolverBody& body = bodies[node.index];
     if (!node.linear_stiffness.isZero(0))
       keep_excess(
@@ -1019,15 +1087,15 @@ double JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solv
 
 void JointTree::settle_velocity_factors(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
-                                        std::span<const Pose> poses, double h,
-                                        bool keep_stiffness) {
+                                        std::span<const Pose> poses, double h, bool keep_stiffness,
+                                        std::span<const JointPoseTerms> terms) {
   if (!share_pending_) return;
   share_pending_ = false;
   // Shared only where no body takes stiffness: a light link's stiffness as mass in the position
   // passes shifted its corrections onto the heavy end, and a chain of beads under a million times
   // heavier end tore. Worked out where the sweeps' own factoring would work it out (the poses
   // after the last pass, the impulses of the sweeps before), so that it can keep it.
-  if (!set_geometric_stiffness(rows, bodies, poses, h)) {
+  if (!set_geometric_stiffness(rows, bodies, poses, h, terms)) {
     velocities_factored_ = true;
     stiffened_ = false;
     return;

@@ -90,8 +90,10 @@ class JointTree {
   // does, and `keep_stiffness`, the stiffness worked out here is the next velocity factoring's
   // (the sweeps that follow meet these poses and impulses; the exact solver's substep clears the
   // impulses first, and does not keep it).
+  // `terms`: as for solve_velocities, at the poses the passes left (or empty).
   void settle_velocity_factors(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
-                               std::span<const Pose> poses, double h, bool keep_stiffness);
+                               std::span<const Pose> poses, double h, bool keep_stiffness,
+                               std::span<const JointPoseTerms> terms = {});
 
   // The exact solver's use of the tree (exact_joints.h), with the velocity factors of the last
   // solve_velocities: whether a body is one of the tree's;
@@ -137,6 +139,11 @@ class JointTree {
     Mat3 linear_stiffness = Mat3::Zero(), angular_stiffness = Mat3::Zero();
     Vec3 longest_lever = Vec3::Zero();  // from the body's centre to its farthest joint anchor
     double longest_arm = 0, second_arm = 0;  // the two longest levers' lengths
+    // The adjugate of its inverse inertia (fixed for the step), and set_geometric_stiffness's
+    // bound on its rho and whether the bound left it to the full test (`weighed`).
+    Mat3 inverse_inertia_adjugate = Mat3::Zero();
+    double rho_bound = 0;
+    bool weighed = false;
     // The inverse of the mass the last factoring used (with stiffness: `stiff`; else the
     // body's inverse mass and inertia).
     bool stiff = false;

@@ -399,12 +399,22 @@ class SerialIsland {
         for (std::uint32_t j : joints_of(component))
           correct_joint_position(c_.scratch.joint_rows[j], bodies_, c_.scratch.poses);
       }
-      if (!trees_.empty())
+    }
+    // The joints' terms at the poses the passes left: the settling reads their anchors, and the
+    // next sweep (nothing moves before it) takes them as they are.
+    joint_terms_current_ = false;
+    bool settling = false;
+    for (std::uint32_t component = mine_.first; component < mine_.second && !trees_.empty();
+         ++component)
+      settling = settling || trees_[component].velocity_factors_pending();
+    if (settling) {
+      prepare_joint_terms();
+      for (std::uint32_t component = mine_.first; component < mine_.second; ++component)
         trees_[component].settle_velocity_factors(c_.scratch.joint_rows, bodies_, c_.scratch.poses,
-                                                  h, !report_->exact_joints);
+                                                  h, !report_->exact_joints,
+                                                  c_.scratch.joint_terms);
     }
     if (team_) c_.scratch.barrier.wait();
-    joint_terms_current_ = false;
   }
   void refresh_separations() {
     if (lead() && coloured_contacts()) {
