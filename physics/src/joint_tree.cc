@@ -815,9 +815,18 @@ void JointTree::substitute_with() {
       TreeJoint& later = joints_[hub_members_[joint.first_later + n]];
       const HubPair& pair = pairs_[joint.first_later_pair + n];
       with_widths<Every>(joint.width, later.width, [&]<int A, int B>() {
-        later.rhs.template head<B>().noalias() -=
-            pair.reach.template topLeftCorner<A, B>().transpose().lazyProduct(
-                joint.rhs.template head<A>());
+        if constexpr (A == 3 && B == 3) {
+          // Written out in the dot products' own order, ((r0 x0 + r1 x1) + r2 x2): the same bits.
+          // The next joint of a chain reads these three values at once; stored one by one by
+          // Eigen's dot products and loaded two at a time, they stalled on store forwarding.
+          const double x0 = joint.rhs[0], x1 = joint.rhs[1], x2 = joint.rhs[2];
+          for (int b = 0; b < 3; ++b)
+            later.rhs[b] -= (pair.reach(0, b) * x0 + pair.reach(1, b) * x1) + pair.reach(2, b) * x2;
+        } else {
+          later.rhs.template head<B>().noalias() -=
+              pair.reach.template topLeftCorner<A, B>().transpose().lazyProduct(
+                  joint.rhs.template head<A>());
+        }
       });
     }
   }
