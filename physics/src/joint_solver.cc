@@ -507,7 +507,16 @@ void equations_of(Out& e, const JointRow& row, std::span<const SolverBody> bodie
       known_anchors != nullptr ? *known_anchors : anchors_of(joint, pose_a, pose_b, world_b);
   const double h = velocities != nullptr ? velocities->h : 0;
   const double most = velocities != nullptr ? velocities->most_speed : 0;
-  const Vec3 rate = (b.v + b.w.cross(anchors.rb)) - (a.v + a.w.cross(anchors.ra));
+  // (b.v + b.w x rb) - (a.v + a.w x ra), a coordinate at a time in Eigen's own order: the cross
+  // products built in memory one value at a time and added two at a time stalled on store
+  // forwarding (a fifth of this function's time). The same bits.
+  const auto point_velocity = [](const SolverBody& body, const Vec3& r, int i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    return body.v[i] + (body.w[j] * r[k] - body.w[k] * r[j]);
+  };
+  const Vec3 rate(point_velocity(b, anchors.rb, 0) - point_velocity(a, anchors.ra, 0),
+                  point_velocity(b, anchors.rb, 1) - point_velocity(a, anchors.ra, 1),
+                  point_velocity(b, anchors.rb, 2) - point_velocity(a, anchors.ra, 2));
   auto turn_of_a = [&] { return turns != nullptr ? turns[row.a] : rotation_quaternion(h * a.w); };
   auto turn_of_b = [&] {
     return turns != nullptr && !world_b ? turns[row.b] : rotation_quaternion(h * b.w);
