@@ -365,6 +365,10 @@ void JointTree::finish_build(std::span<const JointRow> rows, std::span<const Sol
 // to 1.4.
 constexpr double kResolvedShift = 0.5;  // omega h, rad
 constexpr double kResolvedTurn = 1.0;   // omega h, rad
+// The leading-minors test asks for a reach this much short (set_geometric_stiffness), and the
+// loads' bound, which stands in for it, this much shorter again: margins far beyond rounding.
+constexpr double kMinorsShortfall = 1e-6;
+constexpr double kBoundShortfall = 1e-3;
 // How far SHAKE's second iterate of the curvature targets may move them (relative to the first)
 // and still be taken (solve_velocities: measured choices there).
 constexpr double kConvergedTakes = 0.03;
@@ -438,10 +442,9 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
     }
   }
   for (TreeBody& body : tree_bodies_) {
-    // (The reach of turns: kResolvedTurn, squared, short by the minors test's millionth and a
-    // thousandth more.)
     body.weighed =
-        body.weighed || !(body.rho_bound < kResolvedTurn * kResolvedTurn * (1 - 1e-6) * (1 - 1e-3));
+        body.weighed || !(body.rho_bound < kResolvedTurn * kResolvedTurn * (1 - kMinorsShortfall) *
+                                               (1 - kBoundShortfall));
     if (!body.weighed) continue;
     body.longest_lever.setZero();
     body.longest_arm = body.second_arm = 0;
@@ -504,7 +507,7 @@ bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
   // r too (their error is near rounding): the same stiffness, zero, and the same bits.
   auto keep_excess = [&](Mat3& stiffness, const Mat3& mass, auto inverse_of_mass, double reach) {
     const double resolved = reach * reach;
-    const Mat3 margin = resolved * (1 - 1e-6) * mass - stiffness;
+    const Mat3 margin = resolved * (1 - kMinorsShortfall) * mass - stiffness;
     const double minor2 = margin(0, 0) * margin(1, 1) - margin(0, 1) * margin(1, 0);
     if (margin(0, 0) > 0 && minor2 > 0 && margin.determinant() > 0) {
       stiffness.setZero();
