@@ -589,23 +589,27 @@ void with_every_width(int every_width, F&& f) {
     f.template operator()<0>();
 }
 
-// A joint's rows on one of its bodies times x (6 x n): the first A rows of J x. Where the first
-// three are a point's (JointEquations::point_rows: on a, [-I, [r_a]x]; on b, [I, -[r_b]x]), they
-// are plus or minus x's linear half and a cross product with its angular half, half the
-// dense rows' arithmetic; the rest are written out (Eigen's general product of these shapes was
-// a call of its own, a tenth of a ragdoll pile's factoring).
-template <int A, class X>
-TUMBLE_INLINE Eigen::Matrix<double, A, X::ColsAtCompileTime> rows_times(
-    const JointEquations& equations, bool side_b, const X& x) {
+// A joint's rows on one of its bodies times x (6 x n): the first A rows of J x, each value handed
+// to put(i, col, value) as it is formed. Where the first three are a point's
+// (JointEquations::point_rows: on a, [-I, [r_a]x]; on b, [I, -[r_b]x]), they are plus or minus
+// x's linear half and a cross product with its angular half, half the dense rows' arithmetic; the
+// rest are written out (Eigen's general product of these shapes was a call of its own, a tenth of
+// a ragdoll pile's factoring). The values go straight where they are used: built as a matrix on
+// the stack one at a time and then added or copied two at a time, they stalled on store
+// forwarding (a tenth of the pivots' building in a chain).
+template <int A, class X, class Put>
+TUMBLE_INLINE void for_rows_times(const JointEquations& equations, bool side_b, const X& x,
+                                  Put put) {
   const Eigen::Matrix<double, 6, 6>& rows = side_b ? equations.on_b : equations.on_a;
-  Eigen::Matrix<double, A, X::ColsAtCompileTime> out;
   int first = 0;
   if (equations.point_rows) {
     // The cross block [c]x holds c: ([c]x)(2,1) = c_x, (0,2) = c_y, (1,0) = c_z.
     const Vec3 c(rows(2, 4), rows(0, 5), rows(1, 3));
     for (int col = 0; col < x.cols(); ++col) {
       const Vec3 linear = x.col(col).template head<3>(), angular = x.col(col).template tail<3>();
-      out.col(col).template head<3>() = (side_b ? linear : Vec3(-linear)) + c.cross(angular);
+      const Vec3 turn = c.cross(angular);
+      for (int i = 0; i < 3; ++i)
+        put(i, col, (side_b ? linear[i] : -linear[i]) + turn[i]);
     }
     first = 3;
   }
@@ -613,17 +617,16 @@ TUMBLE_INLINE Eigen::Matrix<double, A, X::ColsAtCompileTime> rows_times(
   if (equations.turning_rest) {
     for (int col = 0; col < x.cols(); ++col)
       for (int i = first; i < A; ++i)
-        out(i, col) = rows(i, 3) * x(3, col) + rows(i, 4) * x(4, col) + rows(i, 5) * x(5, col);
-    return out;
+        put(i, col, rows(i, 3) * x(3, col) + rows(i, 4) * x(4, col) + rows(i, 5) * x(5, col));
+    return;
   }
   for (int col = 0; col < x.cols(); ++col)
     for (int i = first; i < A; ++i) {
       double sum = rows(i, 0) * x(0, col);
       for (int k = 1; k < 6; ++k)
         sum += rows(i, k) * x(k, col);
-      out(i, col) = sum;
+      put(i, col, sum);
     }
-  return out;
 }
 
 // Whether the equations' rows after the point's have no linear part (JointEquations::turning_rest).
@@ -659,7 +662,8 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
     equations_[k].turning_rest = turns_only_after_point(equations_[k]);
     joint.width = equations_[k].rows <= 3 ? 3 : equations_[k].rows <= 5 ? 5 : 6;
     with_width(joint.width, [&]<int W>() {
-      Eigen::Matrix<double, W, W> pivot = Eigen::Matrix<double, W, W>::Zero();
+      auto pivot = joint.pivot.template topLeftCorner<W, W>();
+      pivot.setZero();
       for (const bool side_b : {false, true}) {
         const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
         if (b == kNone) continue;
@@ -674,11 +678,11 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
               body.inverse_mass * rows_on_body.template leftCols<3>().transpose();
         response.template bottomLeftCorner<3, W>().noalias() =
             body.angular_inverse.lazyProduct(rows_on_body.template rightCols<3>().transpose());
-        pivot += rows_times<W>(equations_[k], side_b, response.template leftCols<W>());
+        for_rows_times<W>(equations_[k], side_b, response.template leftCols<W>(),
+                          [&](int i, int col, double value) { pivot(i, col) += value; });
       }
       for (int r = equations_[k].rows; r < W; ++r)
         pivot(r, r) = 1;
-      joint.pivot.template topLeftCorner<W, W>() = pivot;
     });
   }
   every_width_ = std::all_of(joints_.begin(), joints_.end(),
@@ -696,8 +700,9 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
           const bool second_b = member_side_b_[hub.first_member + j] != 0;
           const Mat6& response = second_b ? joints_[second].response_b : joints_[second].response_a;
           with_widths<Every>(joints_[first].width, joints_[second].width, [&]<int A, int B>() {
-            pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>() =
-                rows_times<A>(equations_[first], first_b, response.template leftCols<B>());
+            auto block = pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>();
+            for_rows_times<A>(equations_[first], first_b, response.template leftCols<B>(),
+                              [&](int row, int col, double value) { block(row, col) = value; });
           });
         }
       }
@@ -784,8 +789,8 @@ void JointTree::solve(bool from_base, Targets targets) {
         for (const bool side_b : {false, true}) {
           const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
           if (b == kNone) continue;
-          joint.rhs.template head<W>() +=
-              rows_times<W>(equations_[k], side_b, tree_bodies_[b].base);
+          for_rows_times<W>(equations_[k], side_b, tree_bodies_[b].base,
+                            [&](int i, int, double value) { joint.rhs[i] += value; });
         }
       });
     }
