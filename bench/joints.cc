@@ -10,12 +10,16 @@
 // Gauss-Seidel joints (soft, pgs); Bullet 3.24 float and double (its constraint of each joint's
 // kind, 10 sequential-impulse iterations) and Bullet's btMultiBody (float, generalised coordinates;
 // trees from the world alone). ODE and MuJoCo join in the report's joints section (make report).
+// The engines of a scene take turns of 20 steps, and each line ends with the median over the turns
+// of its step time over Bullet float's in the same turn: a ratio the machine's changing speed
+// moves far less than a ratio of two runs' medians (run_together).
 // Usage: bench_joints [seconds] (default 20).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <initializer_list>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -39,32 +43,81 @@ struct Run {
   double gap = 0, median_ms = 0;
   double gap_sum = 0;  // of each step's gap, for their mean
   int steps = 0;
+  bool stopped = false;         // the engine reported that it cannot go on
+  std::vector<double> ms;       // each timed step's time
+  std::vector<double> turn_ms;  // each turn's median (run_together)
+  double median_ratio = 0;      // of its turns' times to the reference's, turn by turn
 };
 
-template <class Measure>
-Run run(Simulation* sim, int steps, Measure measure) {
-  Run r;
-  std::vector<double> ms;
-  for (int k = 0; k < steps; ++k) {
-    const auto start = std::chrono::steady_clock::now();
-    if (!sim->step()) break;
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                     .count());
-    const double gap = measure(*sim);
-    r.gap = std::max(r.gap, gap);
-    r.gap_sum += gap;
-    ++r.steps;
-  }
-  std::sort(ms.begin(), ms.end());
-  r.median_ms = ms.empty() ? 0 : ms[ms.size() / 2];
-  return r;
+// One engine of a group, stepped in turn with the others.
+struct Entry {
+  std::string name;
+  std::unique_ptr<Simulation> sim;
+  Run run;
+};
+
+double median_of(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
 }
 
-// One line of the table: a run's gaps and median step, and where the engine stopped early (it
-// reported that it cannot go on), after how many steps: its gap covers those alone.
-void print_run(const char* label, const char* name, const Run& r, int steps) {
-  std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms", label, name, r.gap,
-              r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms);
+// The engines of a group take turns, kTurnSteps steps each, so that every engine meets the
+// machine at the same speeds: on a shared machine one engine's 5 s and the next's ran up to a
+// quarter apart in speed, which stepping each through its whole run in turn put straight into
+// their ratio. A turn's first step finds the caches full of the other engines' data and is not
+// timed (taking turns a step at a time slowed Bullet's steps by half and ours by less: not the
+// step either engine takes alone). Each engine's time over the reference's (`reference`: an
+// entry's index, the first peer) is taken turn by turn, from the two turns' medians, and its
+// median over the turns kept.
+constexpr int kTurnSteps = 20;
+template <class Measure>
+void run_together(std::vector<Entry>& entries, int steps, Measure measure, std::size_t reference) {
+  for (int first = 0; first < steps; first += kTurnSteps) {
+    for (Entry& entry : entries) {
+      Run& r = entry.run;
+      std::vector<double> turn;
+      for (int k = first; k < std::min(steps, first + kTurnSteps) && !r.stopped; ++k) {
+        const auto start = std::chrono::steady_clock::now();
+        if (!entry.sim->step()) {
+          r.stopped = true;
+          break;
+        }
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        if (k > first) turn.push_back(ms);
+        const double gap = measure(*entry.sim);
+        r.gap = std::max(r.gap, gap);
+        r.gap_sum += gap;
+        ++r.steps;
+      }
+      if (turn.empty()) continue;
+      r.ms.insert(r.ms.end(), turn.begin(), turn.end());
+      r.turn_ms.push_back(median_of(turn));
+    }
+  }
+  const std::vector<double>* peer =
+      reference < entries.size() ? &entries[reference].run.turn_ms : nullptr;
+  for (Entry& entry : entries) {
+    Run& r = entry.run;
+    r.median_ms = median_of(r.ms);
+    if (peer == nullptr) continue;
+    std::vector<double> ratios;
+    for (std::size_t k = 0; k < std::min(r.turn_ms.size(), peer->size()); ++k)
+      if ((*peer)[k] > 0) ratios.push_back(r.turn_ms[k] / (*peer)[k]);
+    r.median_ratio = median_of(ratios);
+  }
+}
+
+// One line of the table: a run's gaps and median step, its median ratio to the reference peer's
+// step, and where the engine stopped early (it reported that it cannot go on), after how many
+// steps: its gap covers those alone.
+void print_run(const char* label, const std::string& name, const Run& r, int steps,
+               const char* reference) {
+  std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms  %5.2fx %s", label,
+              name.c_str(), r.gap, r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms,
+              r.median_ratio, reference);
   if (r.steps < steps) std::printf("  -- stopped after %d of %d steps", r.steps, steps);
   std::printf("\n");
 }
@@ -82,9 +135,14 @@ constexpr Ours kOurs[] = {{"Tumble auto (direct)", SolverKind::kAuto, 0},
                           {"Tumble soft (GS)", SolverKind::kSoft, 0},
                           {"Tumble pgs (GS)", SolverKind::kPgs, 0}};
 
-// Every engine on `scene` (ours in each configuration of kOurs).
+// Every engine on `scene` (ours in each configuration of kOurs; Bullet float, double and
+// multibody; and Bullet float again with each of `bullet_iterations` sequential-impulse
+// iterations: how far its error falls as it is given our time and more), stepped together
+// (run_together), each step's time beside Bullet float's.
 template <class Make, class Measure>
-void each_engine(Make make_scene, int steps, Measure measure, const char* label) {
+void each_engine(Make make_scene, int steps, Measure measure, const char* label,
+                 std::initializer_list<int> bullet_iterations = {}) {
+  std::vector<Entry> entries;
   for (const Ours& ours : kOurs) {
     SceneDef scene = make_scene(ours.solver);
     if (ours.substeps > 0) scene.world.solver.substeps = ours.substeps;
@@ -94,8 +152,9 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
       std::printf("  %-8s %-24s not run: %s\n", label, ours.label, why.c_str());
       continue;
     }
-    print_run(label, ours.label, run(sim.get(), steps, measure), steps);
+    entries.push_back({ours.label, std::move(sim), {}});
   }
+  const std::size_t reference = entries.size();  // Bullet float, where it runs
   const SceneDef scene = make_scene(SolverKind::kSoft);
   const PeerScene peer = peer_scene(scene);
   PeerOptions options;
@@ -109,30 +168,26 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label)
       std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
       continue;
     }
-    print_run(label, name, run(sim.get(), steps, measure), steps);
+    entries.push_back({name, std::move(sim), {}});
   }
-}
-
-// Bullet float on `scene` with more sequential-impulse iterations than its default ten: how far
-// its error falls as it is given our time and more.
-template <class Measure>
-void bullet_iterations(const SceneDef& scene, std::initializer_list<int> counts, int steps,
-                       Measure measure, const char* label) {
-  const PeerScene peer = peer_scene(scene);
-  for (const int iterations : counts) {
-    PeerOptions options;
-    options.sleeping = false;
-    options.iterations = iterations;
+  for (const int iterations : bullet_iterations) {
+    PeerOptions more = options;
+    more.iterations = iterations;
     std::string why;
-    auto sim = make_bullet(peer, options, &why);
+    auto sim = make_bullet(peer, more, &why);
     char name[64];
     std::snprintf(name, sizeof name, "Bullet float, %d iter.", iterations);
     if (!sim) {
       std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
       continue;
     }
-    print_run(label, name, run(sim.get(), steps, measure), steps);
+    entries.push_back({name, std::move(sim), {}});
   }
+  const bool has_reference =
+      reference < entries.size() && entries[reference].name == "Bullet float";
+  run_together(entries, steps, measure, has_reference ? reference : entries.size());
+  for (const Entry& entry : entries)
+    print_run(label, entry.name, entry.run, steps, has_reference ? "Bullet float" : "(no peer)");
 }
 
 }  // namespace
@@ -163,8 +218,7 @@ int main(int argc, char** argv) {
     return scene;
   };
   const auto chain_gap = [&](const Simulation& sim) { return chain_gaps.largest(sim); };
-  each_engine(chain, steps, chain_gap, "chain100");
-  bullet_iterations(chain(SolverKind::kSoft), {20, 50, 100}, steps, chain_gap, "chain100");
+  each_engine(chain, steps, chain_gap, "chain100", {20, 50, 100});
   // The ragdoll pile awake, without its joints' friction (no peer adapter maps it).
   const report::JointGaps ragdoll_gaps(ragdolls_scene(8));
   std::printf(
@@ -181,7 +235,6 @@ int main(int argc, char** argv) {
     return scene;
   };
   const auto ragdoll_gap = [&](const Simulation& sim) { return ragdoll_gaps.largest(sim); };
-  each_engine(ragdolls, steps, ragdoll_gap, "ragdoll8");
-  bullet_iterations(ragdolls(SolverKind::kSoft), {20, 50, 100}, steps, ragdoll_gap, "ragdoll8");
+  each_engine(ragdolls, steps, ragdoll_gap, "ragdoll8", {20, 50, 100});
   return 0;
 }
