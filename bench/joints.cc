@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "peers/peer_world.h"
 #include "peers/simulation.h"
 #include "report/joint_gaps.h"
 #include "scenes/standard.h"
@@ -56,12 +57,6 @@ struct Entry {
   Run run;
 };
 
-double median_of(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
 // The engines of a group take turns, kTurnSteps steps each, so that every engine meets the
 // machine at the same speeds: on a shared machine one engine's 5 s and the next's ran up to a
 // quarter apart in speed, which stepping each through its whole run in turn put straight into
@@ -94,19 +89,19 @@ void run_together(std::vector<Entry>& entries, int steps, Measure measure, std::
       }
       if (turn.empty()) continue;
       r.ms.insert(r.ms.end(), turn.begin(), turn.end());
-      r.turn_ms.push_back(median_of(turn));
+      r.turn_ms.push_back(median(turn));
     }
   }
   const std::vector<double>* peer =
       reference < entries.size() ? &entries[reference].run.turn_ms : nullptr;
   for (Entry& entry : entries) {
     Run& r = entry.run;
-    r.median_ms = median_of(r.ms);
+    r.median_ms = median(r.ms);
     if (peer == nullptr) continue;
     std::vector<double> ratios;
     for (std::size_t k = 0; k < std::min(r.turn_ms.size(), peer->size()); ++k)
       if ((*peer)[k] > 0) ratios.push_back(r.turn_ms[k] / (*peer)[k]);
-    r.median_ratio = median_of(ratios);
+    r.median_ratio = median(ratios);
   }
 }
 
@@ -143,16 +138,20 @@ template <class Make, class Measure>
 void each_engine(Make make_scene, int steps, Measure measure, const char* label,
                  std::initializer_list<int> bullet_iterations = {}) {
   std::vector<Entry> entries;
+  // An engine that cannot take the scene says why, in its line, and is left out.
+  const auto add = [&](const std::string& name, std::unique_ptr<Simulation> sim,
+                       const std::string& why) {
+    if (sim)
+      entries.push_back({name, std::move(sim), {}});
+    else
+      std::printf("  %-8s %-24s not run: %s\n", label, name.c_str(), why.c_str());
+  };
   for (const Ours& ours : kOurs) {
     SceneDef scene = make_scene(ours.solver);
     if (ours.substeps > 0) scene.world.solver.substeps = ours.substeps;
     std::string why;
     auto sim = make_tumble(scene, &why);
-    if (!sim) {
-      std::printf("  %-8s %-24s not run: %s\n", label, ours.label, why.c_str());
-      continue;
-    }
-    entries.push_back({ours.label, std::move(sim), {}});
+    add(ours.label, std::move(sim), why);
   }
   const std::size_t reference = entries.size();  // Bullet float, where it runs
   const SceneDef scene = make_scene(SolverKind::kSoft);
@@ -164,24 +163,14 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label,
         std::pair{"Bullet multibody", &make_bullet_multibody}}) {
     std::string why;
     auto sim = make(peer, options, &why);
-    if (!sim) {
-      std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
-      continue;
-    }
-    entries.push_back({name, std::move(sim), {}});
+    add(name, std::move(sim), why);
   }
   for (const int iterations : bullet_iterations) {
     PeerOptions more = options;
     more.iterations = iterations;
     std::string why;
     auto sim = make_bullet(peer, more, &why);
-    char name[64];
-    std::snprintf(name, sizeof name, "Bullet float, %d iter.", iterations);
-    if (!sim) {
-      std::printf("  %-8s %-24s not run: %s\n", label, name, why.c_str());
-      continue;
-    }
-    entries.push_back({name, std::move(sim), {}});
+    add("Bullet float, " + std::to_string(iterations) + " iter.", std::move(sim), why);
   }
   const bool has_reference =
       reference < entries.size() && entries[reference].name == "Bullet float";
