@@ -377,6 +377,12 @@ constexpr double kConvergedTakes = 0.03;
 // pendulum's period (solve_velocities). At most kMostTakes.
 constexpr double kSettledTakeMove = 1e-7;
 constexpr int kMostTakes = 6;
+// A stiffened velocity factoring starts from the last position pass's factors (refactor_stiffened)
+// only where that pass corrected less than this (m, or rad): its rows are then the sweeps' but for
+// a turn this small, as step.cc's chord steps take them (kNewtonAfter). Past it the rows are
+// formed afresh: in the matrix of hanging chains (bench_hanging_chains 2) the light beads' rows,
+// one pass old after passes that corrected millimetres, tore chains by kilometres.
+constexpr double kKeptRowsTurn = 1e-5;
 
 bool JointTree::set_geometric_stiffness(std::span<const JointRow> rows,
                                         std::span<const SolverBody> bodies,
@@ -640,8 +646,7 @@ bool turns_only_after_point(const JointEquations& equations) {
 
 }  // namespace
 
-template <class Equations>
-void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equations equations) {
+void JointTree::set_masses(std::span<const SolverBody> bodies, bool velocities) {
   for (TreeBody& body : tree_bodies_) {
     const SolverBody& solver_body = bodies[body.index];
     body.stiff =
@@ -655,60 +660,103 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
     }
     body.inverse_mass = solver_body.inverse_mass;
   }
+}
+
+void JointTree::form_pivot(std::size_t k) {
+  TreeJoint& joint = joints_[k];
+  with_width(joint.width, [&]<int W>() {
+    auto pivot = joint.pivot.template topLeftCorner<W, W>();
+    pivot.setZero();
+    for (const bool side_b : {false, true}) {
+      const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
+      if (b == kNone) continue;
+      const TreeBody& body = tree_bodies_[b];
+      const auto rows_on_body = jacobian(k, side_b).template topRows<W>();
+      Mat6& response = side_b ? joint.response_b : joint.response_a;
+      if (body.stiff)
+        response.template topLeftCorner<3, W>().noalias() =
+            body.linear_inverse.lazyProduct(rows_on_body.template leftCols<3>().transpose());
+      else
+        response.template topLeftCorner<3, W>() =
+            body.inverse_mass * rows_on_body.template leftCols<3>().transpose();
+      response.template bottomLeftCorner<3, W>().noalias() =
+          body.angular_inverse.lazyProduct(rows_on_body.template rightCols<3>().transpose());
+      for_rows_times<W>(equations_[k], side_b, response.template leftCols<W>(),
+                        [&](int i, int col, double value) { pivot(i, col) += value; });
+    }
+    for (int r = equations_[k].rows; r < W; ++r)
+      pivot(r, r) = 1;
+  });
+}
+
+template <class Equations>
+void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equations equations) {
+  set_masses(bodies, velocities);
   // Each joint's rows, its response on each body (W J^T) and its diagonal block J W J^T.
   for (std::size_t k = 0; k < joints_.size(); ++k) {
-    TreeJoint& joint = joints_[k];
     equations(k, &equations_[k]);
     equations_[k].turning_rest = turns_only_after_point(equations_[k]);
-    joint.width = equations_[k].rows <= 3 ? 3 : equations_[k].rows <= 5 ? 5 : 6;
-    with_width(joint.width, [&]<int W>() {
-      auto pivot = joint.pivot.template topLeftCorner<W, W>();
-      pivot.setZero();
-      for (const bool side_b : {false, true}) {
-        const std::uint32_t b = side_b ? joint.body_b : joint.body_a;
-        if (b == kNone) continue;
-        const TreeBody& body = tree_bodies_[b];
-        const auto rows_on_body = jacobian(k, side_b).template topRows<W>();
-        Mat6& response = side_b ? joint.response_b : joint.response_a;
-        if (body.stiff)
-          response.template topLeftCorner<3, W>().noalias() =
-              body.linear_inverse.lazyProduct(rows_on_body.template leftCols<3>().transpose());
-        else
-          response.template topLeftCorner<3, W>() =
-              body.inverse_mass * rows_on_body.template leftCols<3>().transpose();
-        response.template bottomLeftCorner<3, W>().noalias() =
-            body.angular_inverse.lazyProduct(rows_on_body.template rightCols<3>().transpose());
-        for_rows_times<W>(equations_[k], side_b, response.template leftCols<W>(),
-                          [&](int i, int col, double value) { pivot(i, col) += value; });
-      }
-      for (int r = equations_[k].rows; r < W; ++r)
-        pivot(r, r) = 1;
-    });
+    joints_[k].width = equations_[k].rows <= 3 ? 3 : equations_[k].rows <= 5 ? 5 : 6;
+    form_pivot(k);
   }
   every_width_ = std::all_of(joints_.begin(), joints_.end(),
                              [](const TreeJoint& joint) { return joint.width == 3; })
                      ? 3
                      : 0;
-  with_every_width(every_width_, [&]<int Every>() {
-    // The blocks between joints of a hub: through the hub's body alone.
-    for (const Hub& hub : hubs_) {
-      for (std::uint32_t i = 0; i + 1 < hub.members; ++i) {
-        const std::uint32_t first = hub_members_[hub.first_member + i];
-        const bool first_b = member_side_b_[hub.first_member + i] != 0;
-        for (std::uint32_t j = i + 1; j < hub.members; ++j) {
-          const std::uint32_t second = hub_members_[hub.first_member + j];
-          const bool second_b = member_side_b_[hub.first_member + j] != 0;
-          const Mat6& response = second_b ? joints_[second].response_b : joints_[second].response_a;
-          with_widths<Every>(joints_[first].width, joints_[second].width, [&]<int A, int B>() {
-            auto block = pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>();
-            for_rows_times<A>(equations_[first], first_b, response.template leftCols<B>(),
-                              [&](int row, int col, double value) { block(row, col) = value; });
-          });
-        }
+  with_every_width(every_width_, [&]<int Every>() { eliminate<Every, false>(); });
+}
+
+// The position pass's factors (its rows, the bodies' plain masses) differ from the stiffened
+// velocity system's only where a joint holds a body that takes stiffness, and in what such a
+// joint's elimination passes on: the joints of its parent's hub after it, and theirs in turn up
+// to the root. Those alone are formed and eliminated again; every other joint's inverse pivot and
+// reaches are what a whole factoring would give them, and so is the rest (the same sums in the
+// same order), at a fraction of the cost: in a hanging chain the stiff links are the loaded ones
+// near its top, and the joints below them keep their factors.
+void JointTree::refactor_stiffened(std::span<const SolverBody> bodies) {
+  set_masses(bodies, true);
+  changed_.assign(joints_.size(), 0);
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    const TreeJoint& joint = joints_[k];
+    const bool holds_stiff = (joint.body_a != kNone && tree_bodies_[joint.body_a].stiff) ||
+                             (joint.body_b != kNone && tree_bodies_[joint.body_b].stiff);
+    if (holds_stiff) changed_[k] = 1;
+    if (!changed_[k]) continue;
+    form_pivot(k);
+    if (joint.hub == kNone) continue;
+    const Hub& hub = hubs_[joint.hub];
+    for (std::uint32_t j = joint.place + 1; j < hub.members; ++j)
+      changed_[hub_members_[hub.first_member + j]] = 1;
+  }
+  with_every_width(every_width_, [&]<int Every>() { eliminate<Every, true>(); });
+}
+
+template <int Every, bool OnlyChanged>
+void JointTree::eliminate() {
+  // The blocks between joints of a hub: through the hub's body alone. (A joint left as it was
+  // keeps its blocks with the later ones: those of a changed one follow it, changed.)
+  for (const Hub& hub : hubs_) {
+    for (std::uint32_t i = 0; i + 1 < hub.members; ++i) {
+      const std::uint32_t first = hub_members_[hub.first_member + i];
+      if (OnlyChanged && !changed_[first]) continue;
+      const bool first_b = member_side_b_[hub.first_member + i] != 0;
+      for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+        const std::uint32_t second = hub_members_[hub.first_member + j];
+        const bool second_b = member_side_b_[hub.first_member + j] != 0;
+        const Mat6& response = second_b ? joints_[second].response_b : joints_[second].response_a;
+        with_widths<Every>(joints_[first].width, joints_[second].width, [&]<int A, int B>() {
+          auto block = pairs_[pair_index(hub, i, j)].block.template topLeftCorner<A, B>();
+          for_rows_times<A>(equations_[first], first_b, response.template leftCols<B>(),
+                            [&](int row, int col, double value) { block(row, col) = value; });
+        });
       }
     }
-    // Each joint eliminated into its later neighbours (each pivot kept as its inverse).
-    for (TreeJoint& joint : joints_) {
+  }
+  // Each joint eliminated into its later neighbours (each pivot kept as its inverse).
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    TreeJoint& joint = joints_[k];
+    const bool changed = !OnlyChanged || changed_[k];
+    if (changed) {
       with_width<Every>(joint.width, [&]<int W>() {
         if constexpr (W == 3)
           invert_in_place(joint.pivot.topLeftCorner<3, 3>());
@@ -718,51 +766,54 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
         else
           joint.pivot = inverse_of_definite<6>(joint.pivot);
       });
-      if (joint.hub == kNone) continue;
-      const Hub& hub = hubs_[joint.hub];
-      const std::uint32_t i = joint.place;
-      for (std::uint32_t j = i + 1; j < hub.members; ++j) {
-        HubPair& pair = pairs_[pair_index(hub, i, j)];
-        with_widths<Every>(joint.width, joints_[hub_members_[hub.first_member + j]].width,
-                           [&]<int A, int B>() {
-                             if constexpr (A == 3 && B == 3)
-                               multiply_into(pair.reach.topLeftCorner<3, 3>(),
-                                             std::as_const(joint.pivot).topLeftCorner<3, 3>(),
-                                             std::as_const(pair.block).topLeftCorner<3, 3>());
-                             else
-                               pair.reach.template topLeftCorner<A, B>().noalias() =
-                                   joint.pivot.template topLeftCorner<A, A>().lazyProduct(
-                                       pair.block.template topLeftCorner<A, B>());
-                           });
-      }
-      for (std::uint32_t j = i + 1; j < hub.members; ++j) {
-        const HubPair& with_j = pairs_[pair_index(hub, i, j)];
-        TreeJoint& later = joints_[hub_members_[hub.first_member + j]];
-        with_widths<Every>(joint.width, later.width, [&]<int A, int B>() {
-          if constexpr (A == 3 && B == 3)
-            subtract_transposed_product(later.pivot.topLeftCorner<3, 3>(),
-                                        with_j.block.topLeftCorner<3, 3>(),
-                                        with_j.reach.topLeftCorner<3, 3>());
-          else
-            later.pivot.template topLeftCorner<B, B>().noalias() -=
-                with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
-                    with_j.reach.template topLeftCorner<A, B>());
-        });
-        for (std::uint32_t l = j + 1; l < hub.members; ++l) {
-          const HubPair& with_l = pairs_[pair_index(hub, i, l)];
-          HubPair& between = pairs_[pair_index(hub, j, l)];
-          with_widths<Every>(
-              later.width, joints_[hub_members_[hub.first_member + l]].width, [&]<int B, int C>() {
-                with_width<Every>(joint.width, [&]<int A>() {
-                  between.block.template topLeftCorner<B, C>().noalias() -=
-                      with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
-                          with_l.reach.template topLeftCorner<A, C>());
-                });
+    }
+    if (joint.hub == kNone) continue;
+    const Hub& hub = hubs_[joint.hub];
+    const std::uint32_t i = joint.place;
+    for (std::uint32_t j = i + 1; j < hub.members && changed; ++j) {
+      HubPair& pair = pairs_[pair_index(hub, i, j)];
+      with_widths<Every>(joint.width, joints_[hub_members_[hub.first_member + j]].width,
+                         [&]<int A, int B>() {
+                           if constexpr (A == 3 && B == 3)
+                             multiply_into(pair.reach.topLeftCorner<3, 3>(),
+                                           std::as_const(joint.pivot).topLeftCorner<3, 3>(),
+                                           std::as_const(pair.block).topLeftCorner<3, 3>());
+                           else
+                             pair.reach.template topLeftCorner<A, B>().noalias() =
+                                 joint.pivot.template topLeftCorner<A, A>().lazyProduct(
+                                     pair.block.template topLeftCorner<A, B>());
+                         });
+    }
+    for (std::uint32_t j = i + 1; j < hub.members; ++j) {
+      const std::uint32_t later_index = hub_members_[hub.first_member + j];
+      // (A changed joint after an unchanged one takes what it passes on again.)
+      if (OnlyChanged && !changed_[later_index]) continue;
+      const HubPair& with_j = pairs_[pair_index(hub, i, j)];
+      TreeJoint& later = joints_[later_index];
+      with_widths<Every>(joint.width, later.width, [&]<int A, int B>() {
+        if constexpr (A == 3 && B == 3)
+          subtract_transposed_product(later.pivot.topLeftCorner<3, 3>(),
+                                      with_j.block.topLeftCorner<3, 3>(),
+                                      with_j.reach.topLeftCorner<3, 3>());
+        else
+          later.pivot.template topLeftCorner<B, B>().noalias() -=
+              with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
+                  with_j.reach.template topLeftCorner<A, B>());
+      });
+      for (std::uint32_t l = j + 1; l < hub.members; ++l) {
+        const HubPair& with_l = pairs_[pair_index(hub, i, l)];
+        HubPair& between = pairs_[pair_index(hub, j, l)];
+        with_widths<Every>(
+            later.width, joints_[hub_members_[hub.first_member + l]].width, [&]<int B, int C>() {
+              with_width<Every>(joint.width, [&]<int A>() {
+                between.block.template topLeftCorner<B, C>().noalias() -=
+                    with_j.block.template topLeftCorner<A, B>().transpose().lazyProduct(
+                        with_l.reach.template topLeftCorner<A, C>());
               });
-        }
+            });
       }
     }
-  });
+  }
 }
 
 void JointTree::set_velocity_base(std::span<const SolverBody> bodies) {
@@ -872,10 +923,13 @@ double JointTree::solve_velocities(std::span<JointRow> rows, std::span<SolverBod
       learn_loads(rows, bodies, equations_of_row);
       stiffness_kept_ = false;
     }
-    stiffened_ =
-        stiffness_kept_ || set_geometric_stiffness(rows, bodies, poses, target.substep, terms);
+    const bool kept = stiffness_kept_;
+    stiffened_ = kept || set_geometric_stiffness(rows, bodies, poses, target.substep, terms);
     stiffness_kept_ = false;
-    factor(bodies, true, equations_of_row);
+    if (kept && factors_kept_)
+      refactor_stiffened(bodies);
+    else
+      factor(bodies, true, equations_of_row);
     velocities_factored_ = true;
   }
   // The targets of a move ahead (the turns' curvature) depend on the velocities: SHAKE's
@@ -1096,6 +1150,7 @@ double JointTree::solve_positions(std::span<const JointRow> rows, std::span<Solv
     });
   }
   if (!solution_finite()) return std::numeric_limits<double>::infinity();
+  if (refactor) factored_correction_ = largest;
   for (const TreeBody& body : tree_bodies_)
     joint_detail::move_body(&bodies[body.index], &poses[body.index], body.result.head<3>(),
                             body.result.tail<3>());
@@ -1118,6 +1173,7 @@ void JointTree::settle_velocity_factors(std::span<const JointRow> rows,
     return;
   }
   stiffness_kept_ = keep_stiffness;
+  factors_kept_ = keep_stiffness && factored_correction_ < kKeptRowsTurn;
 }
 
 void JointTree::set_turns(std::span<const JointRow> rows, std::span<const SolverBody> bodies,

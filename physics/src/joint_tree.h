@@ -89,7 +89,8 @@ class JointTree {
   // the velocity sweeps (no body takes stiffness at the poses the passes left). Where some body
   // does, and `keep_stiffness`, the stiffness worked out here is the next velocity factoring's
   // (the sweeps that follow meet these poses and impulses; the exact solver's substep clears the
-  // impulses first, and does not keep it).
+  // impulses first, and does not keep it), which then factors again from the pass's factors only
+  // the joints it changes (refactor_stiffened).
   // `terms`: as for solve_velocities, at the poses the passes left (or empty).
   void settle_velocity_factors(std::span<const JointRow> rows, std::span<const SolverBody> bodies,
                                std::span<const Pose> poses, double h, bool keep_stiffness,
@@ -197,6 +198,17 @@ class JointTree {
   // masses (with their stiffness for velocities), forms J W J^T and factors it.
   template <class Equations>
   void factor(std::span<const SolverBody> bodies, bool velocities, Equations equations);
+  // The bodies' inverse masses for a factoring (with their stiffness for velocities), and joint
+  // k's response and diagonal block J W J^T from its rows (equations_) and those masses.
+  void set_masses(std::span<const SolverBody> bodies, bool velocities);
+  void form_pivot(std::size_t k);
+  // The hubs' blocks and the elimination; with OnlyChanged, only of the joints changed_ marks
+  // (refactor_stiffened), the others' factors kept.
+  template <int Every, bool OnlyChanged>
+  void eliminate();
+  // The velocity sweeps' factoring from the last position pass's (settle_velocity_factors kept
+  // its stiffness): only the joints the stiffness changes are factored again.
+  void refactor_stiffened(std::span<const SolverBody> bodies);
   // With the factors: the joints' impulses that bring each joint's rows from the bodies' base
   // velocities (or 0) to targets(k), and the bodies' results.
   template <class Targets>
@@ -282,7 +294,13 @@ class JointTree {
   int every_width_ = 0;
   // settle_velocity_factors: a pass's factors that may serve the sweeps, and the bodies'
   // stiffness worked out for the next velocity factoring.
+  // Where stiffness is kept, the factors are still that pass's (refactor_stiffened).
   bool share_pending_ = false, stiffness_kept_ = false;
+  std::vector<std::uint8_t> changed_;  // by joint: refactor_stiffened's
+  // The largest error the last refactoring position pass corrected, and whether its factors are
+  // the next stiffened velocity factoring's start (settle_velocity_factors).
+  double factored_correction_ = 0;
+  bool factors_kept_ = false;
   bool has_motors_ = false;     // a joint with a motor: its row joins the velocity system
   // A joint the step has not yet solved (just made: no impulse to tell its load): the first
   // velocity factoring learns the loads first (solve_velocities).
