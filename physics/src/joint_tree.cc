@@ -770,7 +770,8 @@ void JointTree::eliminate() {
     if (joint.hub == kNone) continue;
     const Hub& hub = hubs_[joint.hub];
     const std::uint32_t i = joint.place;
-    for (std::uint32_t j = i + 1; j < hub.members && changed; ++j) {
+    // (An unchanged joint's reaches are the kept ones.)
+    for (std::uint32_t j = i + 1; changed && j < hub.members; ++j) {
       HubPair& pair = pairs_[pair_index(hub, i, j)];
       with_widths<Every>(joint.width, joints_[hub_members_[hub.first_member + j]].width,
                          [&]<int A, int B>() {
