@@ -16,6 +16,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -33,6 +34,16 @@ namespace tumble {
 struct JointTreeIndex {
   std::vector<std::uint32_t> node_of_body;  // its tree body in the attached forest, or UINT32_MAX
   std::vector<Quat> turns;                  // JointTree::set_turns
+};
+
+// The check of refactor_stiffened by the tests (test_joint_tree_refactor.cc): where `whole` is
+// set, a stiffened velocity factoring that would start from a position pass's factors forms and
+// eliminates every joint of the same rows instead, as factoring them whole does, and must give
+// the same bits; `partial` counts the partial factorings (whole or not), so the check knows the
+// path ran. Process-wide: set it only where no other world steps.
+struct JointTreeRefactorCheck {
+  static inline std::atomic<bool> whole{false};
+  static inline std::atomic<std::uint64_t> partial{0};
 };
 
 class JointTree {
