@@ -1,12 +1,13 @@
 // The standard pile dropped on rolling hills, as a heightfield (the standard scene terrain:N) and
 // as a triangle mesh of the same triangles (terrain-mesh:N), beside the same pile on the plane
-// (pile:N): the whole 10 s run of each, alternated round by round, its median time per step and
-// the ratios; and whether the pile came through the ground, sampled after every step (untimed):
-// the boxes whose centre was ever under the surface (through it), those with a vertex ever more
-// than 1 cm under it (dipped), the deepest any vertex went (a box landing hard, for a step or
-// two), and the deepest any vertex lies at the end (the pile settled). Beside the whole run's
-// time, its first 5 s alone (every box still awake on either ground: the piles' costs step for
-// step before the plane's towers sleep while some of the hills' topple).
+// (pile:N): the whole 10 s run of each, the scenes (and Bullet's runs of them) taking turns of 20
+// steps (run_round), its median time per step over the rounds and the ratios; and whether the
+// pile came through the ground, sampled after every step (untimed): the boxes whose centre was
+// ever under the surface (through it), those with a vertex ever more than 1 cm under it (dipped),
+// the deepest any vertex went (a box landing hard, for a step or two), and the deepest any vertex
+// lies at the end (the pile settled). Beside the whole run's time, its first 5 s alone (every box
+// still awake on either ground: the piles' costs step for step before the plane's towers sleep
+// while some of the hills' topple).
 //
 // With the peers built (make bench), Bullet 3.24 (float, its deactivation on as our sleeping is)
 // takes the same three scenes each round, its heightfield a btHeightfieldTerrainShape and its mesh
@@ -21,6 +22,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -49,12 +53,11 @@ int argument(int argc, char** argv, int index, int fallback, int least, int most
 struct Run {
   double ms_per_step = 0;
   double first_ms_per_step = 0;  // over the first 5 s
-  int through = 0;         // boxes whose centre was under the ground
-  int dipped = 0;          // boxes that had a vertex more than 1 cm under it
-  double deepest = 0;      // m: the deepest any vertex went under it
-  double settled = 0;      // m: the deepest any vertex lies under it after the last step
-  double fastest = 0;      // m/s: the fastest box at the end
-  std::size_t points = 0;  // contact points in the last step
+  int through = 0;               // boxes whose centre was under the ground
+  int dipped = 0;                // boxes that had a vertex more than 1 cm under it
+  double deepest = 0;            // m: the deepest any vertex went under it
+  double settled = 0;            // m: the deepest any vertex lies under it after the last step
+  double fastest = 0;            // m/s: the fastest box at the end
   // Where the engine reported that it cannot go on: the steps it took (the times are theirs).
   int stopped_after = -1;
 };
@@ -91,90 +94,138 @@ struct BoxPose {
   Vec3 half_extents;
 };
 
-// The scene's whole run timed step by step (`step` returns false to stop), its boxes' depths
-// under the ground sampled after every step untimed (every tenth missed a landing box's vertex
-// 4.6 cm under the mesh for the one step it lasted), and their speeds (`speed_of`) at the end.
-// `hills`: the hills' surface (the mesh's triangles are the heightfield's); the static ground is
-// the scene's.
-template <class Step, class BoxAt, class SpeedOf>
-Run timed_run(const SceneDef& scene, const HeightField& hills, std::size_t boxes, Step step,
-              BoxAt box_at, SpeedOf speed_of) {
-  const BodyDef* ground = nullptr;
-  for (const BodyDef& body : scene.bodies)
-    if (body.type == BodyType::kStatic) ground = &body;
-  const HeightField* field = std::holds_alternative<HalfSpaceDef>(ground->shape) ? nullptr : &hills;
-  const Pose ground_pose{ground->position, ground->orientation};
-  const int steps = static_cast<int>(scene.duration / scene.dt + 0.5);
-  const int first_steps = std::min(steps, static_cast<int>(5 / scene.dt + 0.5));
-  std::vector<std::uint8_t> through(boxes, 0), dipped(boxes, 0);
-  Run out;
-  double seconds = 0, first_seconds = 0;
-  int taken = 0;
-  for (; taken < steps; ++taken) {
-    const auto start = std::chrono::steady_clock::now();
-    if (!step()) {
-      out.stopped_after = taken;
-      break;
-    }
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (taken + 1 == first_steps) first_seconds = seconds;
-    sample_depths(field, ground_pose, boxes, box_at, &through, &dipped, &out.deepest);
+// One engine's run of one scene, stepped a turn at a time (run_round): each step timed (but a
+// turn's first), its boxes' depths under the ground sampled after every step untimed (every tenth
+// missed a landing box's vertex 4.6 cm under the mesh for the one step it lasted), and their
+// speeds at the end. `hills`: the hills' surface (the mesh's triangles are the heightfield's); the
+// static ground is the scene's.
+class TimedRun {
+ public:
+  TimedRun(const SceneDef& scene, const HeightField& hills, std::size_t boxes,
+           std::function<bool()> step, std::function<BoxPose(std::size_t)> box_at,
+           std::function<double(std::size_t)> speed_of)
+      : boxes_(boxes),
+        step_(std::move(step)),
+        box_at_(std::move(box_at)),
+        speed_of_(std::move(speed_of)),
+        through_(boxes, 0),
+        dipped_(boxes, 0) {
+    const BodyDef* ground = nullptr;
+    for (const BodyDef& body : scene.bodies)
+      if (body.type == BodyType::kStatic) ground = &body;
+    field_ = std::holds_alternative<HalfSpaceDef>(ground->shape) ? nullptr : &hills;
+    ground_pose_ = Pose{ground->position, ground->orientation};
   }
-  if (taken < first_steps) first_seconds = seconds;
-  std::vector<std::uint8_t> unused_through(boxes, 0), unused_dipped(boxes, 0);
-  sample_depths(field, ground_pose, boxes, box_at, &unused_through, &unused_dipped, &out.settled);
-  for (std::size_t k = 0; k < boxes; ++k) {
-    out.through += through[k];
-    out.dipped += dipped[k];
-    out.fastest = std::max(out.fastest, speed_of(k));
-  }
-  out.ms_per_step = taken > 0 ? 1e3 * seconds / taken : 0.0;
-  out.first_ms_per_step = taken > 0 ? 1e3 * first_seconds / std::min(taken, first_steps) : 0.0;
-  return out;
-}
+  bool stopped() const { return out_.stopped_after >= 0; }
 
-Run run(SceneDef scene, int threads, const HeightField& hills) {
-  scene.world.threads = threads;
-  World world = make_world(scene).value();
-  std::vector<BodyId> ids;
-  for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
-    const BodyId id = world.id_at(slot);
-    if (id.is_valid() && !world.body(id).is_static()) ids.push_back(id);
+  // Step `index` of the run (0 first); `timed` false leaves its time out.
+  void step(int index, bool timed, int first_steps) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!step_()) {
+      out_.stopped_after = index;
+      return;
+    }
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (timed) {
+      ms_ += ms;
+      ++timed_;
+      if (index < first_steps) {
+        first_ms_ += ms;
+        ++first_timed_;
+      }
+    }
+    sample_depths(field_, ground_pose_, boxes_, box_at_, &through_, &dipped_, &out_.deepest);
   }
-  Run out = timed_run(
-      scene, hills, ids.size(), [&] { return world.step(scene.dt).is_ok(); },
-      [&](std::size_t k) {
-        const BodyView body = world.body(ids[k]);
-        return BoxPose{body.position(), body.orientation(), body.shape().half_extents()};
-      },
-      [&](std::size_t k) { return world.body(ids[k]).linear_velocity().norm(); });
-  out.points = world.last_step().contact_points;
-  return out;
-}
+
+  Run finish() {
+    std::vector<std::uint8_t> unused_through(boxes_, 0), unused_dipped(boxes_, 0);
+    sample_depths(field_, ground_pose_, boxes_, box_at_, &unused_through, &unused_dipped,
+                  &out_.settled);
+    for (std::size_t k = 0; k < boxes_; ++k) {
+      out_.through += through_[k];
+      out_.dipped += dipped_[k];
+      out_.fastest = std::max(out_.fastest, speed_of_(k));
+    }
+    out_.ms_per_step = timed_ > 0 ? ms_ / timed_ : 0.0;
+    out_.first_ms_per_step = first_timed_ > 0 ? first_ms_ / first_timed_ : 0.0;
+    return out_;
+  }
+
+ private:
+  std::size_t boxes_;
+  std::function<bool()> step_;
+  std::function<BoxPose(std::size_t)> box_at_;
+  std::function<double(std::size_t)> speed_of_;
+  const HeightField* field_ = nullptr;
+  Pose ground_pose_;
+  std::vector<std::uint8_t> through_, dipped_;
+  double ms_ = 0, first_ms_ = 0;
+  int timed_ = 0, first_timed_ = 0;
+  Run out_;
+};
+
+// Ours on one scene.
+struct OurRun {
+  OurRun(SceneDef scene, int threads, const HeightField& hills)
+      : world(make_world((scene.world.threads = threads, scene)).value()) {
+    for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
+      const BodyId id = world.id_at(slot);
+      if (id.is_valid() && !world.body(id).is_static()) ids.push_back(id);
+    }
+    run = std::make_unique<TimedRun>(
+        scene, hills, ids.size(), [this, dt = scene.dt] { return world.step(dt).is_ok(); },
+        [this](std::size_t k) {
+          const BodyView body = world.body(ids[k]);
+          return BoxPose{body.position(), body.orientation(), body.shape().half_extents()};
+        },
+        [this](std::size_t k) { return world.body(ids[k]).linear_velocity().norm(); });
+  }
+  World world;
+  std::vector<BodyId> ids;
+  std::unique_ptr<TimedRun> run;
+};
 
 #ifdef TUMBLE_HAVE_PEERS
-// The same run in Bullet (float): its time a step and the same marks (no contact count).
-Run run_bullet(const SceneDef& scene, const HeightField& hills) {
-  std::string why_not;
-  const std::unique_ptr<bench::Simulation> sim =
-      bench::make_bullet(bench::peer_scene(scene), bench::PeerOptions{}, &why_not);
-  if (!sim) {
-    std::fprintf(stderr, "bench_terrain: Bullet: %s\n", why_not.c_str());
-    std::exit(1);
+// The same scene in Bullet (float), with the same marks (no contact count).
+struct BulletRun {
+  BulletRun(const SceneDef& scene, const HeightField& hills) {
+    std::string why_not;
+    sim = bench::make_bullet(bench::peer_scene(scene), bench::PeerOptions{}, &why_not);
+    if (!sim) {
+      std::fprintf(stderr, "bench_terrain: Bullet: %s\n", why_not.c_str());
+      std::exit(1);
+    }
+    for (const BodyDef& body : scene.bodies)  // the dynamic bodies, in the adapter's order
+      if (body.type != BodyType::kStatic)
+        half_extents.push_back(std::get<BoxDef>(body.shape).half_extents);
+    run = std::make_unique<TimedRun>(
+        scene, hills, half_extents.size(), [this] { return sim->step(); },
+        [this](std::size_t k) {
+          const bench::BodyState state = sim->body(k);
+          return BoxPose{state.position, state.orientation, half_extents[k]};
+        },
+        [this](std::size_t k) { return sim->body(k).linear_velocity.norm(); });
   }
-  std::vector<Vec3> half_extents;  // the dynamic bodies', in the scene's order (the adapter's)
-  for (const BodyDef& body : scene.bodies)
-    if (body.type != BodyType::kStatic)
-      half_extents.push_back(std::get<BoxDef>(body.shape).half_extents);
-  return timed_run(
-      scene, hills, half_extents.size(), [&] { return sim->step(); },
-      [&](std::size_t k) {
-        const bench::BodyState state = sim->body(k);
-        return BoxPose{state.position, state.orientation, half_extents[k]};
-      },
-      [&](std::size_t k) { return sim->body(k).linear_velocity.norm(); });
-}
+  std::unique_ptr<bench::Simulation> sim;
+  std::vector<Vec3> half_extents;
+  std::unique_ptr<TimedRun> run;
+};
 #endif
+
+// A round: every run of the round's scenes (ours on the plane, the heightfield and the mesh, then
+// Bullet's where `runs` holds them) stepped together, kTurnSteps steps each in turn, so that every
+// one meets the shared machine at the same speeds: run whole one after another, the plane's first
+// 5 s and the hills' ran at speeds up to a half apart (the plane's first 5 s 3.8 to 6.2 ms a step
+// in three rounds), which went straight into their ratio. A turn's first step finds the caches full
+// of the others' data and is not timed (bench_joints does the same).
+constexpr int kTurnSteps = 20;
+void run_round(std::span<TimedRun* const> runs, int steps, int first_steps) {
+  for (int first = 0; first < steps; first += kTurnSteps)
+    for (TimedRun* run : runs)
+      for (int k = first; k < std::min(steps, first + kTurnSteps) && !run->stopped(); ++k)
+        run->step(k, k > first, first_steps);
+}
 
 std::string stop_note(const Run& r) {
   return r.stopped_after < 0 ? ""
@@ -203,6 +254,20 @@ Medians print_medians(const char* engine, const std::vector<double> (&times)[3],
         "%s%s, median ms/step: plane %.3f, heightfield %.3f, mesh %.3f; heightfield / plane "
         "%.2f, mesh / plane %.2f\n",
         engine, label, v[0], v[1], v[2], v[1] / v[0], v[2] / v[0]);
+  // The rounds' own ratios: each round's scenes ran together, so its ratio is the steadier figure.
+  for (const auto& [label, v] : {std::pair{"whole run", &times}, std::pair{"first 5 s", &first}}) {
+    std::printf("%s%s, each round's hills / plane:", engine, label);
+    for (int k = 1; k < 3; ++k) {
+      std::vector<double> ratios;
+      for (std::size_t round = 0; round < (*v)[0].size(); ++round)
+        ratios.push_back((*v)[k][round] / (*v)[0][round]);
+      std::printf("%s", k == 1 ? " heightfield" : "; mesh");
+      for (double ratio : ratios)
+        std::printf(" %.2f", ratio);
+      std::printf(" (median %.2f)", median(ratios));
+    }
+    std::printf("\n");
+  }
   return m;
 }
 
@@ -231,19 +296,36 @@ int main(int argc, char** argv) {
       "round  scene                    ms/step  first 5 s  through  dipped  deepest(m)  at end(m)  "
       "fastest(m/s)  points\n");
   std::vector<double> times[3], first[3], bullet_times[3], bullet_first[3];
+  const int steps = static_cast<int>(scenes[0].duration / scenes[0].dt + 0.5);
+  const int first_steps = std::min(steps, static_cast<int>(5 / scenes[0].dt + 0.5));
   for (int round = 0; round < rounds; ++round) {
+    std::vector<std::unique_ptr<OurRun>> ours;
+    std::vector<TimedRun*> runs;
     for (int k = 0; k < 3; ++k) {
-      const Run r = run(scenes[k], threads, hills);
+      ours.push_back(std::make_unique<OurRun>(scenes[k], threads, hills));
+      runs.push_back(ours.back()->run.get());
+    }
+#ifdef TUMBLE_HAVE_PEERS
+    // Bullet steps on one thread: beside ours on one alone.
+    std::vector<std::unique_ptr<BulletRun>> bullet;
+    for (int k = 0; k < 3 && threads == 1; ++k) {
+      bullet.push_back(std::make_unique<BulletRun>(scenes[k], hills));
+      runs.push_back(bullet.back()->run.get());
+    }
+#endif
+    run_round(runs, steps, first_steps);
+    for (int k = 0; k < 3; ++k) {
+      const Run r = ours[k]->run->finish();
       times[k].push_back(r.ms_per_step);
       first[k].push_back(r.first_ms_per_step);
       std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f  %6zu%s\n", round,
                   names[k].c_str(), r.ms_per_step, r.first_ms_per_step, r.through, r.dipped,
-                  r.deepest, r.settled, r.fastest, r.points, stop_note(r).c_str());
+                  r.deepest, r.settled, r.fastest, ours[k]->world.last_step().contact_points,
+                  stop_note(r).c_str());
     }
 #ifdef TUMBLE_HAVE_PEERS
-    // Bullet steps on one thread: beside ours on one alone.
     for (int k = 0; k < 3 && threads == 1; ++k) {
-      const Run r = run_bullet(scenes[k], hills);
+      const Run r = bullet[k]->run->finish();
       bullet_times[k].push_back(r.ms_per_step);
       bullet_first[k].push_back(r.first_ms_per_step);
       std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f       -%s\n", round,
