@@ -14,10 +14,13 @@
 // a btBvhTriangleMeshShape (bench/peers/bullet_sim.cc): the hills' cost over the plane's in an
 // engine the goal did not shape, and ours beside it.
 //
-// Usage: bench_terrain [BOXES [ROUNDS [THREADS [FLAT]]]]   (defaults 1000, 3, 1, 0)
+// Usage: bench_terrain [BOXES [ROUNDS [THREADS [FLAT [AWAKE]]]]]   (defaults 1000, 3, 1, 0, 0)
 //   FLAT 1: the hills levelled (every height 0), as a heightfield and as a mesh: the pile lands on
 //   them as on the plane (the face rule gives a flat terrain the plane's contacts), so the ratios
 //   are the terrain's own cost.
+//   AWAKE 1: sleeping off in every run (Bullet's deactivation too): each step's cost with every
+//   box awake on either ground, where with sleeping the plane's pile falls asleep seconds before
+//   the hills' (the towers toppling on the slopes keep their islands awake).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -191,7 +194,9 @@ struct OurRun {
 struct BulletRun {
   BulletRun(const SceneDef& scene, const HeightField& hills) {
     std::string why_not;
-    sim = bench::make_bullet(bench::peer_scene(scene), bench::PeerOptions{}, &why_not);
+    bench::PeerOptions options;
+    options.sleeping = scene.world.solver.sleeping;
+    sim = bench::make_bullet(bench::peer_scene(scene), options, &why_not);
     if (!sim) {
       std::fprintf(stderr, "bench_terrain: Bullet: %s\n", why_not.c_str());
       std::exit(1);
@@ -278,7 +283,10 @@ int main(int argc, char** argv) {
   const int rounds = argument(argc, argv, 2, 3, 1, 100);
   const int threads = argument(argc, argv, 3, 1, 1, 256);
   const bool flat = argument(argc, argv, 4, 0, 0, 1) == 1;
+  const bool awake = argument(argc, argv, 5, 0, 0, 1) == 1;
   SceneDef scenes[3] = {pile_scene(boxes), terrain_pile_scene(boxes), terrain_pile_scene(boxes)};
+  for (SceneDef& scene : scenes)
+    scene.world.solver.sleeping = scene.world.solver.sleeping && !awake;
   auto& heights = std::get<HeightFieldDef>(scenes[1].bodies[0].shape);
   if (flat) std::fill(heights.heights.begin(), heights.heights.end(), 0.0);
   const HeightField hills = HeightField::create(heights).value();
@@ -290,8 +298,8 @@ int main(int argc, char** argv) {
       std::string(flat ? "flat-" : "") + "terrain-mesh:" + std::to_string(boxes)};
   std::printf(
       "%d boxes dropped on the plane and on %s (0.5 m cells; a heightfield, then the "
-      "same triangles as a mesh), 10 s at 60 Hz, %d thread(s)\n",
-      boxes, ground, threads);
+      "same triangles as a mesh), 10 s at 60 Hz, %d thread(s)%s\n",
+      boxes, ground, threads, awake ? ", sleeping off" : "");
   std::printf(
       "round  scene                    ms/step  first 5 s  through  dipped  deepest(m)  at end(m)  "
       "fastest(m/s)  points\n");
