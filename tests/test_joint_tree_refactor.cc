@@ -22,12 +22,13 @@ struct Outcome {
 };
 
 Outcome run(const SceneDef& scene, int steps, bool whole) {
-  JointTreeRefactorCheck::whole = whole;
+  JointTreeRefactorCheck::mode =
+      whole ? JointTreeRefactorCheck::kWhole : JointTreeRefactorCheck::kCount;
   JointTreeRefactorCheck::partial = 0;
   World world = build(scene);
   for (int k = 0; k < steps; ++k)
     EXPECT_TRUE(world.step(scene.dt).is_ok()) << "step " << k;
-  JointTreeRefactorCheck::whole = false;
+  JointTreeRefactorCheck::mode = JointTreeRefactorCheck::kOff;
   return {state_hash(world), JointTreeRefactorCheck::partial.load()};
 }
 

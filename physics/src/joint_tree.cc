@@ -715,8 +715,10 @@ void JointTree::factor(std::span<const SolverBody> bodies, bool velocities, Equa
 // near its top, and the joints below them keep their factors.
 void JointTree::refactor_stiffened(std::span<const SolverBody> bodies) {
   set_masses(bodies, true);
-  JointTreeRefactorCheck::partial.fetch_add(1, std::memory_order_relaxed);
-  if (JointTreeRefactorCheck::whole.load(std::memory_order_relaxed)) {
+  const int check = JointTreeRefactorCheck::mode.load(std::memory_order_relaxed);
+  if (check != JointTreeRefactorCheck::kOff)
+    JointTreeRefactorCheck::partial.fetch_add(1, std::memory_order_relaxed);
+  if (check == JointTreeRefactorCheck::kWhole) {
     for (std::size_t k = 0; k < joints_.size(); ++k)
       form_pivot(k);
     with_every_width(every_width_, [&]<int Every>() { eliminate<Every, false>(); });

@@ -36,13 +36,14 @@ struct JointTreeIndex {
   std::vector<Quat> turns;                  // JointTree::set_turns
 };
 
-// The check of refactor_stiffened by the tests (test_joint_tree_refactor.cc): where `whole` is
-// set, a stiffened velocity factoring that would start from a position pass's factors forms and
-// eliminates every joint of the same rows instead, as factoring them whole does, and must give
-// the same bits; `partial` counts the partial factorings (whole or not), so the check knows the
-// path ran. Process-wide: set it only where no other world steps.
+// The check of refactor_stiffened by the tests (test_joint_tree_refactor.cc). With `mode` kCount,
+// `partial` counts the partial factorings, so the check knows the path ran; with kWhole too, each
+// of them forms and eliminates every joint of the same rows instead, as factoring them whole
+// does, and must give the same bits. Process-wide: set it only where no other world steps. Off
+// (kOff), the step only reads `mode`, a line no thread writes.
 struct JointTreeRefactorCheck {
-  static inline std::atomic<bool> whole{false};
+  enum Mode : int { kOff, kCount, kWhole };
+  static inline std::atomic<int> mode{kOff};
   static inline std::atomic<std::uint64_t> partial{0};
 };
 
