@@ -168,10 +168,9 @@ class TimedRun {
   Run out_;
 };
 
-// Ours on one scene.
+// Ours on one scene. (Its run's steps call back into it: it stays where it was made.)
 struct OurRun {
-  OurRun(SceneDef scene, int threads, const HeightField& hills)
-      : world(make_world((scene.world.threads = threads, scene)).value()) {
+  OurRun(const SceneDef& scene, const HeightField& hills) : world(make_world(scene).value()) {
     for (std::uint32_t slot = 0; slot < world.slot_count(); ++slot) {
       const BodyId id = world.id_at(slot);
       if (id.is_valid() && !world.body(id).is_static()) ids.push_back(id);
@@ -184,13 +183,16 @@ struct OurRun {
         },
         [this](std::size_t k) { return world.body(ids[k]).linear_velocity().norm(); });
   }
+  OurRun(const OurRun&) = delete;
+  OurRun& operator=(const OurRun&) = delete;
   World world;
   std::vector<BodyId> ids;
   std::unique_ptr<TimedRun> run;
 };
 
 #ifdef TUMBLE_HAVE_PEERS
-// The same scene in Bullet (float), with the same marks (no contact count).
+// The same scene in Bullet (float), with the same marks (no contact count); as OurRun, it stays
+// where it was made.
 struct BulletRun {
   BulletRun(const SceneDef& scene, const HeightField& hills) {
     std::string why_not;
@@ -212,6 +214,8 @@ struct BulletRun {
         },
         [this](std::size_t k) { return sim->body(k).linear_velocity.norm(); });
   }
+  BulletRun(const BulletRun&) = delete;
+  BulletRun& operator=(const BulletRun&) = delete;
   std::unique_ptr<bench::Simulation> sim;
   std::vector<Vec3> half_extents;
   std::unique_ptr<TimedRun> run;
@@ -285,8 +289,10 @@ int main(int argc, char** argv) {
   const bool flat = argument(argc, argv, 4, 0, 0, 1) == 1;
   const bool awake = argument(argc, argv, 5, 0, 0, 1) == 1;
   SceneDef scenes[3] = {pile_scene(boxes), terrain_pile_scene(boxes), terrain_pile_scene(boxes)};
-  for (SceneDef& scene : scenes)
+  for (SceneDef& scene : scenes) {
+    scene.world.threads = threads;
     scene.world.solver.sleeping = scene.world.solver.sleeping && !awake;
+  }
   auto& heights = std::get<HeightFieldDef>(scenes[1].bodies[0].shape);
   if (flat) std::fill(heights.heights.begin(), heights.heights.end(), 0.0);
   const HeightField hills = HeightField::create(heights).value();
@@ -310,7 +316,7 @@ int main(int argc, char** argv) {
     std::vector<std::unique_ptr<OurRun>> ours;
     std::vector<TimedRun*> runs;
     for (int k = 0; k < 3; ++k) {
-      ours.push_back(std::make_unique<OurRun>(scenes[k], threads, hills));
+      ours.push_back(std::make_unique<OurRun>(scenes[k], hills));
       runs.push_back(ours.back()->run.get());
     }
 #ifdef TUMBLE_HAVE_PEERS
