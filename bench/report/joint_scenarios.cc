@@ -2,6 +2,7 @@
 // driven faster, a heavy slider driven into its stop faster, and Newton's cradle with more balls;
 // each until an engine fails.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -254,6 +255,62 @@ std::vector<Scenario> joint_scenarios() {
   return {chain_mass_ratio(), chain_length(), motor_speed(), hinge_stop(), slider_stop(), cradle()};
 }
 
+namespace {
+
+// One engine's run of a cost scene, stepped by turns with the others' (measure_joint_cost).
+struct CostRun {
+  std::unique_ptr<bench::Simulation> sim;
+  CostRow row;
+  double seconds = 0;  // in the timed steps
+  long timed = 0, steps = 0;
+  double gap_sum = 0;
+  bool done = false;
+  std::vector<double> turn_ms;  // each turn's median step
+};
+
+double median_of(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// A turn of `run`: steps `first` to `end` (exclusive); its first step is not timed.
+void take_turn(CostRun& run, long first, long end, const JointGaps& gaps, double time_limit,
+               double dt) {
+  std::vector<double> turn;
+  for (long k = first; k < end && !run.done; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    const bool ok = run.sim->step();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!ok) {
+      run.row.note = "engine stopped: it reported it cannot go on (buffers full or unstable)";
+      run.done = true;
+      break;
+    }
+    ++run.steps;
+    if (k > first) {
+      run.seconds += seconds;
+      ++run.timed;
+      turn.push_back(1e3 * seconds);
+    }
+    // The cost's error beside it (outside the timed steps): an iterative solver's chain is
+    // cheap where it has come apart.
+    const double gap = gaps.largest(*run.sim);
+    run.row.worst_gap = std::max(run.row.worst_gap, gap);
+    run.gap_sum += gap;
+    if (run.seconds > time_limit) {
+      run.row.note = "too slow: over " + std::to_string(static_cast<int>(time_limit)) +
+                     " s of wall time at t = " + std::to_string(static_cast<double>(k + 1) * dt) +
+                     " s";
+      run.done = true;
+    }
+  }
+  if (!turn.empty()) run.turn_ms.push_back(median_of(turn));
+}
+
+}  // namespace
+
 std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
                                         const StabilityOptions& options) {
   std::vector<CostRow> rows;
@@ -268,30 +325,53 @@ std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
     for (SceneJoint& joint : scene.joints)
       joint.def.friction = 0;
     const JointGaps gaps(scene);
-    for (const Engine& engine : engines) {
-      bench::PeerOptions peer_options;
-      peer_options.sleeping = false;
-      // The cost's error beside it (outside the timed steps): an iterative solver's chain is
-      // cheap where it has come apart.
-      double worst = 0, sum = 0;
-      const RunOutcome outcome = run_scene(
-          engine, scene, peer_options,
-          [&](const bench::Simulation& sim, double, bool) {
-            const double gap = gaps.largest(sim);
-            worst = std::max(worst, gap);
-            sum += gap;
-            return true;
-          },
-          options.time_limit);
-      CostRow row{spec, engine.label, outcome.settings, 0, 0, 0, outcome.why_not};
-      if (outcome.steps > 0 && outcome.why_not.empty()) {
-        row.ms_per_step = 1e3 * outcome.step_seconds / static_cast<double>(outcome.steps);
-        row.worst_gap = worst;
-        row.mean_gap = sum / static_cast<double>(outcome.steps);
+    bench::PeerOptions peer_options;
+    peer_options.sleeping = false;
+    std::vector<CostRun> runs(engines.size());
+    std::size_t reference = runs.size();  // Bullet float's, where it runs
+    for (std::size_t e = 0; e < engines.size(); ++e) {
+      CostRun& run = runs[e];
+      run.row = CostRow{spec, engines[e].label, "", 0, 0, 0, ""};
+      std::string why_not;
+      run.sim = engines[e].make(scene, peer_options, &why_not);
+      if (!run.sim) {
+        run.row.note = "not supported: " + why_not;
+        run.done = true;
+        continue;
+      }
+      run.row.settings = run.sim->settings();
+      if (engines[e].label == "Bullet float") reference = e;
+    }
+    // The engines take turns of kTurnSteps steps, so that each meets the shared machine at the
+    // same speeds (run one after the other, the ratios of two engines' times moved by a fifth
+    // between reports); a turn's first step finds the caches full of the others' data and is not
+    // timed (bench_joints does the same).
+    constexpr long kTurnSteps = 20;
+    const long steps = std::lround(scene.duration / scene.dt);
+    for (long first = 0; first < steps; first += kTurnSteps)
+      for (CostRun& run : runs)
+        if (!run.done)
+          take_turn(run, first, std::min(steps, first + kTurnSteps), gaps, options.time_limit,
+                    scene.dt);
+    for (std::size_t e = 0; e < runs.size(); ++e) {
+      CostRun& run = runs[e];
+      CostRow& row = run.row;
+      if (row.note.empty() && run.timed > 0) {
+        row.ms_per_step = 1e3 * run.seconds / static_cast<double>(run.timed);
+        row.mean_gap = run.gap_sum / static_cast<double>(run.steps);
+        if (reference < runs.size() && runs[reference].row.note.empty()) {
+          const std::vector<double>& peer = runs[reference].turn_ms;
+          std::vector<double> ratios;
+          for (std::size_t k = 0; k < std::min(peer.size(), run.turn_ms.size()); ++k)
+            if (peer[k] > 0) ratios.push_back(run.turn_ms[k] / peer[k]);
+          row.ratio_to_reference = median_of(ratios);
+        }
+      } else {
+        row.worst_gap = 0;
       }
       rows.push_back(row);
       if (options.progress)
-        options.progress(std::string("cost ") + spec + ", " + engine.label, rows.size(), total);
+        options.progress(std::string("cost ") + spec + ", " + row.engine, rows.size(), total);
     }
   }
   return rows;

@@ -44,6 +44,9 @@ struct CostRow {
   // m: the largest over the run, and each step's largest averaged over the steps.
   double worst_gap = 0, mean_gap = 0;
   std::string note;
+  // The engines step by turns: the median over the turns of this engine's turn time over Bullet
+  // float's in the same turn (0 where Bullet float did not run).
+  double ratio_to_reference = 0;
 };
 std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
                                         const StabilityOptions& options);
