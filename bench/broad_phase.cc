@@ -7,17 +7,11 @@
 #include <cstdio>
 
 #include "broad_phase.h"
+#include "timing.h"
 
 using namespace tumble;
 
-namespace {
-
-double median_ms(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
+using tumble::bench::median;
 
 int main() {
   std::printf("Broad phase scaling, unit-size boxes at 1 box per 8 m^3 (bench/broad_phase.cc)\n");
@@ -61,7 +55,7 @@ int main() {
                 .count();
         if (run > 0) times.push_back(ms);
       }
-      const double ms = median_ms(times);
+      const double ms = median(times);
       std::printf("| %d | %s | %d | %zu | %.3f | %.0f |\n", n, v.name, v.threads, pairs.size(), ms,
                   ms * 1e6 / n);
     }

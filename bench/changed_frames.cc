@@ -17,6 +17,7 @@
 #include "convert.h"
 #include "frame.h"
 #include "hosted_world.h"
+#include "timing.h"
 #include "tumble/v1/world.pb.h"
 
 namespace tumble::server {
@@ -28,10 +29,7 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values.empty() ? 0 : values[values.size() / 2];
-}
+using tumble::bench::median;
 
 struct Pose {
   double p[3], q[4];

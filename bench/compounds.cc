@@ -16,6 +16,7 @@
 
 #include "peers/simulation.h"
 #include "scenes/standard.h"
+#include "timing.h"
 
 namespace tumble::bench {
 namespace {
@@ -51,12 +52,6 @@ Run run(Simulation* sim, int steps) {
   }
   r.ran = true;
   return r;
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "physics/world.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
+#include "timing.h"
 
 using namespace tumble;
 
@@ -23,10 +24,7 @@ struct Measured {
   StepStats last;
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
+using tumble::bench::median;
 
 Measured measure(World& world, double dt, long steps) {
   std::vector<double> total, narrow, solve;

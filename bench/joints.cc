@@ -12,7 +12,7 @@
 // trees from the world alone). ODE and MuJoCo join in the report's joints section (make report).
 // The engines of a scene take turns of 20 steps, and each line ends with the median over the turns
 // of its step time over Bullet float's in the same turn: a ratio the machine's changing speed
-// moves far less than a ratio of two runs' medians (run_together).
+// moves far less than a ratio of two runs' medians (timing.h, take_turns).
 // Usage: bench_joints [seconds] (default 20).
 #include <algorithm>
 #include <chrono>
@@ -27,6 +27,7 @@
 #include "peers/simulation.h"
 #include "report/joint_gaps.h"
 #include "scenes/standard.h"
+#include "timing.h"
 
 namespace tumble::bench {
 namespace {
@@ -40,80 +41,24 @@ SceneDef heavy_chain(double ratio, SolverKind solver) {
   return scene;
 }
 
-struct Run {
-  double gap = 0, median_ms = 0;
-  double gap_sum = 0;  // of each step's gap, for their mean
-  int steps = 0;
-  bool stopped = false;         // the engine reported that it cannot go on
-  std::vector<double> ms;       // each timed step's time
-  std::vector<double> turn_ms;  // each turn's median (run_together)
-  double median_ratio = 0;      // of its turns' times to the reference's, turn by turn
-};
-
-// One engine of a group, stepped in turn with the others.
+// One engine of a group, stepped in turn with the others (take_turns), and its error.
 struct Entry {
   std::string name;
   std::unique_ptr<Simulation> sim;
-  Run run;
+  double gap = 0;
+  double gap_sum = 0;  // of each step's gap, for their mean
 };
 
-// The engines of a group take turns, kTurnSteps steps each, so that every engine meets the
-// machine at the same speeds: on a shared machine one engine's 5 s and the next's ran up to a
-// quarter apart in speed, which stepping each through its whole run in turn put straight into
-// their ratio. A turn's first step finds the caches full of the other engines' data and is not
-// timed (taking turns a step at a time slowed Bullet's steps by half and ours by less: not the
-// step either engine takes alone). Each engine's time over the reference's (`reference`: an
-// entry's index, the first peer) is taken turn by turn, from the two turns' medians, and its
-// median over the turns kept.
-constexpr int kTurnSteps = 20;
-template <class Measure>
-void run_together(std::vector<Entry>& entries, int steps, Measure measure, std::size_t reference) {
-  for (int first = 0; first < steps; first += kTurnSteps) {
-    for (Entry& entry : entries) {
-      Run& r = entry.run;
-      std::vector<double> turn;
-      for (int k = first; k < std::min(steps, first + kTurnSteps) && !r.stopped; ++k) {
-        const auto start = std::chrono::steady_clock::now();
-        if (!entry.sim->step()) {
-          r.stopped = true;
-          break;
-        }
-        const double ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count();
-        if (k > first) turn.push_back(ms);
-        const double gap = measure(*entry.sim);
-        r.gap = std::max(r.gap, gap);
-        r.gap_sum += gap;
-        ++r.steps;
-      }
-      if (turn.empty()) continue;
-      r.ms.insert(r.ms.end(), turn.begin(), turn.end());
-      r.turn_ms.push_back(median(turn));
-    }
-  }
-  const std::vector<double>* peer =
-      reference < entries.size() ? &entries[reference].run.turn_ms : nullptr;
-  for (Entry& entry : entries) {
-    Run& r = entry.run;
-    r.median_ms = median(r.ms);
-    if (peer == nullptr) continue;
-    std::vector<double> ratios;
-    for (std::size_t k = 0; k < std::min(r.turn_ms.size(), peer->size()); ++k)
-      if ((*peer)[k] > 0) ratios.push_back(r.turn_ms[k] / (*peer)[k]);
-    r.median_ratio = median(ratios);
-  }
-}
-
-// One line of the table: a run's gaps and median step, its median ratio to the reference peer's
-// step, and where the engine stopped early (it reported that it cannot go on), after how many
-// steps: its gap covers those alone.
-void print_run(const char* label, const std::string& name, const Run& r, int steps,
-               const char* reference) {
+// One line of the table: an engine's gaps and median step, its median ratio to the reference
+// peer's step turn by turn (`ratio`), and where the engine stopped early (it reported that it
+// cannot go on), after how many steps: its gap covers those alone.
+void print_run(const char* label, const Entry& entry, const TurnTimes& times, double ratio,
+               long steps, const char* reference) {
   std::printf("  %-8s %-24s gap %11.3e m (mean %9.3e)  median %8.4f ms  %5.2fx %s", label,
-              name.c_str(), r.gap, r.steps > 0 ? r.gap_sum / r.steps : 0.0, r.median_ms,
-              r.median_ratio, reference);
-  if (r.steps < steps) std::printf("  -- stopped after %d of %d steps", r.steps, steps);
+              entry.name.c_str(), entry.gap,
+              times.steps > 0 ? entry.gap_sum / static_cast<double>(times.steps) : 0.0,
+              median(times.step_ms), ratio, reference);
+  if (times.steps < steps) std::printf("  -- stopped after %ld of %ld steps", times.steps, steps);
   std::printf("\n");
 }
 
@@ -133,7 +78,7 @@ constexpr Ours kOurs[] = {{"Tumble auto (direct)", SolverKind::kAuto, 0},
 // Every engine on `scene` (ours in each configuration of kOurs; Bullet float, double and
 // multibody; and Bullet float again with each of `bullet_iterations` sequential-impulse
 // iterations: how far its error falls as it is given our time and more), stepped together
-// (run_together), each step's time beside Bullet float's.
+// (take_turns), each step's time beside Bullet float's.
 template <class Make, class Measure>
 void each_engine(Make make_scene, int steps, Measure measure, const char* label,
                  std::initializer_list<int> bullet_iterations = {}) {
@@ -142,7 +87,7 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label,
   const auto add = [&](const std::string& name, std::unique_ptr<Simulation> sim,
                        const std::string& why) {
     if (sim)
-      entries.push_back({name, std::move(sim), {}});
+      entries.push_back({name, std::move(sim)});
     else
       std::printf("  %-8s %-24s not run: %s\n", label, name.c_str(), why.c_str());
   };
@@ -174,9 +119,20 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label,
   }
   const bool has_reference =
       reference < entries.size() && entries[reference].name == "Bullet float";
-  run_together(entries, steps, measure, has_reference ? reference : entries.size());
-  for (const Entry& entry : entries)
-    print_run(label, entry.name, entry.run, steps, has_reference ? "Bullet float" : "(no peer)");
+  std::vector<TurnTimes> times(entries.size());
+  take_turns(
+      std::span<TurnTimes>(times), steps,
+      [&](std::size_t i, long) { return entries[i].sim->step(); },
+      [&](std::size_t i, long, double) {
+        const double gap = measure(*entries[i].sim);
+        entries[i].gap = std::max(entries[i].gap, gap);
+        entries[i].gap_sum += gap;
+        return true;
+      });
+  for (std::size_t i = 0; i < entries.size(); ++i)
+    print_run(label, entries[i], times[i],
+              has_reference ? median_turn_ratio(times[i], times[reference]) : 0.0, steps,
+              has_reference ? "Bullet float" : "(no peer)");
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include "bullet_triangles.h"
+#include "timing.h"
 #endif
 
 using namespace tumble;
@@ -47,10 +48,7 @@ struct Slide {
   double ms_per_step = 0;
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using tumble::bench::median;
 
 Slide tumble_slide(bool on_mesh, int steps) {
   World world;

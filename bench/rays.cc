@@ -36,6 +36,7 @@
 #include <btBulletCollisionCommon.h>
 
 #include "bullet_triangles.h"
+#include "timing.h"
 #endif
 
 using namespace tumble;
@@ -86,10 +87,7 @@ std::vector<RayCast> make_rays(int count, std::mt19937_64* rng) {
   return rays;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using tumble::bench::median;
 
 template <class Run>
 double rays_per_second(std::size_t rays, Run&& run) {
@@ -97,8 +95,8 @@ double rays_per_second(std::size_t rays, Run&& run) {
   for (int k = 0; k < 5; ++k) {
     const auto start = std::chrono::steady_clock::now();
     run();
-    rates.push_back(rays / std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                               .count());
+    rates.push_back(
+        rays / std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return median(rates);
 }
@@ -221,8 +219,9 @@ int main(int argc, char** argv) {
     worst = std::max(worst, gap);
     disagreements += gap > 1e-9 ? 1 : 0;
   }
-  std::printf("  brute force, %d rays: %d disagreements (closest hit within 1e-9 m), worst %.3g m\n",
-              sample, disagreements, worst);
+  std::printf(
+      "  brute force, %d rays: %d disagreements (closest hit within 1e-9 m), worst %.3g m\n",
+      sample, disagreements, worst);
 
   // Sphere casts: a ball of 0.3 m along the rays (their full length); none over terrain.
   constexpr double kBall = 0.3;
@@ -243,8 +242,7 @@ int main(int argc, char** argv) {
     (void)world.set_settings(settings);
     const double rate =
         rays_per_second(casts.size(), [&] { (void)world.cast_shapes(casts, cast_hits); });
-    std::printf("  Tumble, %d thread%s   %12.0f casts/s\n", threads, threads > 1 ? "s" : " ",
-                rate);
+    std::printf("  Tumble, %d thread%s   %12.0f casts/s\n", threads, threads > 1 ? "s" : " ", rate);
   }
   int cast_hit_count = 0, unconverged = 0;
   for (const ShapeHit& hit : cast_hits) {
@@ -318,8 +316,8 @@ int main(int argc, char** argv) {
     const double length = casts[i].translation.norm();
     worst_gap = std::max(worst_gap, gap);
     worst_early = std::max(worst_early, (reference - hit.fraction) * length);
-    if (gap > kShapeCastTolerance + 1e-12 || gap < -1e-9 ||
-        hit.fraction > reference + 1e-12 || !hit.converged)
+    if (gap > kShapeCastTolerance + 1e-12 || gap < -1e-9 || hit.fraction > reference + 1e-12 ||
+        !hit.converged)
       ++cast_wrong;
   }
   if (!terrain)
@@ -403,11 +401,12 @@ int main(int argc, char** argv) {
       ++tumble_wrong;
   }
   std::sort(gaps.begin(), gaps.end());
-  std::printf("  Bullet's nearest hits beside Tumble's: %d rays hit in one and not the other, %d "
-              "differ by over 1 mm; the distances' differences: median %.2g m, 99th percentile "
-              "%.2g m, largest %.2g m\n",
-              missed, differ, gaps.empty() ? 0.0 : gaps[gaps.size() / 2],
-              gaps.empty() ? 0.0 : gaps[gaps.size() * 99 / 100], gaps.empty() ? 0.0 : gaps.back());
+  std::printf(
+      "  Bullet's nearest hits beside Tumble's: %d rays hit in one and not the other, %d "
+      "differ by over 1 mm; the distances' differences: median %.2g m, 99th percentile "
+      "%.2g m, largest %.2g m\n",
+      missed, differ, gaps.empty() ? 0.0 : gaps[gaps.size() / 2],
+      gaps.empty() ? 0.0 : gaps[gaps.size() * 99 / 100], gaps.empty() ? 0.0 : gaps.back());
   std::printf("  of the first %d rays where they differ, the brute force sides with Bullet on %d\n",
               std::min(differ, 200), tumble_wrong);
   if (terrain) return disagreements == 0 ? 0 : 1;
@@ -443,14 +442,16 @@ int main(int argc, char** argv) {
     }
   }
   std::sort(cast_gaps.begin(), cast_gaps.end());
-  std::printf("  Bullet's sphere casts beside Tumble's: %d hit in one and not the other; the "
-              "distances' differences: median %.2g m, 99th percentile %.2g m, largest %.2g m\n",
-              cast_missed, cast_gaps.empty() ? 0.0 : cast_gaps[cast_gaps.size() / 2],
-              cast_gaps.empty() ? 0.0 : cast_gaps[cast_gaps.size() * 99 / 100],
-              cast_gaps.empty() ? 0.0 : cast_gaps.back());
-  std::printf("  %d casts differ by over 1 mm; of the first %d, the reference sides with Bullet on "
-              "%d\n",
-              cast_differ, std::min(cast_differ, 200), reference_with_bullet);
+  std::printf(
+      "  Bullet's sphere casts beside Tumble's: %d hit in one and not the other; the "
+      "distances' differences: median %.2g m, 99th percentile %.2g m, largest %.2g m\n",
+      cast_missed, cast_gaps.empty() ? 0.0 : cast_gaps[cast_gaps.size() / 2],
+      cast_gaps.empty() ? 0.0 : cast_gaps[cast_gaps.size() * 99 / 100],
+      cast_gaps.empty() ? 0.0 : cast_gaps.back());
+  std::printf(
+      "  %d casts differ by over 1 mm; of the first %d, the reference sides with Bullet on "
+      "%d\n",
+      cast_differ, std::min(cast_differ, 200), reference_with_bullet);
 #else
   std::printf("  (no Bullet: built without the peers)\n");
 #endif

@@ -34,6 +34,7 @@
 #include "physics/world.h"
 #include "scene_runner.h"  // tests/: state_hash
 #include "scenes/standard.h"
+#include "timing.h"
 
 namespace {
 
@@ -62,10 +63,7 @@ int whole_argument(int argc, char** argv, int index, int fallback, int least, in
   return static_cast<int>(value);
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+using tumble::bench::median;
 
 }  // namespace
 

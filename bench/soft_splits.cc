@@ -16,6 +16,7 @@
 
 #include "physics/world.h"
 #include "scenes/standard.h"
+#include "timing.h"
 
 namespace {
 
@@ -63,10 +64,7 @@ double kinetic_energy(const World& world) {
   return sum;
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values.empty() ? 0 : values[values.size() / 2];
-}
+using tumble::bench::median;
 
 struct PileRow {
   double solve_ms = 0, step_ms = 0, last_second_energy = 0;

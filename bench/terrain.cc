@@ -22,7 +22,7 @@
 //   box awake on either ground, where with sleeping the plane's pile falls asleep seconds before
 //   the hills' (the towers toppling on the slopes keep their islands awake).
 #include <algorithm>
-#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -35,6 +35,7 @@
 #include "physics/world.h"
 #include "scenes/scene.h"
 #include "scenes/standard.h"
+#include "timing.h"
 #ifdef TUMBLE_HAVE_PEERS
 #include "peers/simulation.h"
 #endif
@@ -42,6 +43,7 @@
 namespace {
 
 using namespace tumble;
+using bench::median;
 
 int argument(int argc, char** argv, int index, int fallback, int least, int most) {
   if (argc <= index) return fallback;
@@ -119,18 +121,15 @@ class TimedRun {
     field_ = std::holds_alternative<HalfSpaceDef>(ground->shape) ? nullptr : &hills;
     ground_pose_ = Pose{ground->position, ground->orientation};
   }
-  bool stopped() const { return out_.stopped_after >= 0; }
-
-  // Step `index` of the run (0 first); `timed` false leaves its time out.
-  void step(int index, bool timed, int first_steps) {
-    const auto start = std::chrono::steady_clock::now();
-    if (!step_()) {
-      out_.stopped_after = index;
-      return;
-    }
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    if (timed) {
+  // Step `index` of the run (0 first); false where the engine cannot go on.
+  bool step(int index) {
+    if (step_()) return true;
+    out_.stopped_after = index;
+    return false;
+  }
+  // After step `index`, untimed: its time (`ms`; NaN where it is not timed) and the depths.
+  void record(int index, double ms, int first_steps) {
+    if (!std::isnan(ms)) {
       ms_ += ms;
       ++timed_;
       if (index < first_steps) {
@@ -223,27 +222,23 @@ struct BulletRun {
 #endif
 
 // A round: every run of the round's scenes (ours on the plane, the heightfield and the mesh, then
-// Bullet's where `runs` holds them) stepped together, kTurnSteps steps each in turn, so that every
-// one meets the shared machine at the same speeds: run whole one after another, the plane's first
-// 5 s and the hills' ran at speeds up to a half apart (the plane's first 5 s 3.8 to 6.2 ms a step
-// in three rounds), which went straight into their ratio. A turn's first step finds the caches full
-// of the others' data and is not timed (bench_joints does the same).
-constexpr int kTurnSteps = 20;
+// Bullet's where `runs` holds them) stepped together by turns (bench/timing.h): run whole one
+// after another, the plane's first 5 s and the hills' ran at speeds up to a half apart (the
+// plane's first 5 s 3.8 to 6.2 ms a step in three rounds), which went straight into their ratio.
 void run_round(std::span<TimedRun* const> runs, int steps, int first_steps) {
-  for (int first = 0; first < steps; first += kTurnSteps)
-    for (TimedRun* run : runs)
-      for (int k = first; k < std::min(steps, first + kTurnSteps) && !run->stopped(); ++k)
-        run->step(k, k > first, first_steps);
+  std::vector<bench::TurnTimes> times(runs.size());
+  bench::take_turns(
+      std::span<bench::TurnTimes>(times), steps,
+      [&](std::size_t i, long k) { return runs[i]->step(static_cast<int>(k)); },
+      [&](std::size_t i, long k, double ms) {
+        runs[i]->record(static_cast<int>(k), ms, first_steps);
+        return true;
+      });
 }
 
 std::string stop_note(const Run& r) {
   return r.stopped_after < 0 ? ""
                              : "  (stopped after " + std::to_string(r.stopped_after) + " steps)";
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 // The three scenes' medians (plane, heightfield, mesh), whole runs and first 5 s, printed with
@@ -332,7 +327,7 @@ int main(int argc, char** argv) {
       const Run r = ours[k]->run->finish();
       times[k].push_back(r.ms_per_step);
       first[k].push_back(r.first_ms_per_step);
-      std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f  %6zu%s\n", round,
+      std::printf("%5d  %-23s %8.3f  %9.3f  %7d  %6d  %10.4f  %9.4f  %12.4f  %6u%s\n", round,
                   names[k].c_str(), r.ms_per_step, r.first_ms_per_step, r.through, r.dipped,
                   r.deepest, r.settled, r.fastest, ours[k]->world.last_step().contact_points,
                   stop_note(r).c_str());

@@ -37,6 +37,7 @@
 #include "physics/world.h"
 #include "scene_runner.h"  // tests/: state_hash
 #include "scenes/standard.h"
+#include "timing.h"
 
 namespace {
 
@@ -57,10 +58,7 @@ std::array<double, kStages> split(const StageTimes& t) {
   return {t.broad_phase, t.narrow_phase, t.prepare, t.solve, other, t.total};
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values.empty() ? 0 : values[values.size() / 2];
-}
+using tumble::bench::median;
 
 std::vector<int> number_list(const std::string& text, const char* flag) {
   std::vector<int> numbers;

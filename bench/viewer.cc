@@ -9,16 +9,14 @@
 
 #include "offscreen.h"
 #include "renderer.h"
+#include "timing.h"
 
 namespace {
 
 using namespace tumble::viewer;
 using Clock = std::chrono::steady_clock;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using tumble::bench::median;
 
 }  // namespace
 

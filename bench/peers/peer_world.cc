@@ -84,11 +84,6 @@ double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half) 
   return -lowest;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
-
 RunResult run_ours(SceneDef scene, SolverKind kind, long steps, int threads, bool sleeping) {
   scene.world.solver.kind = kind;
   scene.world.solver.sleeping = sleeping;

@@ -9,6 +9,7 @@
 #include "physics/math.h"
 #include "physics/step.h"
 #include "scenes/scene.h"
+#include "timing.h"  // median
 
 namespace tumble::bench {
 
@@ -27,9 +28,6 @@ double corner_depth(const Vec3& centre, const Quat& rotation, const Vec3& half);
 
 // Ours with one solver, `threads` OpenMP threads; `sleeping` as below.
 RunResult run_ours(SceneDef scene, SolverKind kind, long steps, int threads, bool sleeping);
-
-// The median of a list (0 when empty).
-double median(std::vector<double> values);
 
 // `sleeping` false keeps every body awake (Bullet: DISABLE_DEACTIVATION; ours: solver.sleeping).
 RunResult run_bullet(const SceneDef& scene, long steps, bool sleeping = true);

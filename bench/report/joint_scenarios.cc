@@ -2,7 +2,6 @@
 // driven faster, a heavy slider driven into its stop faster, and Newton's cradle with more balls;
 // each until an engine fails.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -11,6 +10,7 @@
 #include "run.h"
 #include "scenario.h"
 #include "scenes/standard.h"
+#include "timing.h"
 
 namespace tumble::report {
 namespace {
@@ -261,53 +261,9 @@ namespace {
 struct CostRun {
   std::unique_ptr<bench::Simulation> sim;
   CostRow row;
-  double seconds = 0;  // in the timed steps
-  long timed = 0, steps = 0;
   double gap_sum = 0;
-  bool done = false;
-  std::vector<double> turn_ms;  // each turn's median step
+  double seconds = 0;  // in the timed steps, for the time limit
 };
-
-double median_of(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
-// A turn of `run`: steps `first` to `end` (exclusive); its first step is not timed.
-void take_turn(CostRun& run, long first, long end, const JointGaps& gaps, double time_limit,
-               double dt) {
-  std::vector<double> turn;
-  for (long k = first; k < end && !run.done; ++k) {
-    const auto start = std::chrono::steady_clock::now();
-    const bool ok = run.sim->step();
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!ok) {
-      run.row.note = "engine stopped: it reported it cannot go on (buffers full or unstable)";
-      run.done = true;
-      break;
-    }
-    ++run.steps;
-    if (k > first) {
-      run.seconds += seconds;
-      ++run.timed;
-      turn.push_back(1e3 * seconds);
-    }
-    // The cost's error beside it (outside the timed steps): an iterative solver's chain is
-    // cheap where it has come apart.
-    const double gap = gaps.largest(*run.sim);
-    run.row.worst_gap = std::max(run.row.worst_gap, gap);
-    run.gap_sum += gap;
-    if (run.seconds > time_limit) {
-      run.row.note = "too slow: over " + std::to_string(static_cast<int>(time_limit)) +
-                     " s of wall time at t = " + std::to_string(static_cast<double>(k + 1) * dt) +
-                     " s";
-      run.done = true;
-    }
-  }
-  if (!turn.empty()) run.turn_ms.push_back(median_of(turn));
-}
 
 }  // namespace
 
@@ -328,6 +284,7 @@ std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
     bench::PeerOptions peer_options;
     peer_options.sleeping = false;
     std::vector<CostRun> runs(engines.size());
+    std::vector<bench::TurnTimes> times(engines.size());
     std::size_t reference = runs.size();  // Bullet float's, where it runs
     for (std::size_t e = 0; e < engines.size(); ++e) {
       CostRun& run = runs[e];
@@ -336,36 +293,47 @@ std::vector<CostRow> measure_joint_cost(const std::vector<Engine>& engines,
       run.sim = engines[e].make(scene, peer_options, &why_not);
       if (!run.sim) {
         run.row.note = "not supported: " + why_not;
-        run.done = true;
+        times[e].stopped = true;
         continue;
       }
       run.row.settings = run.sim->settings();
       if (engines[e].label == "Bullet float") reference = e;
     }
-    // The engines take turns of kTurnSteps steps, so that each meets the shared machine at the
-    // same speeds (run one after the other, the ratios of two engines' times moved by a fifth
-    // between reports); a turn's first step finds the caches full of the others' data and is not
-    // timed (bench_joints does the same).
-    constexpr long kTurnSteps = 20;
+    // The engines take turns (bench/timing.h): run one after the other, the ratios of two
+    // engines' times moved by a fifth between reports.
     const long steps = std::lround(scene.duration / scene.dt);
-    for (long first = 0; first < steps; first += kTurnSteps)
-      for (CostRun& run : runs)
-        if (!run.done)
-          take_turn(run, first, std::min(steps, first + kTurnSteps), gaps, options.time_limit,
-                    scene.dt);
+    bench::take_turns(
+        std::span<bench::TurnTimes>(times), steps,
+        [&](std::size_t e, long) {
+          if (runs[e].sim->step()) return true;
+          runs[e].row.note =
+              "engine stopped: it reported it cannot go on (buffers full or unstable)";
+          return false;
+        },
+        [&](std::size_t e, long k, double ms) {
+          // The cost's error beside it (outside the timed steps): an iterative solver's chain is
+          // cheap where it has come apart.
+          CostRun& run = runs[e];
+          const double gap = gaps.largest(*run.sim);
+          run.row.worst_gap = std::max(run.row.worst_gap, gap);
+          run.gap_sum += gap;
+          if (!std::isnan(ms)) run.seconds += 1e-3 * ms;
+          if (run.seconds <= options.time_limit) return true;
+          run.row.note =
+              "too slow: over " + std::to_string(static_cast<int>(options.time_limit)) +
+              " s of wall time at t = " + std::to_string(static_cast<double>(k + 1) * scene.dt) +
+              " s";
+          return false;
+        });
     for (std::size_t e = 0; e < runs.size(); ++e) {
       CostRun& run = runs[e];
       CostRow& row = run.row;
-      if (row.note.empty() && run.timed > 0) {
-        row.ms_per_step = 1e3 * run.seconds / static_cast<double>(run.timed);
-        row.mean_gap = run.gap_sum / static_cast<double>(run.steps);
-        if (reference < runs.size() && runs[reference].row.note.empty()) {
-          const std::vector<double>& peer = runs[reference].turn_ms;
-          std::vector<double> ratios;
-          for (std::size_t k = 0; k < std::min(peer.size(), run.turn_ms.size()); ++k)
-            if (peer[k] > 0) ratios.push_back(run.turn_ms[k] / peer[k]);
-          row.ratio_to_reference = median_of(ratios);
-        }
+      const bench::TurnTimes& time = times[e];
+      if (row.note.empty() && !time.step_ms.empty()) {
+        row.ms_per_step = 1e3 * run.seconds / static_cast<double>(time.step_ms.size());
+        row.mean_gap = run.gap_sum / static_cast<double>(time.steps);
+        if (reference < runs.size() && runs[reference].row.note.empty())
+          row.ratio_to_reference = bench::median_turn_ratio(time, times[reference]);
       } else {
         row.worst_gap = 0;
       }
