@@ -1,6 +1,6 @@
 // What the heightfield and mesh tests share: a grid of heights from a function, bodies added in
-// one line, stepping, the height a body comes to rest at, and the nearest front a ray meets by
-// brute force over every triangle.
+// one line, stepping, the height a body comes to rest at, where a sliding box stops, and the
+// nearest front a ray meets by brute force over every triangle.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -58,6 +58,23 @@ inline double rest_height(const ShapeDef& ground, const ShapeDef& body, const Ve
   const BodyId id = add_dynamic(&world, body, at);
   run(&world, 120);
   return world.body(id)->position().z();
+}
+
+// Where a box sliding across `ground` stops: 0.5 m, friction 0.5, sent at 5 m/s from (-12, -3.1)
+// at an angle to the grid (over many inner edges and both diagonals' directions), after 3 s.
+inline constexpr double kSlideStartX = -12, kSlideStartY = -3.1;
+inline Vec3 slide_stop(const ShapeDef& ground) {
+  World world;
+  add_static(&world, ground);
+  BodyDef box;
+  box.shape = BoxDef{Vec3(0.25, 0.25, 0.25)};
+  box.mass = 1;
+  box.friction = 0.5;
+  box.position = Vec3(kSlideStartX, kSlideStartY, 0.25);
+  box.linear_velocity = Vec3(4.5, 2.18, 0);  // 5 m/s
+  const BodyId id = world.create_body(box).value();
+  run(&world, 180);
+  return world.body(id)->position();
 }
 
 // Every one of `count` triangles (`triangle(t)`), the nearest front within max_t; past max_t if
