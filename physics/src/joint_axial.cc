@@ -78,15 +78,6 @@ bool has_drives(const Joint& joint) {
 
 }  // namespace
 
-bool has_cone(const Joint& joint) {
-  return joint.kind == JointKind::kBall && joint.max_swing < kPi;
-}
-
-bool has_axial_rows(const Joint& joint) {
-  return joint.spring.enabled || joint.motor.enabled || joint.limit.enabled || has_cone(joint) ||
-         joint.friction > 0;
-}
-
 double impulse_along(const Joint& joint) {
   if (rigid_distance(joint)) return joint.axial_impulse;
   return joint.limit_impulse + joint.motor_impulse + joint.spring_impulse +

@@ -7,15 +7,23 @@
 // as the joints' own (joint_solver.h).
 #pragma once
 
+#include <numbers>
+
 #include "joint_geometry.h"
 #include "joint_terms.h"
 
 namespace tumble {
 
-// Whether the joint has any of these rows (a spring, motor, limit or cone).
-bool has_axial_rows(const Joint& joint);
 // Whether it is a ball with a swing cone.
-bool has_cone(const Joint& joint);
+inline bool has_cone(const Joint& joint) {
+  return joint.kind == JointKind::kBall && joint.max_swing < std::numbers::pi;
+}
+// Whether the joint has any of these rows (a spring, motor, limit or cone). (Inline: every sweep
+// asks it of every joint.)
+inline bool has_axial_rows(const Joint& joint) {
+  return joint.spring.enabled || joint.motor.enabled || joint.limit.enabled || has_cone(joint) ||
+         joint.friction > 0;
+}
 
 // The impulse the rows above gave along the free coordinate (limit, motor, spring, a hinge's or
 // slider's friction); a rigid rod's, along it.
