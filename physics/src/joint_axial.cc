@@ -105,8 +105,7 @@ void prepare_axial_terms(const Joint& joint, const SolverBody& a, const SolverBo
     if (a.inverse_mass > 0) terms->mobility += a.inverse_inertia;
     if (b.inverse_mass > 0) terms->mobility += b.inverse_inertia;
     terms->mobility_solver.compute(terms->mobility);
-    terms->mobility_usable =
-        terms->mobility_solver.info() == Eigen::Success && terms->mobility.trace() > 0;
+    terms->mobility_usable = terms->mobility_solver.succeeded() && terms->mobility.trace() > 0;
   }
 }
 
@@ -251,8 +250,7 @@ void correct_axial(const Joint& joint, SolverBody* a, SolverBody* b, Pose* pose_
     const double mass = swing.exists && over > 0 ? row_mass(swing.row, *a, body_b) : 0;
     if (mass > 0) displace_row(swing.row, -over / mass, a, b, pose_a, pose_b);
   }
-  if (!joint.limit.enabled ||
-      clearly_within_limit(joint, pose_a->orientation, pb->orientation, 0))
+  if (!joint.limit.enabled || clearly_within_limit(joint, pose_a->orientation, pb->orientation, 0))
     return;
   const FreeCoordinate c = free_coordinate(joint, *pose_a, *pb, world_b);
   if (!c.exists) return;

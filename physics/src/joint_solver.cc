@@ -321,19 +321,19 @@ void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
         hinge_rows(joint, m.pose_a->orientation, world_b ? nullptr : &m.pose_b->orientation,
                    m.a->inverse_inertia + b.inverse_inertia);
     if (rows.k.determinant() > 0) {
-      const Eigen::Vector2d lambda = -rows.k.ldlt().solve(rows.error());
+      const Eigen::Vector2d lambda = -solve_block<2>(rows.k, rows.error());
       displace_angular(m, lambda.x() * rows.g1 + lambda.y() * rows.g2);
     }
   } else if (joint.kind == JointKind::kFixed || joint.kind == JointKind::kSlider) {
     const Mat3 k = m.a->inverse_inertia + b.inverse_inertia;
     const Quat qb = world_b ? Quat::Identity() : m.pose_b->orientation;
     const Vec3 error = rotation_error(joint, m.pose_a->orientation, qb);
-    if (k.determinant() > 0) displace_angular(m, -k.ldlt().solve(error));
+    if (k.determinant() > 0) displace_angular(m, -solve_block<3>(k, error));
   }
   if (joint.kind == JointKind::kSlider) {
     const SliderRows s = slider_rows(joint, *m.pose_a, m.world_pose_b(), world_b, *m.a, b);
     if (!(s.k.determinant() > 0)) return;
-    const Eigen::Vector2d lambda = -s.k.ldlt().solve(s.error);
+    const Eigen::Vector2d lambda = -solve_block<2>(s.k, s.error);
     for (int i = 0; i < 2; ++i)
       displace_row(s.rows[i], lambda[i], m.a, m.b, m.pose_a, m.pose_b);
     return;
@@ -350,7 +350,7 @@ void correct_joint_position(const JointRow& row, std::span<SolverBody> bodies,
     if (k > 0) displace_linear(m, anchors.ra, anchors.rb, -(length - joint.length) / k * n);
     return;
   }
-  displace_linear(m, anchors.ra, anchors.rb, -point_block(*m.a, b, anchors).ldlt().solve(d));
+  displace_linear(m, anchors.ra, anchors.rb, -solve_block<3>(point_block(*m.a, b, anchors), d));
 }
 
 JointReading read_joint(const Joint& joint, const Pose& pose_a, const Pose& pose_b,

@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <span>
 
+#include "block_solve.h"
 #include "joint_geometry.h"
 
 namespace tumble {
@@ -48,23 +49,23 @@ struct JointPoseTerms {
   double cone_mass = 0;
   // A ball's friction: what resists the relative turn (the moving bodies' inverse inertias).
   Mat3 mobility = Mat3::Zero();
-  Eigen::LDLT<Mat3> mobility_solver;
+  BlockSolve3 mobility_solver;
   bool mobility_usable = false;
   // The joint's own rows, where the sweeps solve them (not the direct solve, joint_tree.h):
-  // the point's block (ball, hinge, fixed), factored;
+  // the point's block (ball, hinge, fixed), inverted (block_solve.h);
   Mat3 point = Mat3::Zero();
-  Eigen::LDLT<Mat3> point_solver;
+  BlockSolve3 point_solver;
   // a hinge's axes;
   HingeRows hinge;
-  Eigen::LDLT<Eigen::Matrix2d> hinge_solver;
+  BlockSolve2 hinge_solver;
   bool hinge_usable = false;
   // a fixed joint's or slider's rotation;
   Mat3 rotation = Mat3::Zero();
-  Eigen::LDLT<Mat3> rotation_solver;
+  BlockSolve3 rotation_solver;
   bool rotation_usable = false;
   // a slider's rows across its axis.
   SliderRows slider;
-  Eigen::LDLT<Eigen::Matrix2d> slider_solver;
+  BlockSolve2 slider_solver;
   bool slider_usable = false;
 };
 
