@@ -1,7 +1,8 @@
 // The Gauss-Seidel joints' small block solves (physics/src/block_solve.h): the inverse where the
 // block is positive definite agrees with a pivoted LDLT to rounding over the blocks the joints
 // make, and every other block (bodies that cannot move, a rank lost, a value not finite) gets
-// LDLT's answer, bit for bit.
+// LDLT's answer, bit for bit; and the point block's lever terms, worked out entry by entry, are
+// the dense product's to rounding.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -83,6 +84,33 @@ TEST(BlockSolve, BlocksWithoutAnInverseTakeLdltsAnswer) {
         EXPECT_EQ(ours[i], theirs[i]);
     }
   }
+}
+
+TEST(BlockSolve, LeverInertiaIsTheDenseProductAndSymmetricToTheBit) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> exponent(-3, 3), unit(-1, 1);
+  double worst = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Eigen::Quaterniond turn =
+        Eigen::Quaterniond(unit(random), unit(random), unit(random), unit(random)).normalized();
+    const Vec3 moments(std::pow(10.0, exponent(random)), std::pow(10.0, exponent(random)),
+                       std::pow(10.0, exponent(random)));
+    const Mat3 inverse_inertia =
+        turn.toRotationMatrix() * moments.asDiagonal() * turn.toRotationMatrix().transpose();
+    const Vec3 lever =
+        Vec3(unit(random), unit(random), unit(random)) * std::pow(10.0, exponent(random) / 3 - 1);
+    Mat3 cross;
+    cross << 0, -lever.z(), lever.y(), lever.z(), 0, -lever.x(), -lever.y(), lever.x(), 0;
+    const Mat3 dense = cross * inverse_inertia * cross.transpose();
+    Mat3 ours = Mat3::Zero();
+    add_lever_inertia(inverse_inertia, lever, &ours);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) EXPECT_EQ(ours(i, j), ours(j, i));
+    // Both sum products of the same terms in other orders: they differ by rounding at the scale
+    // of the largest term, |A| |r|^2.
+    worst = std::max(worst, (ours - dense).norm() / (inverse_inertia.norm() * lever.squaredNorm()));
+  }
+  EXPECT_LT(worst, 1e-14);
 }
 
 TEST(BlockSolve, TwoByTwoBlocksToo) {

@@ -19,12 +19,6 @@ namespace tumble::joint_detail {
 // The world as body b: no mass, no motion, and its own frame.
 inline const SolverBody kWorldBody{};
 
-inline Mat3 skew(const Vec3& v) {
-  Mat3 m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
 // Any unit vector perpendicular to the unit vector n.
 inline Vec3 perpendicular(const Vec3& n) {
   const Vec3 axis = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();

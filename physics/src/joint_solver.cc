@@ -41,9 +41,10 @@ double drift_velocity(double drift, double h, double most) {
 
 // The point constraint of ball, hinge and fixed joints: three rows solved together; their block.
 Mat3 point_block(const SolverBody& a, const SolverBody& b, const Anchors& anchors) {
-  const Mat3 ra_skew = skew(anchors.ra), rb_skew = skew(anchors.rb);
-  return (a.inverse_mass + b.inverse_mass) * Mat3::Identity() -
-         ra_skew * a.inverse_inertia * ra_skew - rb_skew * b.inverse_inertia * rb_skew;
+  Mat3 block = (a.inverse_mass + b.inverse_mass) * Mat3::Identity();
+  add_lever_inertia(a.inverse_inertia, anchors.ra, &block);
+  add_lever_inertia(b.inverse_inertia, anchors.rb, &block);
+  return block;
 }
 
 double solve_point(JointRow& row, JointBodies& j, const JointPoseTerms& terms,
