@@ -7,9 +7,10 @@
 // anchors (report::JointGaps) over the run and its mean over the steps, beside the step time, and
 // Bullet again with 20, 50 and 100 iterations: what its error does with our time and more. Ours
 // with the direct solve of joint trees (auto, with the default four substeps and with one) and with
-// Gauss-Seidel joints (soft, pgs); Bullet 3.24 float and double (its constraint of each joint's
-// kind, 10 sequential-impulse iterations) and Bullet's btMultiBody (float, generalised coordinates;
-// trees from the world alone). ODE and MuJoCo join in the report's joints section (make report).
+// Gauss-Seidel joints (soft; pgs, and pgs with two joint position passes where the default is
+// three); Bullet 3.24 float and double (its constraint of each joint's kind, 10 sequential-impulse
+// iterations) and Bullet's btMultiBody (float, generalised coordinates; trees from the world
+// alone). ODE and MuJoCo join in the report's joints section (make report).
 // The engines of a scene take turns of 20 steps, and each line ends with the median over the turns
 // of its step time over Bullet float's in the same turn: a ratio the machine's changing speed
 // moves far less than a ratio of two runs' medians (timing.h, take_turns).
@@ -62,18 +63,23 @@ void print_run(const char* label, const Entry& entry, const TurnTimes& times, do
   std::printf("\n");
 }
 
-// Ours as configured: the solver, and the substeps (0: the settings' default).
+// Ours as configured: the solver, the substeps and the joint position passes (0 and -1: the
+// settings' defaults).
 struct Ours {
   const char* label;
   SolverKind solver;
   int substeps;
+  int joint_passes = -1;
 };
 // auto with one substep takes one step of dt, as the peers do: a pendulum's period error at dt
 // 1/60 is then theirs (docs/PERFORMANCE.md), where the default four substeps cut it sixteenfold.
+// pgs with two joint passes after its move where the default is three: what the third costs and
+// holds (SolverSettings::joint_position_passes).
 constexpr Ours kOurs[] = {{"Tumble auto (direct)", SolverKind::kAuto, 0},
                           {"Tumble auto, 1 substep", SolverKind::kAuto, 1},
                           {"Tumble soft (GS)", SolverKind::kSoft, 0},
-                          {"Tumble pgs (GS)", SolverKind::kPgs, 0}};
+                          {"Tumble pgs (GS)", SolverKind::kPgs, 0},
+                          {"Tumble pgs, 2 passes", SolverKind::kPgs, 0, 2}};
 
 // Every engine on `scene` (ours in each configuration of kOurs; Bullet float, double and
 // multibody; and Bullet float again with each of `bullet_iterations` sequential-impulse
@@ -94,6 +100,7 @@ void each_engine(Make make_scene, int steps, Measure measure, const char* label,
   for (const Ours& ours : kOurs) {
     SceneDef scene = make_scene(ours.solver);
     if (ours.substeps > 0) scene.world.solver.substeps = ours.substeps;
+    if (ours.joint_passes >= 0) scene.world.solver.joint_position_passes = ours.joint_passes;
     std::string why;
     auto sim = make_tumble(scene, &why);
     add(ours.label, std::move(sim), why);

@@ -11,8 +11,9 @@
 //   ROUNDS   rounds (default 5)
 //   THREADS  step threads (default 1)
 // TUMBLE_SOLVER=exact|pgs|soft|auto in the environment replaces the scene's solver, and
-// TUMBLE_SUBSTEPS=N (1 to 32) its substeps, and TUMBLE_JOINT_FRICTION=F (N m, 0 or more) every
-// joint's friction (bench_joints times the ragdolls with 0: no peer maps it).
+// TUMBLE_SUBSTEPS=N (1 to 32) its substeps, TUMBLE_JOINT_PASSES=N (0 to 32) its joint position
+// passes, and TUMBLE_JOINT_FRICTION=F (N m, 0 or more) every joint's friction (bench_joints times
+// the ragdolls with 0: no peer maps it).
 // Sleeping is off, so the whole scene is awake. Each round restores the state, takes two untimed
 // steps (the restored world's buffers warm up) and times STEPS more. Prints the mean time per step
 // of each stage per round, then each stage's minimum and median over the rounds, and the state's
@@ -98,6 +99,14 @@ int main(int argc, char** argv) {
       return 2;
     }
     scene.value().world.solver.substeps = count;
+  }
+  if (const char* passes = std::getenv("TUMBLE_JOINT_PASSES")) {
+    const int count = std::atoi(passes);
+    if (count < 0 || count > 32 || (count == 0 && std::string(passes) != "0")) {
+      std::fprintf(stderr, "bench_replay: TUMBLE_JOINT_PASSES=%s is not 0 to 32\n", passes);
+      return 2;
+    }
+    scene.value().world.solver.joint_position_passes = count;
   }
   if (const char* friction = std::getenv("TUMBLE_JOINT_FRICTION")) {
     char* end = nullptr;

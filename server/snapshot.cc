@@ -58,6 +58,7 @@ void put_settings(const WorldSettings& s, pb::WorldSettings* out) {
   o->set_speculative_distance(v.speculative_distance);
   o->set_restitution_threshold(v.restitution_threshold);
   o->set_manifold_reuse(v.manifold_reuse);
+  o->set_joint_position_passes(v.joint_position_passes);
   o->set_continuous(v.continuous);
   o->set_continuous_fraction(v.continuous_fraction);
   o->set_continuous_iterations(v.continuous_iterations);
@@ -128,6 +129,7 @@ Result<WorldSettings> take_settings(const pb::WorldSettings& in) {
   v.speculative_distance = o.speculative_distance();
   v.restitution_threshold = o.restitution_threshold();
   if (o.has_manifold_reuse()) v.manifold_reuse = o.manifold_reuse();
+  if (o.has_joint_position_passes()) v.joint_position_passes = o.joint_position_passes();
   take_limits(in.limits(), &s.limits);
   v.continuous = o.continuous();
   v.continuous_fraction = o.continuous_fraction();

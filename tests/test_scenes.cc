@@ -25,6 +25,7 @@ TEST(SceneJson, ReadsEveryField) {
   const Result<SceneDef> scene = parse_scene(R"({
     "name": "test", "dt": 0.01, "duration": 2, "gravity": [0, 0, -1.5], "threads": 1,
     "solver": "pgs", "iterations": 7, "substeps": 3, "friction_directions": 12, "slop": 0.001,
+    "joint_position_passes": 2,
     "bodies": [
       {"shape": "plane"},
       {"shape": "box", "size": [1, 2, 3], "mass": 4, "position": [1, 2, 3],
@@ -43,6 +44,7 @@ TEST(SceneJson, ReadsEveryField) {
   EXPECT_EQ(s.world.solver.iterations, 7);
   EXPECT_EQ(s.world.solver.substeps, 3);
   EXPECT_EQ(s.world.solver.friction_directions, 12);
+  EXPECT_EQ(s.world.solver.joint_position_passes, 2);
   ASSERT_EQ(s.bodies.size(), 5u);
   EXPECT_EQ(s.bodies[0].type, BodyType::kStatic);  // planes are static by default
   const BodyDef& box = s.bodies[1];
@@ -80,6 +82,8 @@ TEST(SceneJson, NamesTheBadField) {
             "solver: unknown solver 'magic' (exact, pgs, soft or auto)");
   EXPECT_EQ(error_of(R"({"dt": 0})"), "dt: must be > 0");
   EXPECT_EQ(error_of(R"({"substeps": 0})"), "substeps: must be in [1, 1000]");
+  EXPECT_EQ(error_of(R"({"joint_position_passes": -1})"),
+            "joint_position_passes: must be in [0, 1000]");
   EXPECT_EQ(error_of(R"({"gravity": [0, 0, "down"]})"), "gravity[2]: must be a number");
   EXPECT_EQ(error_of(R"({"bodies": [{"shape": "plane", "static": false}]})"),
             "bodies[0].type: a half_space must be static");

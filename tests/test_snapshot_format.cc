@@ -60,6 +60,21 @@ TEST(SnapshotFormat, WrapsTheEnginesBytesAndRoundTrips) {
   EXPECT_EQ(testing::state_hash(resumed), testing::state_hash(expected));
 }
 
+TEST(SnapshotFormat, TheJointPassesRoundTripAndASnapshotWithoutThemTakesTheDefault) {
+  server::SavedWorld saved = landed_pile();
+  saved.settings.solver.joint_position_passes = 1;
+  const Result<server::SavedWorld> read = server::decode_snapshot(server::encode_snapshot(saved));
+  ASSERT_TRUE(read) << read.error();
+  EXPECT_EQ(read.value().settings.solver.joint_position_passes, 1);
+  // Written before the field existed: absent, not 0 (which would turn the passes off).
+  v1::snapshot::WorldSnapshot older = parsed(server::encode_snapshot(saved));
+  older.mutable_settings()->mutable_solver()->clear_joint_position_passes();
+  const Result<server::SavedWorld> old_read = server::decode_snapshot(older.SerializeAsString());
+  ASSERT_TRUE(old_read) << old_read.error();
+  EXPECT_EQ(old_read.value().settings.solver.joint_position_passes,
+            SolverSettings{}.joint_position_passes);
+}
+
 TEST(SnapshotFormat, OtherVersionsAreRefusedNamingBoth) {
   v1::snapshot::WorldSnapshot old = parsed(server::encode_snapshot(landed_pile()));
   old.set_version(v1::snapshot::VERSION_1);

@@ -218,6 +218,11 @@ TEST(WorldState, BadStatesAreRefusedNamingTheField) {
   Result<World> world = world_of(bad_settings, good);
   ASSERT_FALSE(world);
   EXPECT_NE(world.error().find("settings.solver.iterations"), std::string::npos);
+  bad_settings = original.settings();
+  bad_settings.solver.joint_position_passes = 1001;
+  world = world_of(bad_settings, good);
+  ASSERT_FALSE(world);
+  EXPECT_NE(world.error().find("settings.solver.joint_position_passes"), std::string::npos);
 }
 
 TEST(WorldState, ShapeStateRoundTripsAndBadPolyhedraAreRefused) {

@@ -32,6 +32,8 @@ class TumbleSimulation final : public Simulation {
         settings_ = "Lemke, " + std::to_string(s.friction_directions) + "-sided friction pyramid";
         break;
     }
+    if (s.joint_position_passes != SolverSettings{}.joint_position_passes)
+      settings_ += "; " + std::to_string(s.joint_position_passes) + " joint position passes";
     const int threads = scene.world.threads;
     settings_ += "; " + (threads > 0 ? std::to_string(threads) : std::string("all")) + " thread" +
                  (threads == 1 ? "" : "s") + "; sleeping " + (s.sleeping ? "on" : "off");

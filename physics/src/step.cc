@@ -163,7 +163,8 @@ void team_integrate_positions(const IslandContext& c, double h, bool solo) {
   c.scratch.barrier.wait();
 }
 
-// Nonlinear Gauss-Seidel passes over an island's joints after each move. Each pass takes a
+// Nonlinear Gauss-Seidel passes over an island's joints after each move (joint by joint, the
+// settings' joint_position_passes; a tree's, these constants). Each pass takes a
 // joint's error to second order in its size (a substep's drift is ~1e-5 m); a chain passes
 // corrections along one link a pass, which the next moves' passes carry on. Solved directly
 // (joint_tree.h), the first two passes are Newton steps and the last reuses the second's rows (on
@@ -371,8 +372,10 @@ class SerialIsland {
     }
     for (std::uint32_t component = mine_.first; component < mine_.second; ++component) {
       double corrected = std::numeric_limits<double>::infinity();
-      // (Where contacts act through the trees, one chord pass more: kLaterBoundSlack.)
-      const int passes = kJointPositionPasses + (contacts_through_tree_ ? 1 : 0);
+      // (Where contacts act through the trees, one chord pass more: kLaterBoundSlack.) Joint by
+      // joint, the settings' count.
+      const int passes = trees_.empty() ? c_.settings.solver.joint_position_passes
+                                        : kJointPositionPasses + (contacts_through_tree_ ? 1 : 0);
       for (int pass = 0; pass < passes; ++pass) {
         if (!trees_.empty()) {
           // A pass after the refactored ones corrects what the last left, about the square of

@@ -111,6 +111,8 @@ Status validate(const WorldSettings& s) {
     return Status::error("solver.substeps: must be in [1, 1000]");
   if (v.position_iterations < 0 || v.position_iterations > 1000)
     return Status::error("solver.position_iterations: must be in [0, 1000]");
+  if (v.joint_position_passes < 0 || v.joint_position_passes > 1000)
+    return Status::error("solver.joint_position_passes: must be in [0, 1000]");
   if (v.exact_max_points < 0) return Status::error("solver.exact_max_points: must be >= 0");
   if (v.friction_directions < 4 || v.friction_directions > 32)
     return Status::error("solver.friction_directions: must be in [4, 32]");

@@ -472,6 +472,8 @@ SceneDef read_scene(const Json& json) {
   solver.substeps = r.integer("substeps", solver.substeps, 1, 1000);
   solver.position_iterations =
       r.integer("position_iterations", solver.position_iterations, 0, 1000);
+  solver.joint_position_passes =
+      r.integer("joint_position_passes", solver.joint_position_passes, 0, 1000);
   solver.exact_max_points = r.integer("exact_max_points", solver.exact_max_points, 0, 100000);
   solver.friction_directions = r.integer("friction_directions", solver.friction_directions, 4, 32);
   solver.exact_max_island_points =
@@ -714,6 +716,7 @@ std::string scene_to_json(const SceneDef& scene) {
               {"relax_iterations", s.relax_iterations},
               {"substeps", s.substeps},
               {"position_iterations", s.position_iterations},
+              {"joint_position_passes", s.joint_position_passes},
               {"exact_max_points", s.exact_max_points},
               {"friction_directions", s.friction_directions},
               {"exact_max_island_points", s.exact_max_island_points},

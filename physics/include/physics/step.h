@@ -31,6 +31,11 @@ struct SolverSettings {
   // Position iterations after the velocity solve (pgs, and exact islands that fell back to it):
   // nonlinear Gauss-Seidel that moves bodies out of penetration without adding velocity.
   int position_iterations = 3;
+  // Nonlinear Gauss-Seidel passes over the joints after each move, where joints are solved joint
+  // by joint (soft and pgs; joint loops under auto; trees under auto take Newton passes instead).
+  // Each pass closes part of what the velocity sweeps left open; 0 leaves the joints to the
+  // sweeps' drift correction alone. Fewer passes cost less and hold less (docs/PERFORMANCE.md).
+  int joint_position_passes = 3;
   // auto: an island with at most this many contact points may go to the exact solver.
   int exact_max_points = 12;
   // Directions of the friction pyramid in the exact solver (its facets); 4 to 32. The first one
