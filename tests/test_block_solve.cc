@@ -19,24 +19,41 @@ namespace {
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
-// A point's block as a joint makes it: (1/m_a + 1/m_b) 1 + [r_a]x W_a [r_a]x^T + ... for bodies
-// of masses and inertias over six orders of magnitude and levers from a millimetre to 10 m.
-Mat3 point_block(std::mt19937_64& random) {
-  std::uniform_real_distribution<double> exponent(-3, 3), unit(-1, 1);
-  Mat3 block = Mat3::Zero();
-  for (int side = 0; side < 2; ++side) {
-    const double inverse_mass = std::pow(10.0, exponent(random));
-    const Eigen::Quaterniond turn =
-        Eigen::Quaterniond(unit(random), unit(random), unit(random), unit(random)).normalized();
-    const Vec3 moments(std::pow(10.0, exponent(random)), std::pow(10.0, exponent(random)),
-                       std::pow(10.0, exponent(random)));
-    const Mat3 inverse_inertia =
-        turn.toRotationMatrix() * moments.asDiagonal() * turn.toRotationMatrix().transpose();
-    const Vec3 lever =
-        Vec3(unit(random), unit(random), unit(random)) * std::pow(10.0, exponent(random) / 3 - 1);
+// One body's side of a joint: masses and inertias over six orders of magnitude, levers from a
+// millimetre to 10 m.
+struct JointSide {
+  double inverse_mass;
+  Mat3 inverse_inertia;
+  Vec3 lever;
+  // [r]x W [r]x^T, as two dense products.
+  Mat3 dense_lever_term() const {
     Mat3 cross;
     cross << 0, -lever.z(), lever.y(), lever.z(), 0, -lever.x(), -lever.y(), lever.x(), 0;
-    block += inverse_mass * Mat3::Identity() + cross * inverse_inertia * cross.transpose();
+    return cross * inverse_inertia * cross.transpose();
+  }
+};
+
+JointSide random_side(std::mt19937_64& random) {
+  std::uniform_real_distribution<double> exponent(-3, 3), unit(-1, 1);
+  JointSide side;
+  side.inverse_mass = std::pow(10.0, exponent(random));
+  const Eigen::Quaterniond turn =
+      Eigen::Quaterniond(unit(random), unit(random), unit(random), unit(random)).normalized();
+  const Vec3 moments(std::pow(10.0, exponent(random)), std::pow(10.0, exponent(random)),
+                     std::pow(10.0, exponent(random)));
+  side.inverse_inertia =
+      turn.toRotationMatrix() * moments.asDiagonal() * turn.toRotationMatrix().transpose();
+  side.lever =
+      Vec3(unit(random), unit(random), unit(random)) * std::pow(10.0, exponent(random) / 3 - 1);
+  return side;
+}
+
+// A point's block as a joint makes it: (1/m_a + 1/m_b) 1 + [r_a]x W_a [r_a]x^T + ...
+Mat3 point_block(std::mt19937_64& random) {
+  Mat3 block = Mat3::Zero();
+  for (int k = 0; k < 2; ++k) {
+    const JointSide side = random_side(random);
+    block += side.inverse_mass * Mat3::Identity() + side.dense_lever_term();
   }
   return block;
 }
@@ -88,27 +105,17 @@ TEST(BlockSolve, BlocksWithoutAnInverseTakeLdltsAnswer) {
 
 TEST(BlockSolve, LeverInertiaIsTheDenseProductAndSymmetricToTheBit) {
   std::mt19937_64 random(11);
-  std::uniform_real_distribution<double> exponent(-3, 3), unit(-1, 1);
   double worst = 0;
   for (int trial = 0; trial < 20000; ++trial) {
-    const Eigen::Quaterniond turn =
-        Eigen::Quaterniond(unit(random), unit(random), unit(random), unit(random)).normalized();
-    const Vec3 moments(std::pow(10.0, exponent(random)), std::pow(10.0, exponent(random)),
-                       std::pow(10.0, exponent(random)));
-    const Mat3 inverse_inertia =
-        turn.toRotationMatrix() * moments.asDiagonal() * turn.toRotationMatrix().transpose();
-    const Vec3 lever =
-        Vec3(unit(random), unit(random), unit(random)) * std::pow(10.0, exponent(random) / 3 - 1);
-    Mat3 cross;
-    cross << 0, -lever.z(), lever.y(), lever.z(), 0, -lever.x(), -lever.y(), lever.x(), 0;
-    const Mat3 dense = cross * inverse_inertia * cross.transpose();
+    const JointSide side = random_side(random);
     Mat3 ours = Mat3::Zero();
-    add_lever_inertia(inverse_inertia, lever, &ours);
+    add_lever_inertia(side.inverse_inertia, side.lever, &ours);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) EXPECT_EQ(ours(i, j), ours(j, i));
     // Both sum products of the same terms in other orders: they differ by rounding at the scale
     // of the largest term, |A| |r|^2.
-    worst = std::max(worst, (ours - dense).norm() / (inverse_inertia.norm() * lever.squaredNorm()));
+    worst = std::max(worst, (ours - side.dense_lever_term()).norm() /
+                                (side.inverse_inertia.norm() * side.lever.squaredNorm()));
   }
   EXPECT_LT(worst, 1e-14);
 }
