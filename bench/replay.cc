@@ -101,12 +101,13 @@ int main(int argc, char** argv) {
     scene.value().world.solver.substeps = count;
   }
   if (const char* passes = std::getenv("TUMBLE_JOINT_PASSES")) {
-    const int count = std::atoi(passes);
-    if (count < 0 || count > 32 || (count == 0 && std::string(passes) != "0")) {
+    char* end = nullptr;
+    const long count = std::strtol(passes, &end, 10);
+    if (end == passes || *end != '\0' || count < 0 || count > 32) {
       std::fprintf(stderr, "bench_replay: TUMBLE_JOINT_PASSES=%s is not 0 to 32\n", passes);
       return 2;
     }
-    scene.value().world.solver.joint_position_passes = count;
+    scene.value().world.solver.joint_position_passes = static_cast<int>(count);
   }
   if (const char* friction = std::getenv("TUMBLE_JOINT_FRICTION")) {
     char* end = nullptr;

@@ -22,10 +22,10 @@ class BlockSolve {
 
   void compute(const Matrix& block) {
     const double determinant = block.determinant();
-    // (The determinant of a positive semidefinite block is at most (trace / N)^N; one far below
-    // that is nearly singular, and its cofactors would carry the rounding: LDLT's.)
-    // (The power by products: std::pow with an integer exponent is libm's pow, which cost the
-    // ragdoll pile 1.4% of its instructions with pgs.)
+    // The determinant of a positive semidefinite block is at most (trace / N)^N; one far below
+    // that is nearly singular, and its cofactors would carry the rounding: LDLT's. (The power by
+    // products: std::pow with an integer exponent is libm's pow, 1.4% of the ragdoll pile's
+    // instructions with pgs.)
     const double mean = block.trace() / N;
     double bound = mean;
     for (int k = 1; k < N; ++k) bound *= mean;
