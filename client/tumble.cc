@@ -637,12 +637,16 @@ int main(int argc, char** argv) {
 
   CLI::App* set = app.add_subcommand("set", "change run settings (only those given)");
   std::optional<double> dt, real_time_factor;
-  std::optional<std::uint32_t> substeps;
+  std::optional<std::uint32_t> substeps, iterations, joint_position_passes;
   std::string solver;
   std::vector<double> gravity;
   set->add_option("--dt", dt, "s per step");
   set->add_option("--real-time-factor", real_time_factor, "1: real time; 0: as fast as possible");
   set->add_option("--substeps", substeps, "substeps of the soft solver");
+  set->add_option("--iterations", iterations, "velocity sweeps a step of the pgs solver");
+  set->add_option("--joint-position-passes", joint_position_passes,
+                  "position passes over the joints solved joint by joint (soft, pgs) after each "
+                  "move: fewer cost less and hold the joints less");
   set->add_option("--solver", solver, "exact, pgs, soft or auto")
       ->check(CLI::IsMember({"exact", "pgs", "soft", "auto"}));
   set->add_option("--gravity", gravity, "x,y,z (m/s^2)")->delimiter(',')->expected(3);
@@ -981,6 +985,8 @@ int main(int argc, char** argv) {
     if (dt) settings->set_dt(*dt);
     if (real_time_factor) settings->set_real_time_factor(*real_time_factor);
     if (substeps) settings->set_substeps(*substeps);
+    if (iterations) settings->set_iterations(*iterations);
+    if (joint_position_passes) settings->set_joint_position_passes(*joint_position_passes);
     if (!solver.empty()) settings->set_solver(*solver_kind(solver));
     if (!gravity.empty()) set_vec(gravity, settings->mutable_gravity());
     if (sleeping) settings->set_sleeping(*sleeping);
@@ -1003,6 +1009,8 @@ int main(int argc, char** argv) {
                        {"dt", now.dt()},
                        {"real_time_factor", now.real_time_factor()},
                        {"substeps", now.substeps()},
+                       {"iterations", now.iterations()},
+                       {"joint_position_passes", now.joint_position_passes()},
                        {"solver", solver_name(now.solver())},
                        {"sleeping", now.sleeping()},
                        {"gravity", {now.gravity().x(), now.gravity().y(), now.gravity().z()}}}

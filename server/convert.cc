@@ -414,6 +414,8 @@ void stats_to_proto(const StepStats& s, v1::StepStats* out) {
 WorldSettings RunChange::applied_to(WorldSettings settings) const {
   if (gravity) settings.gravity = *gravity;
   if (substeps) settings.solver.substeps = *substeps;
+  if (iterations) settings.solver.iterations = *iterations;
+  if (joint_position_passes) settings.solver.joint_position_passes = *joint_position_passes;
   if (solver) settings.solver.kind = *solver;
   if (sleeping) settings.solver.sleeping = *sleeping;
   return settings;
@@ -436,6 +438,9 @@ Result<RunChange> run_change_from_proto(const v1::RunSettings& settings, double 
     change.gravity = vec(settings.gravity());
   }
   if (settings.has_substeps()) change.substeps = settings.substeps();
+  if (settings.has_iterations()) change.iterations = settings.iterations();
+  if (settings.has_joint_position_passes())
+    change.joint_position_passes = settings.joint_position_passes();
   if (settings.has_sleeping()) change.sleeping = settings.sleeping();
   switch (settings.solver()) {
     case v1::SOLVER_KIND_UNSPECIFIED:
@@ -463,6 +468,8 @@ void run_settings_to_proto(double dt, double real_time_factor, const WorldSettin
   out->set_dt(dt);
   out->set_real_time_factor(real_time_factor);
   out->set_substeps(world.solver.substeps);
+  out->set_iterations(world.solver.iterations);
+  out->set_joint_position_passes(world.solver.joint_position_passes);
   out->set_sleeping(world.solver.sleeping);
   out->set_solver(static_cast<v1::SolverKind>(static_cast<int>(world.solver.kind) + 1));
   set(world.gravity, out->mutable_gravity());

@@ -58,7 +58,7 @@ void joint_spec_to_proto(const JointDef& def, std::uint64_t a, std::uint64_t b, 
 struct RunChange {
   std::optional<double> dt, real_time_factor;
   std::optional<Vec3> gravity;
-  std::optional<int> substeps;
+  std::optional<int> substeps, iterations, joint_position_passes;
   std::optional<SolverKind> solver;
   std::optional<bool> sleeping;
   // `settings` with this change's world settings applied.

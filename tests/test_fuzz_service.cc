@@ -375,6 +375,9 @@ class FuzzService {
         if (h.chance(0.2)) s->set_solver(static_cast<v1::SolverKind>(h.integer(0, 6)));
         if (h.chance(0.2)) set(h.vector(-20, 20), s->mutable_gravity());
         if (h.chance(0.1)) s->set_real_time_factor(h.number(0, 2));
+        if (h.chance(0.1)) s->set_iterations(h.chance(0.8) ? h.integer(-2, 40) : 1000000);
+        if (h.chance(0.1))
+          s->set_joint_position_passes(h.chance(0.8) ? h.integer(-2, 12) : 1000000);
         switch (h.integer(0, 3)) {
           case 0:
             request.set_step(static_cast<std::uint32_t>(h.integer(1, 3)));

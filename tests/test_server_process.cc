@@ -132,6 +132,13 @@ TEST(ServerProcess, CliCommandsHealthSnapshotRecordAndReplay) {
   ASSERT_EQ(set.code, 0) << set.text;
   EXPECT_NE(set.text.find("\"dt\":0.01"), std::string::npos) << set.text;
   EXPECT_NE(run(tumble + "set --dt -1").code, 0);
+  const Output sweeps = run(tumble + "set --iterations 20 --joint-position-passes 2");
+  ASSERT_EQ(sweeps.code, 0) << sweeps.text;
+  EXPECT_NE(sweeps.text.find("\"iterations\":20"), std::string::npos) << sweeps.text;
+  EXPECT_NE(sweeps.text.find("\"joint_position_passes\":2"), std::string::npos) << sweeps.text;
+  const Output too_many = run(tumble + "set --joint-position-passes 1001");
+  EXPECT_NE(too_many.code, 0);
+  EXPECT_NE(too_many.text.find("joint_position_passes"), std::string::npos) << too_many.text;
 
   ASSERT_EQ(run(tumble + "step 30").code, 0);
   const Output saved = run(tumble + "snapshot " + dir / "world.snapshot");

@@ -10,6 +10,7 @@
 
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include "scene_runner.h"
 #include "service.h"
@@ -261,6 +262,51 @@ TEST_F(ServiceTest, ControlChangesSettingsAllOrNothingAndResets) {
     EXPECT_EQ(body_count(), 9u);
     EXPECT_EQ(response.step(), 0u);
   }
+}
+
+// The pgs sweeps and the joints' position passes, the solver's cost against its accuracy, change
+// while the world runs; a value out of range is refused by name and changes nothing.
+TEST_F(ServiceTest, ControlChangesTheSweepsAndJointPassesWhileRunning) {
+  const auto control = [&](int iterations, int passes, v1::ControlResponse* response) {
+    v1::ControlRequest request;
+    request.mutable_settings()->set_iterations(iterations);
+    request.mutable_settings()->set_joint_position_passes(passes);
+    request.mutable_settings()->set_solver(v1::SOLVER_KIND_PGS);
+    request.set_step(2);
+    grpc::ClientContext context;
+    return stub_->Control(&context, request, response);
+  };
+  const auto settings_now = [&] {
+    v1::GetInfoRequest request;
+    grpc::ClientContext context;
+    v1::GetInfoResponse response;
+    EXPECT_TRUE(stub_->GetInfo(&context, request, &response).ok());
+    return response.settings();
+  };
+  const v1::RunSettings before = settings_now();
+  EXPECT_EQ(before.iterations(), SolverSettings{}.iterations);
+  EXPECT_EQ(before.joint_position_passes(), SolverSettings{}.joint_position_passes);
+  for (const auto& [iterations, passes, field] :
+       {std::tuple{0, 2, "iterations"}, std::tuple{1001, 2, "iterations"},
+        std::tuple{20, -1, "joint_position_passes"}, std::tuple{20, 1001, "joint_position_passes"}}) {
+    v1::ControlResponse response;
+    const grpc::Status status = control(iterations, passes, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_NE(status.error_message().find(field), std::string::npos) << status.error_message();
+    const v1::RunSettings now = settings_now();
+    EXPECT_EQ(now.iterations(), before.iterations());
+    EXPECT_EQ(now.joint_position_passes(), before.joint_position_passes());
+    EXPECT_EQ(now.solver(), before.solver());
+  }
+  v1::ControlResponse response;
+  ASSERT_TRUE(control(20, 0, &response).ok());
+  EXPECT_EQ(response.settings().iterations(), 20);
+  EXPECT_EQ(response.settings().joint_position_passes(), 0);
+  ASSERT_TRUE(host_.wait_idle(std::chrono::seconds(30)));
+  const v1::RunSettings now = settings_now();
+  EXPECT_EQ(now.iterations(), 20);
+  EXPECT_EQ(now.joint_position_passes(), 0);
+  EXPECT_EQ(now.solver(), v1::SOLVER_KIND_PGS);
 }
 
 TEST_F(ServiceTest, LoadSceneReplacesTheWorldOrNothing) {

@@ -85,6 +85,16 @@ def test_bad_scenes_settings_and_snapshots_leave_the_world_alone(world):
     with pytest.raises(tumble.Error) as dt:
         world.settings(dt=-1)
     assert "dt" in dt.value.message
+    with pytest.raises(tumble.Error) as passes:
+        world.settings(iterations=20, joint_position_passes=-1)
+    assert "joint_position_passes" in passes.value.message
+    assert world.settings().iterations == 10
+    with pytest.raises(tumble.ArgumentError) as sweeps:
+        world.settings(iterations=2.5)
+    assert "iterations" in sweeps.value.message
+    with pytest.raises(tumble.ArgumentError) as huge:
+        world.settings(substeps=2**40)
+    assert "substeps" in huge.value.message
     with pytest.raises(tumble.Error) as snapshot:
         world.restore(b"not a snapshot")
     assert snapshot.value.code == grpc.StatusCode.INVALID_ARGUMENT

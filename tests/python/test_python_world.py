@@ -87,7 +87,13 @@ def test_step_reset_and_settings(world):
     assert now.dt == 1 / 120 and now.substeps == 8 and now.solver == "soft"
     assert now.gravity == (0, 0, -3.7)
     assert now.real_time_factor == 0
+    assert now.iterations == 10 and now.joint_position_passes == 3
     assert world.settings() == now
+    swept = world.settings(solver="pgs", iterations=20, joint_position_passes=2)
+    assert swept.iterations == 20 and swept.joint_position_passes == 2
+    assert swept.solver == "pgs" and swept.substeps == 8
+    assert world.step(2) == 2
+    assert world.settings() == swept
 
 
 def test_play_runs_until_paused(world):

@@ -14,6 +14,15 @@ def number(value, name):
     return float(value)
 
 
+def integer(value, name):
+    """A whole number the wire carries as int32 (its range the server's to judge)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ArgumentError(f"{name}: expected an integer, got {value!r}")
+    if not -2**31 <= value < 2**31:
+        raise ArgumentError(f"{name}: {value} is out of range")
+    return int(value)
+
+
 def array(value, count, name):
     try:
         values = np.asarray(value, dtype=float).ravel()

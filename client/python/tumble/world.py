@@ -49,7 +49,9 @@ def _placed(query, shape, position, orientation, mask, call):
 class Settings:
     """The run's settings in force: dt (s), substeps (soft solver), solver, gravity (m/s^2),
     real_time_factor (1: wall-clock pace, 0: as fast as the machine can), sleeping (bodies at
-    rest fall asleep and cost nothing until touched)."""
+    rest fall asleep and cost nothing until touched), iterations (pgs's velocity sweeps a step),
+    joint_position_passes (position passes over the joints solved joint by joint, soft and pgs,
+    after each move)."""
 
     dt: float
     substeps: int
@@ -57,13 +59,15 @@ class Settings:
     gravity: tuple
     real_time_factor: float
     sleeping: bool = True
+    iterations: int = 10
+    joint_position_passes: int = 3
 
     @staticmethod
     def from_proto(settings):
         solver = next((k for k, v in _SOLVERS.items() if v == settings.solver), "unspecified")
         gravity = (settings.gravity.x, settings.gravity.y, settings.gravity.z)
         return Settings(settings.dt, settings.substeps, solver, gravity, settings.real_time_factor,
-                        settings.sleeping)
+                        settings.sleeping, settings.iterations, settings.joint_position_passes)
 
 
 @dataclass
@@ -459,16 +463,19 @@ class WorldCalls:
         self._control(pb.ControlRequest(reset=True))
 
     def settings(self, dt=None, substeps=None, solver=None, gravity=None, real_time_factor=None,
-                 sleeping=None):
+                 sleeping=None, iterations=None, joint_position_passes=None):
         """Changes the settings given (none: reads them); returns the settings in force."""
         request = pb.ControlRequest()
         settings = request.settings
         if dt is not None:
             settings.dt = convert.number(dt, "dt")
         if substeps is not None:
-            if isinstance(substeps, bool) or not isinstance(substeps, int):
-                raise ArgumentError(f"substeps: expected an integer, got {substeps!r}", "settings")
-            settings.substeps = substeps
+            settings.substeps = convert.integer(substeps, "substeps")
+        if iterations is not None:
+            settings.iterations = convert.integer(iterations, "iterations")
+        if joint_position_passes is not None:
+            settings.joint_position_passes = convert.integer(joint_position_passes,
+                                                             "joint_position_passes")
         if solver is not None:
             if solver not in _SOLVERS:
                 raise ArgumentError(
