@@ -105,6 +105,12 @@ def test_limits_and_refusals_are_the_servers():
     with pytest.raises(tumble.Error) as solver:
         world.settings(dt=-1)
     assert solver.value.message.startswith("settings.dt")
+    with pytest.raises(tumble.Error) as passes:
+        world.settings(iterations=5, joint_position_passes=1001)
+    assert passes.value.message.startswith("settings.solver.joint_position_passes")
+    assert world.settings().iterations == 10
+    now = world.settings(iterations=5, joint_position_passes=2)
+    assert (now.iterations, now.joint_position_passes) == (5, 2)
 
 
 def test_frames_step_the_local_world_and_describe_its_bodies_first():
