@@ -421,6 +421,19 @@ WorldSettings RunChange::applied_to(WorldSettings settings) const {
   return settings;
 }
 
+Status RunChange::check_against(const WorldSettings& now) const {
+  const Status checked = validate(applied_to(now));
+  if (checked) return checked;
+  // The world's solver fields that RunSettings carries at its top level.
+  for (const std::string_view field : {"substeps", "iterations", "joint_position_passes"}) {
+    const std::string world_name = "solver." + std::string(field) + ":";
+    if (checked.message().starts_with(world_name))
+      return Status::error(checked.message().substr(std::string_view("solver.").size()),
+                           checked.code());
+  }
+  return checked;
+}
+
 Result<RunChange> run_change_from_proto(const v1::RunSettings& settings, double max_time_step) {
   RunChange change;
   if (settings.has_dt()) {

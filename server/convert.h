@@ -63,6 +63,9 @@ struct RunChange {
   std::optional<bool> sleeping;
   // `settings` with this change's world settings applied.
   WorldSettings applied_to(WorldSettings settings) const;
+  // Whether the world would take `now` with this change applied; a refusal names the request's
+  // field (RunSettings.substeps, where the world says solver.substeps).
+  Status check_against(const WorldSettings& now) const;
 };
 Result<RunChange> run_change_from_proto(const v1::RunSettings& settings, double max_time_step);
 // The settings in force: the host's pace and the world's solver and gravity.

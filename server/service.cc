@@ -260,7 +260,7 @@ grpc::Status WorldService::control(const v1::ControlRequest& request,
   if (!change) return invalid("settings." + change.error());
   Status acceptable = Status::ok();
   host_.inspect([&](const HostedWorld& hosted) {
-    acceptable = validate(change.value().applied_to(hosted.world.settings()));
+    acceptable = change.value().check_against(hosted.world.settings());
   });
   if (!acceptable) return invalid("settings." + acceptable.message());
   if (request.action_case() == v1::ControlRequest::kReset && request.reset()) {

@@ -292,7 +292,9 @@ TEST_F(ServiceTest, ControlChangesTheSweepsAndJointPassesWhileRunning) {
     v1::ControlResponse response;
     const grpc::Status status = control(iterations, passes, &response);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
-    EXPECT_NE(status.error_message().find(field), std::string::npos) << status.error_message();
+    // Named as the request names it: RunSettings carries them at its top level.
+    EXPECT_EQ(status.error_message().rfind("settings." + std::string(field) + ": must be in", 0), 0u)
+        << status.error_message();
     const v1::RunSettings now = settings_now();
     EXPECT_EQ(now.iterations(), before.iterations());
     EXPECT_EQ(now.joint_position_passes(), before.joint_position_passes());

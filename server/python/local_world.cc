@@ -135,8 +135,8 @@ Result<std::string> LocalWorld::control(std::string_view bytes) {
   Result<server::RunChange> change =
       server::run_change_from_proto(r.settings(), limits_.world.max_time_step);
   if (!change) return change.status().within("settings.");
-  const WorldSettings wanted = change.value().applied_to(hosted_.world.settings());
-  if (Status s = validate(wanted); !s) return s.within("settings.");
+  if (Status s = change.value().check_against(hosted_.world.settings()); !s)
+    return s.within("settings.");
   if (r.action_case() == v1::ControlRequest::kReset && r.reset()) {
     running_ = false;
     Result<World> made = server::world_of_scene(scene_, limits_.world, limits_.max_bodies);

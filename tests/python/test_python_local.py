@@ -107,7 +107,7 @@ def test_limits_and_refusals_are_the_servers():
     assert solver.value.message.startswith("settings.dt")
     with pytest.raises(tumble.Error) as passes:
         world.settings(iterations=5, joint_position_passes=1001)
-    assert passes.value.message.startswith("settings.solver.joint_position_passes")
+    assert passes.value.message.startswith("settings.joint_position_passes: must be in [0, 1000]")
     assert world.settings().iterations == 10
     now = world.settings(iterations=5, joint_position_passes=2)
     assert (now.iterations, now.joint_position_passes) == (5, 2)
