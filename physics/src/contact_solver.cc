@@ -640,8 +640,9 @@ bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> co
 
 void correct_positions(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,
                        std::span<const std::uint32_t> ids, std::span<const SolverBody> bodies,
-                       std::span<Pose> poses, const SolverSettings& settings) {
-  for (std::uint32_t id : ids) {
+                       std::span<Pose> poses, const SolverSettings& settings, bool backward) {
+  for (std::size_t n = 0; n < ids.size(); ++n) {
+    const std::uint32_t id = backward ? ids[ids.size() - 1 - n] : ids[n];
     const ContactRow& row = rows[id];
     Pose& pa = poses[row.a];
     Pose& pb = poses[row.b];

@@ -172,10 +172,15 @@ bool pass_impacts(std::span<const ContactRow> rows, std::span<ContactRowCold> co
                   std::span<SolverBody> bodies, const SolverSettings& settings, double reach);
 
 // Nonlinear Gauss-Seidel on positions (Catto, Box2D 2.x): moves bodies out of penetration
-// without touching velocities.
+// without touching velocities. Point by point, each point's push turns its body and moves the
+// points corrected after it, so one order run every time leans a face the same way each step: a
+// tower of ten pgs boxes dropped 0.7 m, kept awake, settled and then swayed ever wider until it
+// fell at 27 s (twenty and thirty high, within 60 s). Callers alternate `backward` (the rows in
+// reverse) from one iteration to the next, as the velocity sweeps alternate theirs (symmetric
+// Gauss-Seidel), and the towers stand (tests/test_tall_stacks.cc).
 void correct_positions(std::span<const ContactRow> rows, std::span<const ContactRowCold> cold,
                        std::span<const std::uint32_t> ids, std::span<const SolverBody> bodies,
-                       std::span<Pose> poses, const SolverSettings& settings);
+                       std::span<Pose> poses, const SolverSettings& settings, bool backward);
 
 // |min(impulse / effective mass, normal velocity - target)| over the normal rows, m/s.
 double normal_residual(std::span<const ContactRow> rows, std::span<const std::uint32_t> ids,

@@ -1367,14 +1367,17 @@ void World::correct_positions(double dt) {
 #pragma omp single
     s.barrier.reset(omp_get_num_threads());
     auto correct_coloured = [&](std::uint32_t i, bool solo) {
-      for (int k = 0; k < solver.position_iterations; ++k)
+      for (int k = 0; k < solver.position_iterations; ++k) {
+        const bool backward = k % 2 == 1;
         sweep_colours(
-            s, s.island_colour_begin[i], s.island_colour_begin[i + 1], false, solo,
+            s, s.island_colour_begin[i], s.island_colour_begin[i + 1], backward, solo,
             [&](std::span<const std::uint32_t> ids) {
-              tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses, solver);
+              tumble::correct_positions(s.rows, s.cold_rows, ids, s.bodies, s.poses, solver,
+                                        backward);
               return 0.0;
             },
             false);
+      }
     };
     for (std::uint32_t i : s.team_islands)
       if (needs_correction(i) && team_runs(threads, manifolds_in(s, i))) correct_coloured(i, false);
@@ -1387,7 +1390,8 @@ void World::correct_positions(double dt) {
       if (!needs_correction(i)) return;
       const auto rows = island_context(s, settings_, i).rows;
       for (int n = 0; n < solver.position_iterations; ++n)
-        tumble::correct_positions(s.rows, s.cold_rows, rows, s.bodies, s.poses, solver);
+        tumble::correct_positions(s.rows, s.cold_rows, rows, s.bodies, s.poses, solver,
+                                  n % 2 == 1);
     });
   });
 }
