@@ -36,8 +36,7 @@ namespace {
 
 using namespace tumble;
 
-constexpr double kDuration = 10;      // s
-constexpr double kQuietSpeed = 0.05;  // m/s and rad/s: SolverSettings' sleep speeds
+constexpr double kDuration = 10;  // s
 
 // The stacks on `ground` (the plane or the hills), `boxes` high, on a square grid as wide as fits
 // the hills with a box's height to spare between neighbours (7 x 7 stacks of three, 4 x 4 of ten).
@@ -82,6 +81,9 @@ Outcome follow(const SceneDef& scene, int boxes, int stacks, const std::function
   out.last_moved.assign(stacks, 0.0);
   out.toppled.assign(stacks, false);
   const int steps = static_cast<int>(kDuration / scene.dt + 0.5);
+  // Quiet as sleeping counts it (the stacks run awake, but with its speeds).
+  const double quiet_speed = scene.world.solver.sleep_linear_speed;
+  const double quiet_spin = scene.world.solver.sleep_angular_speed;
   for (int n = 1; n <= steps; ++n) {
     if (!step()) {
       out.stopped = true;
@@ -90,7 +92,7 @@ Outcome follow(const SceneDef& scene, int boxes, int stacks, const std::function
     for (int s = 0; s < stacks; ++s)
       for (int k = 0; k < boxes; ++k) {
         const BoxRead read = box(static_cast<std::size_t>(s * boxes + k));
-        if (read.speed > kQuietSpeed || read.spin > kQuietSpeed) out.last_moved[s] = n * scene.dt;
+        if (read.speed > quiet_speed || read.spin > quiet_spin) out.last_moved[s] = n * scene.dt;
       }
   }
   for (int s = 0; s < stacks; ++s) {
