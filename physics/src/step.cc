@@ -1273,7 +1273,7 @@ void World::solve_islands(double dt) {
     }
     s.lane_pack_begin.push_back(s.lane_pack_begin.back() + most);
   }
-  s.lane_packs.resize(s.lane_pack_begin.back());
+  resize_for_overwrite(s.lane_packs, s.lane_pack_begin.back());
   for (const StepScratch::PackedManifolds& pack : s.pack_manifolds)
     stats_.packed_manifolds += pack.count;
   const bool parallel =

@@ -59,8 +59,8 @@ void World::load_solver_bodies() {
   if (!kinematic_.empty())
     for (std::uint32_t k = s.moving; k < solver_bodies; ++k)
       s.kinematic_contacts |= bodies_[s.solver_slot[k]].body.carries();
-  s.bodies.resize(solver_bodies);
-  s.poses.resize(solver_bodies);
+  resize_for_overwrite(s.bodies, solver_bodies);
+  resize_for_overwrite(s.poses, solver_bodies);
   s.dynamic.resize(solver_bodies);
   s.body_of.resize(solver_bodies);
   const int threads = team_size(settings_.threads);

@@ -50,9 +50,9 @@ void World::prepare_contact_rows() {
   // A pair keeps the colour it was given when it started touching (colouring.h); its record
   // carries it to the next step (below, with the rows).
   keep_manifold_colours(s.links, s.dynamic, s.kept_colours, &s.colouring_scratch, s.colours);
-  s.rows.resize(s.row_begin[manifolds]);
-  s.cold_rows.resize(s.rows.size());
-  s.blocks.resize(manifolds);
+  resize_for_overwrite(s.rows, s.row_begin[manifolds]);
+  resize_for_overwrite(s.cold_rows, s.rows.size());
+  resize_for_overwrite(s.blocks, manifolds);
   if (s.row_ids.size() < s.rows.size()) {
     const std::size_t from = s.row_ids.size();
     s.row_ids.resize(s.rows.size());

@@ -13,6 +13,7 @@
 #include "joint_solver.h"
 #include "joint_terms.h"
 #include "joint_tree.h"
+#include "scratch_buffer.h"
 #include "tall_stacks.h"
 #include "team_barrier.h"
 
@@ -65,8 +66,8 @@ struct StepScratch {
   // (kNoSolverBody where it has none), solver_slot names it back.
   std::vector<std::uint32_t> solver_slot, solver_of_slot;
   std::uint32_t moving = 0;  // solver indices [0, moving) move
-  std::vector<SolverBody> bodies;
-  std::vector<Pose> poses;
+  ScratchBuffer<SolverBody> bodies;  // (load_solver_bodies assigns each whole)
+  ScratchBuffer<Pose> poses;
   std::vector<std::uint8_t> dynamic;  // 1 for [0, moving)
   // Some contact touches a kinematic body with a velocity (SolverBody::kinematic): the solvers'
   // separations count its motion, and what it touches does not fall asleep (carried, by solver
@@ -74,9 +75,10 @@ struct StepScratch {
   bool kinematic_contacts = false;
   std::vector<std::uint8_t> carried;
   std::vector<const Body*> body_of;
-  std::vector<ContactRow> rows;           // manifold order
-  std::vector<ContactRowCold> cold_rows;  // beside rows, row for row
-  std::vector<NormalBlock> blocks;        // one per manifold
+  // (Written whole by prepare_rows each step: ScratchBuffer, scratch_buffer.h.)
+  ScratchBuffer<ContactRow> rows;           // manifold order
+  ScratchBuffer<ContactRowCold> cold_rows;  // beside rows, row for row
+  ScratchBuffer<NormalBlock> blocks;        // one per manifold
   std::vector<std::uint32_t> row_begin;   // rows of manifold m: [row_begin[m], row_begin[m+1])
   std::vector<IslandLink> links;          // one per manifold
   // The joints with a moving body (world_joints.cc), and their links into islands.
@@ -102,7 +104,7 @@ struct StepScratch {
   // Islands solved together sweep packs (contact_packs.h), lane k for the item's k-th island:
   // item k's are lane_packs[lane_pack_begin[k] .. [k+1]), pack j holding each island's j-th
   // manifold.
-  std::vector<ContactPack> lane_packs;
+  ScratchBuffer<ContactPack> lane_packs;  // each filled whole by its item (IslandLanes)
   std::vector<std::uint32_t> lane_pack_begin;
   // Islands with at least kColouredIsland manifolds are solved by the whole team, colour by
   // colour: island i has colours [island_colour_begin[i], island_colour_begin[i+1]).
@@ -119,7 +121,7 @@ struct StepScratch {
   bool packed = false;  // this step sweeps packs (packed_sweeps())
   // A colour's manifolds while they are grouped by size, one buffer per thread.
   std::vector<std::vector<std::uint32_t>> thread_grouped;
-  std::vector<ContactPack> packs;
+  ScratchBuffer<ContactPack> packs;  // each filled whole by pack_manifolds
   std::vector<PackedManifolds> pack_manifolds;
   std::vector<std::uint32_t> colour_pack_begin;
   std::vector<double> team_values;  // one per thread, for reductions inside a team
@@ -154,13 +156,15 @@ struct StepScratch {
   // The touching pairs as the last step left them, with their impulses (contact_pairs.h), sorted
   // by body pair; and this step's, contact for contact, with the index of each one's record in
   // `pairs` (kNoRecord: none) and whether its manifold was taken from there.
-  std::vector<ContactPairRecord> pairs, next_pairs;
+  // (Each of next_pairs assigned whole before it is read: ScratchBuffer, scratch_buffer.h.)
+  ScratchBuffer<ContactPairRecord> pairs, next_pairs;
   static constexpr std::uint8_t kPairTouches = 1, kPairKeptFeature = 2;
   // The narrow phase's output by broad-phase pair, before the touching ones are copied out to the
-  // world's contacts and next_pairs. Never cut back, so that a step reuses what the last one
-  // constructed (cutting and growing again constructed every pair's contact anew, serially).
-  std::vector<Contact> found_contacts;
-  std::vector<ContactPairRecord> found_records;
+  // world's contacts and next_pairs. Each pair's contact is written before it is read, and its
+  // record where it touches (only those are read), so growing them writes nothing
+  // (ScratchBuffer); they are never cut back.
+  ScratchBuffer<Contact> found_contacts;
+  ScratchBuffer<ContactPairRecord> found_records;
   std::vector<std::uint32_t> found_previous;  // the record of the last step, or kNoRecord
   std::vector<std::uint8_t> found_flags;      // kPairTouches, kPairKeptFeature
   std::vector<std::uint8_t> unjoined;         // 1: a joint keeps the pair apart

@@ -128,7 +128,7 @@ void World::group_for_sweeps() {
     }
     s.colour_pack_begin.push_back(static_cast<std::uint32_t>(s.pack_manifolds.size()));
   }
-  s.packs.resize(s.pack_manifolds.size());
+  resize_for_overwrite(s.packs, s.pack_manifolds.size());
   const std::int64_t packs = static_cast<std::int64_t>(s.packs.size());
   for_indices(threads, worth_a_team(packs, 225), packs, [&](std::int64_t k) {
     std::uint32_t lanes[kWideLanes];

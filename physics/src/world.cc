@@ -777,8 +777,8 @@ void World::find_contacts(double dt) {
   // Every pair writes its own slot, then the touching ones are packed in pair order: the same
   // result for any thread count.
   if (s.found_contacts.size() < pairs_.size()) {
-    resize_reusing(s.found_contacts, pairs_.size());
-    resize_reusing(s.found_records, pairs_.size());
+    resize_for_overwrite(s.found_contacts, pairs_.size());
+    resize_for_overwrite(s.found_records, pairs_.size());
   }
   resize_reusing(s.found_previous, pairs_.size());
   resize_reusing(s.found_flags, pairs_.size());
@@ -953,7 +953,7 @@ void World::find_contacts(double dt) {
     kept += many ? s.many_found[s.many_slot[i]].count : 1;
   }
   resize_reusing(contacts_, kept);
-  resize_reusing(s.next_pairs, kept);
+  resize_for_overwrite(s.next_pairs, kept);
   resize_reusing(s.previous_pair, kept);
   resize_reusing(s.reused, kept);
   for_indices(threads, worth_a_team(n, 20), n, [&](std::int64_t i) {

@@ -178,7 +178,7 @@ WorldStateData WorldInternals::state_of(const World& world) {
   state.free_slots = world.free_slots_;
   state.time = world.time_;
   state.step = world.stats_.step;
-  state.contact_pairs = world.scratch_->pairs;
+  state.contact_pairs.assign(world.scratch_->pairs.begin(), world.scratch_->pairs.end());
   if (world.joint_count_ > 0 || !world.free_joint_slots_.empty()) {
     state.joints = world.joints_;
     state.free_joints = world.free_joint_slots_;
@@ -273,7 +273,7 @@ Result<World> WorldInternals::world_from(const WorldSettings& settings, WorldSta
   world.live_count_ = live;
   world.time_ = state.time;
   world.stats_.step = state.step;
-  world.scratch_->pairs = std::move(state.contact_pairs);
+  world.scratch_->pairs.assign(state.contact_pairs.begin(), state.contact_pairs.end());
   world.joints_ = std::move(state.joints);
   world.free_joint_slots_ = std::move(state.free_joints);
   world.restore_joint_indexes();
