@@ -1,6 +1,6 @@
 // The step's scratch buffers (physics/src/scratch_buffer.h): sizing one writes none of its
-// elements, so their memory is first written by the threads that fill them, and growing one
-// drops what it held instead of copying it.
+// elements, so their memory is first written by the threads that fill them; growing one drops
+// what it held instead of copying it; large ones start on 2 MB pages.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -57,6 +57,20 @@ TEST(ScratchBuffer, PushBackAndCopiesKeepValues) {
     EXPECT_EQ(copy[i].value, 0.5 * i);
     EXPECT_EQ(copy[i].id, i);
   }
+}
+
+// A buffer of two large pages or more starts on one, where the kernel can back it with them; a
+// small one is an ordinary allocation.
+TEST(ScratchBuffer, LargeBuffersStartOnLargePages) {
+  constexpr std::size_t kLargePage = UninitializedAllocator<Record>::kLargePage;
+  ScratchBuffer<Record> large;
+  resize_for_overwrite(large, 2 * kLargePage / sizeof(Record) + 1);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(large.data()) % kLargePage, 0u);
+  large[large.size() - 1] = {2.5, 3};  // the rounded-up allocation holds every element
+  EXPECT_EQ(large.back().id, 3u);
+  ScratchBuffer<Record> small;
+  resize_for_overwrite(small, 10);
+  EXPECT_EQ(small.capacity(), 10u);
 }
 
 }  // namespace

@@ -1,12 +1,16 @@
-// Buffers that a step writes whole before it reads them (the rows, the packs), sized without
-// writing a byte: their memory is first touched by the team's threads that fill them.
+// Buffers that a step writes whole before it reads them (the rows, the packs, the pair records),
+// sized without writing a byte, so that their memory is first touched by the team's threads that
+// fill them; the large ones on 2 MB pages.
 //
 // A std::vector that grows value-initialises its new elements (a memset) and copies the old ones
 // into the new storage, both on the stepping thread. While a pile lands its contacts grow every
-// step, and the first write to each new page is a page fault (about 5 us on a virtual machine):
-// the falling pile of 4000 faulted in 70 MB that way over its first 1.5 s, a millisecond a step
-// of serial time, more than Jolt's whole step on 16 threads (docs/PERFORMANCE.md, "Beside
-// Jolt"). Jolt avoids it by allocating its step's memory from one block it keeps.
+// step, and the first write to each new 4 KB page is a page fault (about 5 us on a virtual
+// machine): the falling pile of 4000 faulted in 70 MB that way over its first 1.5 s, about a
+// millisecond a step, all of it serial (docs/PERFORMANCE.md, "Beside Jolt"). Jolt allocates its
+// step's memory from one block it keeps. Here a buffer of 4 MB or more is also asked to be backed
+// by 2 MB pages (Linux's transparent huge pages, madvise): one fault per 2 MB, and fewer TLB
+// misses while the sweeps stream through the packs. Where the kernel does not give them, the
+// hint changes nothing.
 #pragma once
 
 #include <algorithm>
@@ -16,6 +20,10 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace tumble {
 
@@ -28,8 +36,25 @@ struct UninitializedAllocator {
   UninitializedAllocator() = default;
   template <class U>
   UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
-  T* allocate(std::size_t n) { return std::allocator<T>{}.allocate(n); }
-  void deallocate(T* p, std::size_t n) noexcept { std::allocator<T>{}.deallocate(p, n); }
+  // Buffers of two large pages or more are laid out on whole ones (rounded up: less than a third
+  // of the buffer wasted).
+  static constexpr std::size_t kLargePage = std::size_t{2} << 20;
+  static bool on_large_pages(std::size_t n) { return n * sizeof(T) >= 2 * kLargePage; }
+  T* allocate(std::size_t n) {
+    if (!on_large_pages(n)) return std::allocator<T>{}.allocate(n);
+    if (n > std::allocator_traits<std::allocator<T>>::max_size(std::allocator<T>{}))
+      throw std::bad_array_new_length();
+    const std::size_t bytes = (n * sizeof(T) + kLargePage - 1) / kLargePage * kLargePage;
+    void* p = ::operator new(bytes, std::align_val_t{kLargePage});
+#ifdef MADV_HUGEPAGE
+    madvise(p, bytes, MADV_HUGEPAGE);  // a hint: refused, the buffer keeps small pages
+#endif
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t n) noexcept {
+    if (!on_large_pages(n)) return std::allocator<T>{}.deallocate(p, n);
+    ::operator delete(p, std::align_val_t{kLargePage});
+  }
   template <class U>
   void construct(U*) noexcept {
     static_assert(std::is_trivially_destructible_v<U> &&
