@@ -32,15 +32,15 @@ TEST(ScratchBuffer, SizingWithinItsCapacityWritesNoElement) {
   }
 }
 
-// Past its capacity it takes half as much again at least, so a count that creeps up step after
-// step reallocates rarely. What it held is dropped, not copied: its callers write every element.
-TEST(ScratchBuffer, GrowingTakesHalfAsMuchAgainAtLeast) {
+// Past its capacity it doubles at least, so a count that creeps up step after step reallocates
+// rarely. What it held is dropped, not copied: its callers write every element.
+TEST(ScratchBuffer, GrowingDoublesItsCapacityAtLeast) {
   ScratchBuffer<Record> buffer;
   resize_for_overwrite(buffer, 1000);
   const std::size_t capacity = buffer.capacity();
   ASSERT_GE(capacity, 1000u);
   resize_for_overwrite(buffer, capacity + 1);
-  EXPECT_GE(buffer.capacity(), capacity + capacity / 2);
+  EXPECT_GE(buffer.capacity(), 2 * capacity);
   EXPECT_EQ(buffer.size(), capacity + 1);
   resize_for_overwrite(buffer, 10 * capacity);
   EXPECT_EQ(buffer.size(), 10 * capacity);

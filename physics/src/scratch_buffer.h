@@ -75,12 +75,13 @@ template <class T>
 using ScratchBuffer = std::vector<T, UninitializedAllocator<T>>;
 
 // Sizes a buffer whose elements the caller then writes whole: growing, it drops what it held
-// instead of copying it, and grows by half its capacity at least (a count that creeps up step
-// after step reallocates rarely).
+// instead of copying it, and doubles its capacity at least, as std::vector does (a count that
+// creeps up step after step reallocates rarely; grown by half, the falling pile of 1000 faulted
+// in a quarter more pages than doubled).
 template <class T>
 void resize_for_overwrite(ScratchBuffer<T>& buffer, std::size_t size) {
   if (size > buffer.capacity()) {
-    const std::size_t capacity = std::max(size, buffer.capacity() + buffer.capacity() / 2);
+    const std::size_t capacity = std::max(size, 2 * buffer.capacity());
     buffer.clear();
     buffer.reserve(capacity);
   }
