@@ -106,6 +106,25 @@ TEST(Shapes, BoxInertiaIsTheStandardFormula) {
   EXPECT_NEAR(p.inertia(2, 2), (1 + 4) / 12.0, 1e-12);
 }
 
+// Boxes of one size share one polyhedron (a pile of equal boxes reads one in its narrow phase);
+// another size gets its own, and one made again after every holder is gone is whole.
+TEST(Shapes, BoxesOfOneSizeShareTheirPolyhedron) {
+  const Shape a = Shape::create(BoxDef{Vec3(0.5, 0.25, 1.0)}).value();
+  const Shape b = Shape::create(BoxDef{Vec3(0.5, 0.25, 1.0)}).value();
+  const Shape c = Shape::create(BoxDef{Vec3(0.5, 0.25, 1.0 + 1e-12)}).value();
+  ASSERT_NE(a.polyhedron(), nullptr);
+  EXPECT_EQ(a.polyhedron(), b.polyhedron());
+  EXPECT_NE(a.polyhedron(), c.polyhedron());
+  EXPECT_EQ(c.polyhedron()->vertices[7], Vec3(0.5, 0.25, 1.0 + 1e-12));
+  // Many sizes made and dropped (their entries swept as they accumulate), then one made again.
+  for (int k = 1; k <= 1000; ++k)
+    ASSERT_TRUE(Shape::create(BoxDef{Vec3::Constant(0.001 * k)}));
+  const Shape d = Shape::create(BoxDef{Vec3::Constant(0.5)}).value();
+  ASSERT_EQ(d.polyhedron()->vertices.size(), 8u);
+  EXPECT_EQ(d.polyhedron()->vertices[7], Vec3::Constant(0.5));
+  EXPECT_EQ(d.polyhedron()->faces.size(), 6u);
+}
+
 TEST(Bodies, RefusesBadDefinitionsNamingTheField) {
   BodyDef def;
   def.mass = -1;

@@ -4,6 +4,7 @@
 #include <numbers>
 #include <string>
 
+#include "box_polyhedra.h"
 #include "mass_integrals.h"
 #include "physics/compound.h"
 #include "physics/shape.h"
@@ -61,7 +62,7 @@ Result<Shape> Shape::create(const ShapeDef& def) {
     }
     shape.type_ = ShapeType::kBox;
     shape.half_extents_ = box->half_extents;
-    shape.polyhedron_ = std::make_shared<ConvexPolyhedron>(make_box_polyhedron(box->half_extents));
+    shape.polyhedron_ = shared_box_polyhedron(box->half_extents);
   } else if (const auto* hull = std::get_if<HullDef>(&def)) {
     if (hull->points.size() > kMaxHullPoints)
       return Status::error("points: " + std::to_string(hull->points.size()) +
