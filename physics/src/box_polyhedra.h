@@ -1,5 +1,5 @@
-// Boxes of one size share one polyhedron: a pile of 16,000 equal boxes reads one 1 KB polyhedron
-// in its narrow phase instead of 16,000 scattered over 16 MB.
+// Boxes of one size share one polyhedron: a pile of 16,000 equal boxes reads one polyhedron in its
+// narrow phase instead of 16,000 copies of about 1.25 KB each, scattered over 20 MB.
 #pragma once
 
 #include <memory>

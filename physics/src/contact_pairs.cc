@@ -91,6 +91,9 @@ void record_manifold(const ContactManifold& manifold, const PolytopeFeature& fea
   out->feature_first = feature.first;
   out->feature_second = feature.second;
   out->count = manifold.count;
+  // Given by the step's rows stage (prepare_contact_rows); written here too, so that a record
+  // in the narrow phase's unwritten buffers (ScratchBuffer) holds nothing undefined that is read.
+  out->colour = kNoContactColour;
   for (int i = 0; i < manifold.count; ++i) {
     const ContactPoint& point = manifold.points[i];
     out->points[i] = {point.feature_id, pose_a.inverse_transform(point.point_a), 0.0, Vec3::Zero()};

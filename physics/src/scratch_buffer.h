@@ -6,11 +6,11 @@
 // into the new storage, both on the stepping thread. While a pile lands its contacts grow every
 // step, and the first write to each new 4 KB page is a page fault (about 5 us on a virtual
 // machine): the falling pile of 4000 faulted in 70 MB that way over its first 1.5 s, about a
-// millisecond a step, all of it serial (docs/PERFORMANCE.md, "Beside Jolt"). Jolt allocates its
-// step's memory from one block it keeps. Here a buffer of 4 MB or more is also asked to be backed
-// by 2 MB pages (Linux's transparent huge pages, madvise): one fault per 2 MB, and fewer TLB
-// misses while the sweeps stream through the packs. Where the kernel does not give them, the
-// hint changes nothing.
+// millisecond a step, all of it serial (docs/PERFORMANCE.md, "The landing pile's page faults").
+// Jolt allocates its step's memory from one block it keeps. Here a buffer of 4 MB or more is also
+// asked to be backed by 2 MB pages (Linux's transparent huge pages, madvise): one fault per 2 MB,
+// and fewer TLB misses while the sweeps stream through the packs. Where the kernel does not give
+// them, the hint changes nothing.
 #pragma once
 
 #include <algorithm>
