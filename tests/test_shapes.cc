@@ -1,5 +1,7 @@
 // Shapes and bodies: validation messages, convex hulls, exact mass properties, and the world's
 // all-or-nothing creation.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "physics/world.h"
@@ -123,6 +125,69 @@ TEST(Shapes, BoxesOfOneSizeShareTheirPolyhedron) {
   ASSERT_EQ(d.polyhedron()->vertices.size(), 8u);
   EXPECT_EQ(d.polyhedron()->vertices[7], Vec3::Constant(0.5));
   EXPECT_EQ(d.polyhedron()->faces.size(), 6u);
+}
+
+// A rock of 40 points on a lumpy ellipsoid, some inside the hull: the shared hull must be the
+// one these points build, interior points and all.
+std::vector<Vec3> rock_points(double squash) {
+  std::vector<Vec3> points;
+  for (int i = 0; i < 40; ++i) {
+    const double z = 1 - (2 * i + 1) / 40.0, r = std::sqrt(1 - z * z), a = 2.399963 * i;
+    const double lump = 0.9 + 0.1 * std::sin(7.0 * i);
+    points.emplace_back(0.4 * lump * r * std::cos(a), 0.3 * lump * r * std::sin(a),
+                        squash * lump * z + 0.05);
+  }
+  return points;
+}
+
+TEST(Shapes, HullsOfOnePointSetShareTheirPolyhedra) {
+  const std::vector<Vec3> points = rock_points(0.2);
+  std::vector<Vec3> nudged = points;
+  nudged[3].x() = std::nextafter(nudged[3].x(), 1.0);
+  const Shape a = Shape::create(HullDef{points}).value();
+  const Shape b = Shape::create(HullDef{points}).value();
+  const Shape c = Shape::create(HullDef{nudged}).value();
+  ASSERT_NE(a.polyhedron(), nullptr);
+  EXPECT_EQ(a.polyhedron(), b.polyhedron());
+  EXPECT_NE(a.polyhedron(), c.polyhedron());
+
+  // Moved to a centre of mass: one copy for every shape moved by the same offset, and exactly the
+  // copy a shape of its own would make.
+  const Vec3 offset(0.01, -0.02, 0.05);
+  const Shape moved_a = a.recentred(offset);
+  const Shape moved_b = b.recentred(offset);
+  const Shape moved_other = a.recentred(Vec3(0.01, -0.02, 0.06));
+  EXPECT_EQ(moved_a.polyhedron(), moved_b.polyhedron());
+  EXPECT_NE(moved_a.polyhedron(), moved_other.polyhedron());
+  ASSERT_EQ(moved_a.polyhedron()->vertices.size(), a.polyhedron()->vertices.size());
+  for (std::size_t i = 0; i < a.polyhedron()->vertices.size(); ++i)
+    EXPECT_EQ(moved_a.polyhedron()->vertices[i], a.polyhedron()->vertices[i] - offset);
+  for (std::size_t i = 0; i < a.polyhedron()->faces.size(); ++i)
+    EXPECT_EQ(moved_a.polyhedron()->faces[i].offset,
+              a.polyhedron()->faces[i].offset - a.polyhedron()->faces[i].normal.dot(offset));
+
+  // Bodies keep only the moved copies, and still share one hull: the last hulls built are kept.
+  World world;
+  std::vector<BodyDef> defs(3);
+  for (int i = 0; i < 3; ++i) {
+    defs[i].shape = HullDef{i < 2 ? points : nudged};
+    defs[i].position = Vec3(i, 0, 1);
+  }
+  const std::vector<BodyId> ids = world.create_bodies(defs).value();
+  EXPECT_EQ(world.body(ids[0]).shape().polyhedron(), world.body(ids[1]).shape().polyhedron());
+  EXPECT_NE(world.body(ids[0]).shape().polyhedron(), world.body(ids[2]).shape().polyhedron());
+
+  // Many other rocks made and dropped (the kept hulls and the maps' entries turned over), then
+  // the first made again: the hull its points build.
+  for (int k = 1; k <= 300; ++k) ASSERT_TRUE(Shape::create(HullDef{rock_points(0.2 + 1e-3 * k)}));
+  const Shape d = Shape::create(HullDef{points}).value();
+  EXPECT_EQ(d.polyhedron()->vertices, a.polyhedron()->vertices);
+  EXPECT_EQ(d.polyhedron()->face_vertices, a.polyhedron()->face_vertices);
+  // A refusal is the builder's, and nothing is kept of it.
+  std::vector<Vec3> flat = points;
+  for (Vec3& p : flat) p.z() = 0;
+  EXPECT_FALSE(Shape::create(HullDef{flat}));
+  EXPECT_FALSE(Shape::create(HullDef{flat}));
 }
 
 TEST(Bodies, RefusesBadDefinitionsNamingTheField) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "box_polyhedra.h"
+#include "hull_polyhedra.h"
 #include "mass_integrals.h"
 #include "physics/compound.h"
 #include "physics/shape.h"
@@ -68,10 +69,10 @@ Result<Shape> Shape::create(const ShapeDef& def) {
       return Status::error("points: " + std::to_string(hull->points.size()) +
                            " points, more than the " + std::to_string(kMaxHullPoints) +
                            " a hull may have");
-    Result<ConvexPolyhedron> built = build_convex_hull(hull->points);
+    Result<std::shared_ptr<const ConvexPolyhedron>> built = shared_hull_polyhedron(hull->points);
     if (!built) return built.status();
     shape.type_ = ShapeType::kHull;
-    shape.polyhedron_ = std::make_shared<ConvexPolyhedron>(std::move(built).value());
+    shape.polyhedron_ = std::move(built).value();
     const Aabb bounds = shape.local_bounds();
     shape.half_extents_ = 0.5 * bounds.extent();
   } else if (const auto* field = std::get_if<HeightFieldDef>(&def)) {
@@ -306,14 +307,8 @@ Vec3 Shape::support(const Vec3& d) const {
 Shape Shape::recentred(const Vec3& offset) const {
   if (type_ == ShapeType::kCompound && !offset.isZero(0)) return compound_->recentred(offset);
   if (type_ != ShapeType::kHull || offset.isZero(0)) return *this;
-  auto moved = std::make_shared<ConvexPolyhedron>(*polyhedron_);
-  for (Vec3& v : moved->vertices)
-    v -= offset;
-  for (auto& face : moved->faces)
-    face.offset -= face.normal.dot(offset);
-  moved->centroid -= offset;
   Shape shape = *this;
-  shape.polyhedron_ = std::move(moved);
+  shape.polyhedron_ = shared_moved_polyhedron(polyhedron_, offset);
   shape.update_radii();
   return shape;
 }
