@@ -17,12 +17,14 @@
 #include <vector>
 
 #include "physics/world.h"
+#include "timing.h"
 
 namespace {
 
 using tumble::BodyDef;
 using tumble::HullDef;
 using tumble::Vec3;
+using tumble::bench::median;
 
 // A rock: `count` points on a lumpy ellipsoid (every point a vertex of the hull or near one).
 std::vector<Vec3> rock(std::mt19937_64& random, int count) {
@@ -67,11 +69,6 @@ Result create(const std::vector<std::vector<Vec3>>& rocks, int bodies) {
   return {1e6 * seconds / bodies, (heap_kb() - before_kb) / bodies};
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -84,8 +81,8 @@ int main(int argc, char** argv) {
   std::printf(
       "%d hull bodies created in one batch, %d rounds, one thread: median us and KB a body\n",
       bodies, rounds);
-  std::printf("%-8s %-10s %12s %12s %12s %12s %10s\n", "points", "", "alike us", "distinct us",
-              "alike KB", "distinct KB", "ratio");
+  std::printf("%-8s %12s %12s %12s %12s %10s\n", "points", "alike us", "distinct us", "alike KB",
+              "distinct KB", "ratio");
   for (const int points : {64, 1024}) {
     std::mt19937_64 random(20261205);
     const std::vector<std::vector<Vec3>> one{rock(random, points)};
@@ -101,7 +98,7 @@ int main(int argc, char** argv) {
       alike_kb.push_back(a.kb_per_body);
       distinct_kb.push_back(d.kb_per_body);
     }
-    std::printf("%-8d %-10s %12.2f %12.2f %12.2f %12.2f %9.3fx\n", points, "", median(alike_us),
+    std::printf("%-8d %12.2f %12.2f %12.2f %12.2f %9.3fx\n", points, median(alike_us),
                 median(distinct_us), median(alike_kb), median(distinct_kb),
                 median(alike_us) / median(distinct_us));
   }

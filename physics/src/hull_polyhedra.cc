@@ -1,6 +1,5 @@
 #include "hull_polyhedra.h"
 
-#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -9,6 +8,8 @@
 #include <mutex>
 #include <vector>
 
+#include "weak_table.h"
+
 namespace tumble {
 namespace {
 
@@ -16,15 +17,6 @@ namespace {
 // order totally where a NaN would break the map (build_convex_hull refuses it anyway).
 std::uint64_t bits(double x) {
   return std::bit_cast<std::uint64_t>(x);
-}
-
-// Entries of freed polyhedra are swept when a map has doubled since its last sweep: a client making
-// ever new rocks and removing them holds a map to twice the live ones.
-template <class Map, class Dead>
-void sweep(Map& map, std::size_t& swept_at, Dead dead) {
-  if (map.size() < 2 * swept_at) return;
-  std::erase_if(map, dead);
-  swept_at = std::max<std::size_t>(kSweptAtLeast, map.size());
 }
 
 std::size_t bytes_of(const ConvexPolyhedron& p) {
@@ -72,7 +64,7 @@ Result<std::shared_ptr<const ConvexPolyhedron>> shared_hull_polyhedron(
     recent_bytes -= bytes_of(*recent.front());
     recent.pop_front();
   }
-  sweep(live, swept_at, [](const auto& item) { return item.second.expired(); });
+  sweep_when_doubled(live, swept_at, [](const auto& item) { return item.second.expired(); });
   return made;
 }
 
@@ -100,7 +92,7 @@ std::shared_ptr<const ConvexPolyhedron> shared_moved_polyhedron(
     face.offset -= face.normal.dot(offset);
   moved->centroid -= offset;
   entry = {source, moved};
-  sweep(live, swept_at, [](const auto& item) { return item.second.moved.expired(); });
+  sweep_when_doubled(live, swept_at, [](const auto& item) { return item.second.moved.expired(); });
   return moved;
 }
 

@@ -18,8 +18,6 @@ namespace tumble {
 // about 1 MB however many different rocks a client makes.
 inline constexpr std::size_t kRecentHulls = 64;
 inline constexpr std::size_t kRecentHullBytes = std::size_t{1} << 20;
-// The maps of live entries are swept no smaller than this.
-inline constexpr std::size_t kSweptAtLeast = 64;
 
 // build_convex_hull(points)'s polyhedron, shared with every other live hull made from exactly
 // the same points (bit for bit, in the same order, so the shared hull is the one these points
